@@ -1,0 +1,245 @@
+//! The one configuration type. Every width in the model, the ROM contents, the templates,
+//! the vectors and the testbenches is read from a validated [`Config`]; derived widths are
+//! methods here so that no width is computed in two places.
+
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// Parameters of one reflectance-map shader. Construct with [`Config::default`] (the paper's
+/// design) or load from TOML, then call [`Config::validate`] (loaders do it for you).
+#[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Config {
+    /// Width of each two's-complement gradient component at the input.
+    pub grad_bits: u32,
+    /// Width of the magnitudes after sort & shift (leading zeros out, then truncated).
+    pub red_bits: u32,
+    /// Width of one reciprocal-ROM entry.
+    pub recip_bits: u32,
+    /// Width of the normalised fractions u, v; the compensation ROM has 2^frac_bits entries.
+    pub frac_bits: u32,
+    /// Map index bits per component (per sign half): 2^index_bits entries span 0..45 degrees.
+    pub index_bits: u32,
+    /// Interpolation fraction bits per component (0 when interpolation is off).
+    pub interp_bits: u32,
+    /// Width of one reflectance-map entry and of the output intensity.
+    pub map_bits: u32,
+    /// Distortion compensation (atan ROM) on, or a linear index mapping when off.
+    pub compensation: bool,
+    /// Bilinear interpolation of four neighbours on, or nearest entry when off.
+    pub interpolation: bool,
+    /// Multiply an 8-bit RGB sample colour by the intensity.
+    pub color: bool,
+}
+
+/// Width of each channel of the optional sample colour.
+pub const COLOR_BITS: u32 = 8;
+
+/// Allowed range of every width field, in one table so errors, `--help` and the README agree.
+pub const RANGES: &[(&str, u32, u32)] = &[
+    ("grad_bits", 8, 16),
+    ("red_bits", 6, 12),
+    ("recip_bits", 4, 20),
+    ("frac_bits", 4, 12),
+    ("index_bits", 2, 6),
+    ("interp_bits", 0, 5),
+    ("map_bits", 6, 12),
+];
+
+#[derive(Debug, thiserror::Error, PartialEq, Eq)]
+pub enum ConfigError {
+    #[error("{field} = {value} is out of range; allowed {min}..={max}")]
+    OutOfRange { field: &'static str, value: u32, min: u32, max: u32 },
+    #[error("{0}")]
+    Conflict(String),
+}
+
+impl Default for Config {
+    /// The paper's configuration: 12-bit gradients, 8-bit reduced magnitudes and fractions,
+    /// a 256-entry compensation ROM with 6-bit entries (3 index + 3 interpolation bits) and
+    /// three 512-byte maps.
+    fn default() -> Self {
+        Config {
+            grad_bits: 12,
+            red_bits: 8,
+            recip_bits: 10,
+            frac_bits: 8,
+            index_bits: 3,
+            interp_bits: 3,
+            map_bits: 8,
+            compensation: true,
+            interpolation: true,
+            color: false,
+        }
+    }
+}
+
+impl Config {
+    pub fn field(&self, name: &str) -> u32 {
+        match name {
+            "grad_bits" => self.grad_bits,
+            "red_bits" => self.red_bits,
+            "recip_bits" => self.recip_bits,
+            "frac_bits" => self.frac_bits,
+            "index_bits" => self.index_bits,
+            "interp_bits" => self.interp_bits,
+            "map_bits" => self.map_bits,
+            _ => unreachable!("no width field {name}"),
+        }
+    }
+
+    /// Checks every range and every constraint between fields.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        for &(field, min, max) in RANGES {
+            let value = self.field(field);
+            if value < min || value > max {
+                return Err(ConfigError::OutOfRange { field, value, min, max });
+            }
+        }
+        let c = |s: String| Err(ConfigError::Conflict(s));
+        if self.red_bits > self.grad_bits {
+            return c(format!(
+                "red_bits = {} exceeds grad_bits = {}; the reduced magnitude cannot be wider than the gradient",
+                self.red_bits, self.grad_bits
+            ));
+        }
+        if self.recip_bits < self.frac_bits + 1 {
+            return c(format!(
+                "recip_bits = {} must be at least frac_bits + 1 = {} so the normalised fraction keeps its precision",
+                self.recip_bits,
+                self.frac_bits + 1
+            ));
+        }
+        if self.interpolation && self.interp_bits == 0 {
+            return c("interp_bits = 0 with interpolation on; give interp_bits >= 1 or turn interpolation off".into());
+        }
+        if !self.interpolation && self.interp_bits != 0 {
+            return c(format!(
+                "interp_bits = {} with interpolation off; interp_bits must be 0 when interpolation is off",
+                self.interp_bits
+            ));
+        }
+        Ok(())
+    }
+
+    /// Loads and validates a TOML configuration file.
+    pub fn from_toml_file(path: &Path) -> anyhow::Result<Config> {
+        use anyhow::Context;
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read config {}", path.display()))?;
+        let cfg: Config = toml::from_str(&text)
+            .map_err(|e| anyhow::anyhow!("{}", e.message()))
+            .with_context(|| format!("malformed config {}", path.display()))?;
+        cfg.validate().with_context(|| format!("invalid config {}", path.display()))?;
+        Ok(cfg)
+    }
+
+    /// Magnitude width: |-(2^(G-1))| needs all G bits.
+    pub fn mag_bits(&self) -> u32 {
+        self.grad_bits
+    }
+    /// Map entries per component per sign half.
+    pub fn entries(&self) -> u32 {
+        1 << self.index_bits
+    }
+    /// One interpolation step, 2^interp_bits.
+    pub fn step(&self) -> u32 {
+        1 << self.interp_bits
+    }
+    /// Largest position: the outer entry, (entries - 1) * step.
+    pub fn pos_max(&self) -> u32 {
+        (self.entries() - 1) * self.step()
+    }
+    /// Width of a position (index and fraction together), as stored in the compensation ROM.
+    pub fn pos_bits(&self) -> u32 {
+        self.index_bits + self.interp_bits
+    }
+    /// Width of an interpolation weight, 0..=step.
+    pub fn weight_bits(&self) -> u32 {
+        self.interp_bits + 1
+    }
+    /// Entries in the reciprocal ROM: the reduced max always has its MSB set.
+    pub fn recip_entries(&self) -> u32 {
+        1 << (self.red_bits - 1)
+    }
+    /// Right shift that turns a * recip into a frac_bits fraction.
+    pub fn norm_shift(&self) -> u32 {
+        self.red_bits - 1 + self.recip_bits - self.frac_bits
+    }
+    /// Address width of one axis map: {s_max, s_u, i_u, s_v, i_v}.
+    pub fn map_addr_bits(&self) -> u32 {
+        3 + 2 * self.index_bits
+    }
+    /// Entries of one axis map.
+    pub fn map_entries(&self) -> u32 {
+        1 << self.map_addr_bits()
+    }
+    /// Bits of all three maps (one buffer).
+    pub fn map_total_bits(&self) -> u64 {
+        3 * self.map_entries() as u64 * self.map_bits as u64
+    }
+    /// Bits of the fixed ROMs (reciprocal and, when on, compensation).
+    pub fn rom_total_bits(&self) -> u64 {
+        let recip = self.recip_entries() as u64 * self.recip_bits as u64;
+        let atan = if self.compensation {
+            (1u64 << self.frac_bits) * self.pos_bits() as u64
+        } else {
+            0
+        };
+        recip + atan
+    }
+    pub fn map_max(&self) -> u32 {
+        (1 << self.map_bits) - 1
+    }
+    pub fn frac_max(&self) -> u32 {
+        (1 << self.frac_bits) - 1
+    }
+    /// A short, stable description used in headers and file names.
+    pub fn summary(&self) -> String {
+        format!(
+            "G{} R{} W{} F{} I{} P{} M{} comp={} interp={} color={}",
+            self.grad_bits,
+            self.red_bits,
+            self.recip_bits,
+            self.frac_bits,
+            self.index_bits,
+            self.interp_bits,
+            self.map_bits,
+            self.compensation as u8,
+            self.interpolation as u8,
+            self.color as u8
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_is_valid_and_is_the_papers_size() {
+        let c = Config::default();
+        c.validate().unwrap();
+        assert_eq!(c.map_entries(), 512);
+        assert_eq!(c.map_total_bits(), 3 * 512 * 8);
+        assert_eq!(c.pos_bits(), 6);
+        assert_eq!(c.pos_max(), 56);
+    }
+
+    #[test]
+    fn out_of_range_names_field() {
+        let c = Config { grad_bits: 20, ..Config::default() };
+        let e = c.validate().unwrap_err().to_string();
+        assert!(e.contains("grad_bits = 20") && e.contains("8..=16"), "{e}");
+    }
+
+    #[test]
+    fn conflicts_say_how() {
+        let c = Config { red_bits: 12, grad_bits: 10, ..Config::default() };
+        assert!(c.validate().unwrap_err().to_string().contains("exceeds grad_bits"));
+        let c = Config { interpolation: false, ..Config::default() };
+        assert!(c.validate().unwrap_err().to_string().contains("interpolation is off"));
+        let c = Config { interp_bits: 0, ..Config::default() };
+        assert!(c.validate().unwrap_err().to_string().contains("interpolation on"));
+    }
+}

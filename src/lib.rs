@@ -1,0 +1,6 @@
+//! rmapgen: a generator of synthesizable Verilog for the on-chip reflectance-map shader of
+//! Terwisscha van Scheltinga, Smit and Bosma, with the bit-accurate model that checks it.
+
+pub mod config;
+pub mod model;
+pub mod scene;

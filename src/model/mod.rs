@@ -1,0 +1,104 @@
+//! The bit-accurate model: one module per pipeline stage, each a pure function on integers
+//! of its hardware widths. [`Model::trace`] runs a sample through every stage and keeps every
+//! intermediate value (the per-stage test vectors are written from it); [`Model::shade`] is
+//! the same computation returning only the output.
+
+pub mod atan_rom;
+pub mod color_mul;
+pub mod interpolate;
+pub mod linear_index;
+pub mod map_lookup;
+pub mod normalise;
+pub mod recip_rom;
+pub mod reflectance_map;
+pub mod sort_shift;
+pub mod zero_detect;
+
+use crate::config::Config;
+pub use reflectance_map::Maps;
+
+/// The fixed ROMs of one configuration, built once.
+#[derive(Clone, Debug)]
+pub struct Model {
+    pub cfg: Config,
+    pub recip: Vec<u32>,
+    /// Present only with distortion compensation.
+    pub atan: Option<Vec<u32>>,
+}
+
+/// Every intermediate value of one sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Hash)]
+pub struct Trace {
+    pub zero: bool,
+    pub sort: sort_shift::SortShift,
+    pub norm: normalise::Normalise,
+    /// Positions after the atan ROM or the linear index.
+    pub p_u: u32,
+    pub p_v: u32,
+    pub lookup: map_lookup::Lookup,
+    /// Interpolated (or nearest) intensity before the zero flag is applied.
+    pub interp: u32,
+    pub out: Output,
+}
+
+/// What the pipeline delivers for one sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Hash)]
+pub struct Output {
+    /// Set for an all-zero gradient; intensity and colour are then 0.
+    pub zero: bool,
+    pub intensity: u32,
+    /// Colour times intensity; [0; 3] when colour multiply is off.
+    pub rgb: [u32; 3],
+}
+
+impl Model {
+    /// Builds the ROMs for a configuration; panics if it has not been validated.
+    pub fn new(cfg: &Config) -> Model {
+        cfg.validate().expect("Model::new needs a validated Config");
+        Model {
+            cfg: cfg.clone(),
+            recip: recip_rom::contents(cfg),
+            atan: cfg.compensation.then(|| atan_rom::contents(cfg)),
+        }
+    }
+
+    /// The position stage: atan ROM, or linear index without compensation.
+    #[inline]
+    pub fn position(&self, u: u32) -> u32 {
+        match &self.atan {
+            Some(rom) => rom[u as usize],
+            None => linear_index::eval(&self.cfg, u),
+        }
+    }
+
+    /// Runs one sample through every stage. `rgb` is ignored when colour multiply is off.
+    pub fn trace(&self, maps: &Maps, g: [i32; 3], rgb: [u32; 3]) -> Trace {
+        let cfg = &self.cfg;
+        let zero = zero_detect::eval(g);
+        let sort = sort_shift::eval(cfg, g);
+        let norm = normalise::eval(cfg, &self.recip, sort.m, sort.a, sort.b);
+        let p_u = self.position(norm.u);
+        let p_v = self.position(norm.v);
+        let lookup = map_lookup::eval(cfg, maps, sort.axis, sort.s_max, sort.s_u, sort.s_v, p_u, p_v);
+        let interp = if cfg.interpolation {
+            interpolate::eval(cfg, lookup.e, lookup.w_u, lookup.w_v)
+        } else {
+            lookup.e[0]
+        };
+        let intensity = if zero { 0 } else { interp };
+        let rgb = if cfg.color { color_mul::eval(cfg, rgb, intensity) } else { [0; 3] };
+        Trace { zero, sort, norm, p_u, p_v, lookup, interp, out: Output { zero, intensity, rgb } }
+    }
+
+    /// The output of one sample.
+    #[inline]
+    pub fn shade(&self, maps: &Maps, g: [i32; 3], rgb: [u32; 3]) -> Output {
+        self.trace(maps, g, rgb).out
+    }
+
+    /// Intensity only (no colour), the hot path of renders and benchmarks.
+    #[inline]
+    pub fn intensity(&self, maps: &Maps, g: [i32; 3]) -> u32 {
+        self.trace(maps, g, [0; 3]).out.intensity
+    }
+}
