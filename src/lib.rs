@@ -1,6 +1,9 @@
 //! rmapgen: a generator of synthesizable Verilog for the on-chip reflectance-map shader of
 //! Terwisscha van Scheltinga, Smit and Bosma, with the bit-accurate model that checks it.
 
+pub mod cmd;
 pub mod config;
+pub mod hexfile;
 pub mod model;
+pub mod output;
 pub mod scene;

@@ -1,0 +1,36 @@
+//! `rmapgen roms`: the ROM and map contents as `$readmemh` files, nothing else.
+
+use super::config_args::ConfigArgs;
+use crate::hexfile;
+use crate::output::StagedDir;
+use crate::scene::Scene;
+use anyhow::Result;
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct RomsArgs {
+    #[command(flatten)]
+    pub cfg: ConfigArgs,
+    /// Scene whose light model fills the maps [default: the standard scene].
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
+    /// Output directory (replaced whole on success).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+}
+
+pub fn run(a: &RomsArgs) -> Result<()> {
+    let cfg = a.cfg.resolve()?;
+    let scene = match &a.scene {
+        Some(p) => Scene::from_toml_file(p)?,
+        None => Scene::standard(),
+    };
+    let out = StagedDir::new(&a.out)?;
+    for (name, text) in hexfile::all(&cfg, &scene) {
+        out.write_text(&name, &text)?;
+    }
+    let p = out.commit()?;
+    eprintln!("rmapgen: wrote ROM and map hex files to {}", p.display());
+    Ok(())
+}
