@@ -7,3 +7,5 @@ pub mod hexfile;
 pub mod model;
 pub mod output;
 pub mod scene;
+pub mod tb;
+pub mod vectors;

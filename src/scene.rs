@@ -64,6 +64,10 @@ fn one() -> f64 {
 /// The standard scene of the README and the tests, as shipped in `scenes/standard.toml`.
 pub const STANDARD_TOML: &str = include_str!("../scenes/standard.toml");
 
+/// A second scene (`scenes/two_lights.toml`): the map the double-buffer tests load through the
+/// host port and swap in mid-stream.
+pub const ALTERNATE_TOML: &str = include_str!("../scenes/two_lights.toml");
+
 fn check_dir(what: &str, d: [f64; 3]) -> anyhow::Result<DVec3> {
     let v = DVec3::from_array(d);
     if !v.is_finite() {
@@ -85,6 +89,10 @@ fn check_coef(what: &str, x: f64) -> anyhow::Result<()> {
 impl Scene {
     pub fn standard() -> Scene {
         Scene::from_toml_str(STANDARD_TOML).expect("the standard scene is valid")
+    }
+
+    pub fn alternate() -> Scene {
+        Scene::from_toml_str(ALTERNATE_TOML).expect("the alternate scene is valid")
     }
 
     pub fn from_toml_str(text: &str) -> anyhow::Result<Scene> {

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Installs the simulators and synthesis tools from Debian's packages when any is missing.
+# Fails loudly (exit 1) when it cannot: the tests must never skip a simulator silently.
+set -euo pipefail
+need=()
+for t in iverilog:iverilog vvp:iverilog verilator:verilator yosys:yosys; do
+  bin=${t%%:*}; pkg=${t##*:}
+  command -v "$bin" >/dev/null 2>&1 || need+=("$pkg")
+done
+if [ "${WITH_FPGA:-0}" = 1 ]; then
+  command -v nextpnr-ice40 >/dev/null 2>&1 || need+=(nextpnr-ice40)
+  command -v icepack >/dev/null 2>&1 || need+=(fpga-icestorm)
+fi
+if [ ${#need[@]} -eq 0 ]; then
+  exit 0
+fi
+mapfile -t need < <(printf '%s\n' "${need[@]}" | sort -u)
+echo "install-tools: installing ${need[*]} with apt-get"
+SUDO=
+if [ "$(id -u)" != 0 ]; then
+  command -v sudo >/dev/null 2>&1 || { echo "install-tools: need root or sudo to install ${need[*]}" >&2; exit 1; }
+  SUDO=sudo
+fi
+$SUDO apt-get update -qq || { echo "install-tools: apt-get update failed" >&2; exit 1; }
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${need[@]}" >/dev/null \
+  || { echo "install-tools: apt-get install ${need[*]} failed" >&2; exit 1; }
+for t in iverilog vvp verilator yosys; do
+  command -v "$t" >/dev/null 2>&1 || { echo "install-tools: $t still missing after install" >&2; exit 1; }
+done
+echo "install-tools: $(iverilog -V 2>&1 | head -1); $(verilator --version); $(yosys -V)"

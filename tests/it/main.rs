@@ -1,0 +1,3 @@
+//! One integration-test binary; modules mirror the source tree.
+
+mod helpers;
