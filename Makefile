@@ -26,7 +26,7 @@ tools:
 	@scripts/install-tools.sh
 
 cargo-test:
-	$(CARGO) test --release
+	$(CARGO) test
 
 roms: build
 	$(RMAPGEN) roms --out $(OUT)/roms
