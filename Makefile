@@ -32,3 +32,48 @@ roms: build
 	$(RMAPGEN) roms --out $(OUT)/roms
 
 test: tools cargo-test
+
+# ---- Simulation (tb/run_sims.sh): every testbench of $(OUT), generated with $(GEN_FLAGS),
+# under Verilator (sim), Icarus (sim-icarus) or both (sim-all); build products in build/sim/.
+# sim-matrix runs both simulators over the configuration list of tb/sim_matrix.sh.
+GEN_FLAGS     ?=
+SIM_STREAM    ?= 1000000
+SIM_TB_STREAM ?= 100000
+SIM_ENV        = IVERILOG=$(IVERILOG) VVP=$(VVP) VERILATOR=$(VERILATOR) RMAPGEN=$(abspath $(RMAPGEN))
+
+.PHONY: sim sim-icarus sim-all sim-matrix sim-gen
+
+sim-gen: build
+	$(RMAPGEN) generate --out $(OUT) $(GEN_FLAGS)
+
+# Verilator: every testbench, the top's on $(SIM_TB_STREAM) more vectors, and the C++ harness
+# on $(SIM_STREAM) random vectors.
+sim: sim-gen
+	$(SIM_ENV) tb/run_sims.sh --verilator --stream $(SIM_STREAM) --tb-stream $(SIM_TB_STREAM) $(OUT)
+
+sim-icarus: sim-gen
+	$(SIM_ENV) tb/run_sims.sh --icarus --tb-stream $(SIM_TB_STREAM) $(OUT)
+
+sim-all: sim-gen
+	$(SIM_ENV) tb/run_sims.sh --icarus --verilator --stream $(SIM_STREAM) --tb-stream $(SIM_TB_STREAM) $(OUT)
+
+sim-matrix: build
+	$(SIM_ENV) STREAM=$(SIM_STREAM) tb/sim_matrix.sh
+
+# ---- Design (src/rtl, templates/): the default design into $(OUT); Verilator lint of its
+# .v files (testbenches excluded; any warning fails); Yosys synthesis of rmap_top for the
+# iCE40 (any latch fails; prints cells, memory bits and SB_RAM40_4K; logs in $(SYNTH_DIR)).
+SYNTH_DIR ?= build/synth
+
+.PHONY: generate lint synth
+
+generate: build
+	$(RMAPGEN) generate --out $(OUT)
+
+lint:
+	@test -f $(OUT)/rmap_top.v || { echo "lint: no $(OUT)/rmap_top.v; run 'make generate'" >&2; exit 1; }
+	cd $(OUT) && $(VERILATOR) --lint-only -Wall --top-module rmap_top *.v
+	@echo "lint: $(OUT) is clean (verilator -Wall, no warnings)"
+
+synth:
+	YOSYS=$(YOSYS) scripts/synth.sh $(OUT) $(SYNTH_DIR)

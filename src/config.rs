@@ -46,10 +46,20 @@ pub const RANGES: &[(&str, u32, u32)] = &[
     ("map_bits", 6, 12),
 ];
 
+/// Bits needed to write `v` in binary (at least 1).
+pub fn bit_length(v: u64) -> u32 {
+    (64 - v.leading_zeros()).max(1)
+}
+
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]
 pub enum ConfigError {
     #[error("{field} = {value} is out of range; allowed {min}..={max}")]
-    OutOfRange { field: &'static str, value: u32, min: u32, max: u32 },
+    OutOfRange {
+        field: &'static str,
+        value: u32,
+        min: u32,
+        max: u32,
+    },
     #[error("{0}")]
     Conflict(String),
 }
@@ -93,7 +103,12 @@ impl Config {
         for &(field, min, max) in RANGES {
             let value = self.field(field);
             if value < min || value > max {
-                return Err(ConfigError::OutOfRange { field, value, min, max });
+                return Err(ConfigError::OutOfRange {
+                    field,
+                    value,
+                    min,
+                    max,
+                });
             }
         }
         let c = |s: String| Err(ConfigError::Conflict(s));
@@ -130,7 +145,8 @@ impl Config {
         let cfg: Config = toml::from_str(&text)
             .map_err(|e| anyhow::anyhow!("{}", e.message()))
             .with_context(|| format!("malformed config {}", path.display()))?;
-        cfg.validate().with_context(|| format!("invalid config {}", path.display()))?;
+        cfg.validate()
+            .with_context(|| format!("invalid config {}", path.display()))?;
         Ok(cfg)
     }
 
@@ -191,6 +207,92 @@ impl Config {
     pub fn map_max(&self) -> u32 {
         (1 << self.map_bits) - 1
     }
+
+    // Widths and constants of the generated RTL (src/rtl, templates/). Each is defined here
+    // once; the templates only name them.
+
+    /// Width of sort & shift's left-shift count, which runs 0..grad_bits-1.
+    pub fn shift_bits(&self) -> u32 {
+        bit_length(self.grad_bits as u64 - 1)
+    }
+    /// Reciprocal-ROM address width: the reduced max's bits below its MSB.
+    pub fn recip_addr_bits(&self) -> u32 {
+        self.red_bits - 1
+    }
+    /// Width of a * recip plus the rounding constant in normalise (never overflows).
+    pub fn norm_sum_bits(&self) -> u32 {
+        self.red_bits + self.recip_bits + 1
+    }
+    /// Normalise's rounding constant, half an LSB of the fraction: 2^(norm_shift - 1).
+    pub fn norm_half(&self) -> u64 {
+        1 << (self.norm_shift() - 1)
+    }
+    /// Normalise multiplies a * recip as two registered halves of a: the low half's width.
+    pub fn norm_split_bits(&self) -> u32 {
+        self.red_bits / 2
+    }
+    /// Entries of the compensation (atan) ROM: one per fraction code.
+    pub fn atan_entries(&self) -> u32 {
+        1 << self.frac_bits
+    }
+    /// Width of u * pos_max plus the rounding constant in the linear index.
+    pub fn linear_sum_bits(&self) -> u32 {
+        self.frac_bits + self.pos_bits()
+    }
+    /// The linear index's rounding constant, half a fraction LSB scaled: 2^(frac_bits - 1).
+    pub fn frac_half(&self) -> u64 {
+        1 << (self.frac_bits - 1)
+    }
+    /// Largest base entry of an interpolation: the outer entry is never a base.
+    pub fn base_max(&self) -> u32 {
+        self.entries() - 2
+    }
+    /// Width of the interpolator's first pass a = e * step + (e' - e) * w, 0..=map_max * step.
+    pub fn interp_a_bits(&self) -> u32 {
+        self.map_bits + self.interp_bits
+    }
+    /// Width of the second pass r (before rounding), 0..=map_max * step^2, plus half.
+    pub fn interp_r_bits(&self) -> u32 {
+        self.map_bits + 2 * self.interp_bits
+    }
+    /// The interpolator's rounding constant, step^2 / 2 (needs interp_bits >= 1).
+    pub fn interp_half(&self) -> u64 {
+        1 << (2 * self.interp_bits - 1)
+    }
+    /// Map RAM banks: four (by the parities of i_u and i_v) with interpolation, else one.
+    pub fn bank_count(&self) -> u32 {
+        if self.interpolation {
+            4
+        } else {
+            1
+        }
+    }
+    /// Width of an entry index inside a bank: i >> 1 with four banks, i with one.
+    pub fn bank_index_bits(&self) -> u32 {
+        if self.interpolation {
+            self.index_bits - 1
+        } else {
+            self.index_bits
+        }
+    }
+    /// Bank address {buf, axis[1:0], s_max, s_u, i_u', s_v, i_v'}: 6 + 2 * bank_index_bits
+    /// (2 * index_bits + 4 with four banks, 2 * index_bits + 6 with one).
+    pub fn bank_addr_bits(&self) -> u32 {
+        6 + 2 * self.bank_index_bits()
+    }
+    /// Entries of one bank (both buffers, four axis slots of which three are used).
+    pub fn bank_entries(&self) -> u32 {
+        1 << self.bank_addr_bits()
+    }
+    /// Bits of all map banks together.
+    pub fn bank_total_bits(&self) -> u64 {
+        self.bank_count() as u64 * self.bank_entries() as u64 * self.map_bits as u64
+    }
+    /// Width of the colour multiplier's product numerator * K: the quotient (at most 255)
+    /// sits above the shift S, so nothing wider is ever non-zero.
+    pub fn color_product_bits(&self) -> u32 {
+        crate::model::color_mul::constants(self).1 + COLOR_BITS
+    }
     pub fn frac_max(&self) -> u32 {
         (1 << self.frac_bits) - 1
     }
@@ -228,18 +330,43 @@ mod tests {
 
     #[test]
     fn out_of_range_names_field() {
-        let c = Config { grad_bits: 20, ..Config::default() };
+        let c = Config {
+            grad_bits: 20,
+            ..Config::default()
+        };
         let e = c.validate().unwrap_err().to_string();
         assert!(e.contains("grad_bits = 20") && e.contains("8..=16"), "{e}");
     }
 
     #[test]
     fn conflicts_say_how() {
-        let c = Config { red_bits: 12, grad_bits: 10, ..Config::default() };
-        assert!(c.validate().unwrap_err().to_string().contains("exceeds grad_bits"));
-        let c = Config { interpolation: false, ..Config::default() };
-        assert!(c.validate().unwrap_err().to_string().contains("interpolation is off"));
-        let c = Config { interp_bits: 0, ..Config::default() };
-        assert!(c.validate().unwrap_err().to_string().contains("interpolation on"));
+        let c = Config {
+            red_bits: 12,
+            grad_bits: 10,
+            ..Config::default()
+        };
+        assert!(c
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("exceeds grad_bits"));
+        let c = Config {
+            interpolation: false,
+            ..Config::default()
+        };
+        assert!(c
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("interpolation is off"));
+        let c = Config {
+            interp_bits: 0,
+            ..Config::default()
+        };
+        assert!(c
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("interpolation on"));
     }
 }

@@ -35,12 +35,22 @@ pub fn scene_maps(cfg: &Config, scene: &Scene) -> Maps {
 pub fn all(cfg: &Config, scene: &Scene) -> Vec<(String, String)> {
     let mut v = vec![(
         "recip_rom.hex".to_string(),
-        format(cfg, "reciprocal ROM", cfg.recip_bits, &recip_rom::contents(cfg)),
+        format(
+            cfg,
+            "reciprocal ROM",
+            cfg.recip_bits,
+            &recip_rom::contents(cfg),
+        ),
     )];
     if cfg.compensation {
         v.push((
             "atan_rom.hex".to_string(),
-            format(cfg, "distortion compensation (atan) ROM", cfg.pos_bits(), &atan_rom::contents(cfg)),
+            format(
+                cfg,
+                "distortion compensation (atan) ROM",
+                cfg.pos_bits(),
+                &atan_rom::contents(cfg),
+            ),
         ));
     }
     let maps = scene_maps(cfg, scene);

@@ -13,13 +13,34 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Generate the Verilog, ROM/map files, manifest, test vectors and testbenches of one
+    /// configuration.
+    ///
+    /// Ranges: grad-bits 8..=16, red-bits 6..=12 (<= grad-bits), recip-bits 4..=20
+    /// (>= frac-bits + 1), frac-bits 4..=12, index-bits 2..=6, interp-bits 0..=5 (0 exactly
+    /// when --no-interpolation), map-bits 6..=12.
+    Generate(cmd::generate::GenerateArgs),
     /// Write the ROM and map contents as $readmemh hex files.
     Roms(cmd::roms::RomsArgs),
+    /// Render the sphere test image with the model and the float reference, and measure the error.
+    Render(cmd::render::RenderArgs),
+    /// Write a large top-level vector stream for the Verilator C++ harness (tb/top_stream.cpp).
+    Vectors(cmd::vectors::VectorsArgs),
+    /// Ray cast a volume (raw, NRRD or the synthetic engine block) shaded by the model and the float reference.
+    Volume(cmd::volume::VolumeArgs),
+    /// Run the model over every gradient (--exhaustive) or a sample sweeping every magnitude,
+    /// and report the worst angular and intensity errors per magnitude class.
+    Stress(cmd::stress::StressArgs),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
+        Command::Generate(a) => cmd::generate::run(&a),
         Command::Roms(a) => cmd::roms::run(&a),
+        Command::Render(a) => cmd::render::run(&a),
+        Command::Vectors(a) => cmd::vectors::run(&a),
+        Command::Stress(a) => cmd::stress::run(&a),
+        Command::Volume(a) => cmd::volume::run(&a),
     }
 }
 

@@ -24,7 +24,10 @@ impl StagedDir {
             _ => PathBuf::from("."),
         };
         if target.exists() && !target.is_dir() {
-            anyhow::bail!("output path {} exists and is not a directory", target.display());
+            anyhow::bail!(
+                "output path {} exists and is not a directory",
+                target.display()
+            );
         }
         let staging = parent.join(format!(".{name}.staging-{}", std::process::id()));
         if staging.exists() {
@@ -32,7 +35,11 @@ impl StagedDir {
         }
         std::fs::create_dir_all(&staging)
             .with_context(|| format!("cannot write output directory {}", target.display()))?;
-        Ok(StagedDir { target: target.to_path_buf(), staging, done: false })
+        Ok(StagedDir {
+            target: target.to_path_buf(),
+            staging,
+            done: false,
+        })
     }
 
     /// Where to write files now.

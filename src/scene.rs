@@ -16,6 +16,10 @@ pub struct Scene {
     pub material: Material,
     #[serde(default, rename = "light")]
     pub lights: Vec<Light>,
+    /// Opacity transfer function for volume rendering (`rmapgen volume`); not used by the
+    /// shading itself, so sphere scenes leave it out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub transfer: Option<crate::volume::transfer::Transfer>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -35,7 +39,10 @@ fn default_view() -> [f64; 3] {
 
 impl Default for View {
     fn default() -> Self {
-        View { direction: default_view(), two_sided: false }
+        View {
+            direction: default_view(),
+            two_sided: false,
+        }
     }
 }
 
@@ -68,6 +75,30 @@ pub const STANDARD_TOML: &str = include_str!("../scenes/standard.toml");
 /// host port and swap in mid-stream.
 pub const ALTERNATE_TOML: &str = include_str!("../scenes/two_lights.toml");
 
+/// A dot product whose three products are added in ascending order, so that permuting the
+/// axes of both vectors gives the identical float result. Map entries and the reference use it
+/// so that an axis-swapped gradient under an axis-swapped scene shades bit-identically.
+#[inline]
+pub fn sym_dot(a: DVec3, b: DVec3) -> f64 {
+    let (mut p, mut q, mut r) = (a.x * b.x, a.y * b.y, a.z * b.z);
+    if p > q {
+        std::mem::swap(&mut p, &mut q);
+    }
+    if q > r {
+        std::mem::swap(&mut q, &mut r);
+    }
+    if p > q {
+        std::mem::swap(&mut p, &mut q);
+    }
+    (p + q) + r
+}
+
+/// Normalisation with [`sym_dot`]: axis permutations commute with it exactly.
+#[inline]
+pub fn sym_normalize(v: DVec3) -> DVec3 {
+    v / sym_dot(v, v).sqrt()
+}
+
 fn check_dir(what: &str, d: [f64; 3]) -> anyhow::Result<DVec3> {
     let v = DVec3::from_array(d);
     if !v.is_finite() {
@@ -76,7 +107,7 @@ fn check_dir(what: &str, d: [f64; 3]) -> anyhow::Result<DVec3> {
     if v.length() < 1e-12 {
         anyhow::bail!("{what} {d:?} has zero length");
     }
-    Ok(v.normalize())
+    Ok(sym_normalize(v))
 }
 
 fn check_coef(what: &str, x: f64) -> anyhow::Result<()> {
@@ -96,13 +127,15 @@ impl Scene {
     }
 
     pub fn from_toml_str(text: &str) -> anyhow::Result<Scene> {
-        let s: Scene = toml::from_str(text).map_err(|e| anyhow::anyhow!("{}", e.message().trim()))?;
+        let s: Scene =
+            toml::from_str(text).map_err(|e| anyhow::anyhow!("{}", e.message().trim()))?;
         s.validate()?;
         Ok(s)
     }
 
     pub fn from_toml_file(path: &Path) -> anyhow::Result<Scene> {
-        let text = std::fs::read_to_string(path).with_context(|| format!("cannot read scene {}", path.display()))?;
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read scene {}", path.display()))?;
         Scene::from_toml_str(&text).with_context(|| format!("bad scene {}", path.display()))
     }
 
@@ -117,6 +150,9 @@ impl Scene {
             check_dir(&format!("light {} direction", i + 1), l.direction)?;
             check_coef(&format!("light {} intensity", i + 1), l.intensity)?;
         }
+        if let Some(t) = &self.transfer {
+            t.validate()?;
+        }
         Ok(())
     }
 
@@ -128,10 +164,10 @@ impl Scene {
             .lights
             .iter()
             .filter(|l| l.intensity > 0.0 && (m.diffuse > 0.0 || m.specular > 0.0))
-            .map(|l| (DVec3::from_array(l.direction).normalize(), l.intensity))
+            .map(|l| (sym_normalize(DVec3::from_array(l.direction)), l.intensity))
             .collect();
         PreparedScene {
-            view: DVec3::from_array(self.view.direction).normalize(),
+            view: sym_normalize(DVec3::from_array(self.view.direction)),
             two_sided: self.view.two_sided,
             ambient: m.ambient,
             diffuse: m.diffuse,
@@ -168,16 +204,20 @@ impl PreparedScene {
     /// + specular * max(0, r.v)^shininess), r = 2 (n.l) n - l, specular only where n.l > 0.
     #[inline]
     pub fn shade(&self, n: DVec3) -> f64 {
-        let n = if self.two_sided && n.dot(self.view) < 0.0 { -n } else { n };
+        let n = if self.two_sided && sym_dot(n, self.view) < 0.0 {
+            -n
+        } else {
+            n
+        };
         let mut i = self.ambient;
         for &(l, li) in &self.lights {
-            let nl = n.dot(l);
+            let nl = sym_dot(n, l);
             if nl <= 0.0 {
                 continue;
             }
             let mut c = self.diffuse * nl;
             if self.specular > 0.0 {
-                let rv = (2.0 * nl * n - l).dot(self.view);
+                let rv = sym_dot(2.0 * nl * n - l, self.view);
                 if rv > 0.0 {
                     c += self.specular * rv.powf(self.shininess);
                 }
@@ -210,5 +250,20 @@ mod tests {
         assert!(bad(&format!("{mat}[[light]]\ndirection=[nan,0,1]\n")).contains("not finite"));
         assert!(bad(&mat.replace("shininess=20", "shininess=-1")).contains("shininess"));
         assert!(bad("[material\n").len() > 3);
+    }
+
+    #[test]
+    fn optional_transfer_function() {
+        assert_eq!(Scene::standard().transfer, None);
+        let mat = "[material]\nambient=0.1\ndiffuse=0.6\nspecular=0.3\nshininess=20\n";
+        let s =
+            Scene::from_toml_str(&format!("{mat}[transfer]\npoints=[[10,0],[20,1]]\n")).unwrap();
+        assert_eq!(s.transfer.unwrap().points, vec![[10.0, 0.0], [20.0, 1.0]]);
+        let e = Scene::from_toml_str(&format!("{mat}[transfer]\npoints=[[20,0],[10,1]]\n"))
+            .unwrap_err();
+        assert!(e.to_string().contains("not monotonic"), "{e}");
+        assert!(
+            Scene::from_toml_str(&format!("{mat}[transfer]\npoint=[[10,0],[20,1]]\n")).is_err()
+        );
     }
 }

@@ -1,4 +1,9 @@
 //! One file per subcommand; each owns its clap arguments and its `run`.
 
 pub mod config_args;
+pub mod generate;
+pub mod render;
 pub mod roms;
+pub mod stress;
+pub mod vectors;
+pub mod volume;

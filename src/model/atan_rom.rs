@@ -32,9 +32,14 @@ pub fn contents(cfg: &Config) -> Vec<u32> {
         .collect()
 }
 
-/// The angle from the axis of a map entry's position.
+/// The tangent of a map entry's angle from the axis. The outer entry is exactly 1 (tan of
+/// FRAC_PI_4 rounds to 1 - 2^-53), so the border entries of two faces are the same direction.
 pub fn entry_tangent(cfg: &Config, index: u32) -> f64 {
-    (index as f64 / (cfg.entries() - 1) as f64 * FRAC_PI_4).tan()
+    if index == cfg.entries() - 1 {
+        1.0
+    } else {
+        (index as f64 / (cfg.entries() - 1) as f64 * FRAC_PI_4).tan()
+    }
 }
 
 #[cfg(test)]

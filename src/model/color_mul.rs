@@ -40,14 +40,21 @@ mod tests {
     #[test]
     fn equals_rounded_quotient_everywhere() {
         for map_bits in 6..=12 {
-            let cfg = Config { map_bits, ..Config::default() };
+            let cfg = Config {
+                map_bits,
+                ..Config::default()
+            };
             let d = cfg.map_max() as u64;
             let (k, s) = constants(&cfg);
             for c in 0..256u32 {
                 for i in 0..=cfg.map_max() {
                     let x = c as u64 * i as u64;
                     let exact = (2 * x + d) / (2 * d);
-                    assert_eq!(channel(&cfg, k, s, c, i) as u64, exact, "M{map_bits} c{c} i{i}");
+                    assert_eq!(
+                        channel(&cfg, k, s, c, i) as u64,
+                        exact,
+                        "M{map_bits} c{c} i{i}"
+                    );
                 }
             }
             assert_eq!(channel(&cfg, k, s, 255, cfg.map_max()), 255);

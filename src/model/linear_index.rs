@@ -25,7 +25,10 @@ mod tests {
 
     #[test]
     fn ends() {
-        let c = Config { compensation: false, ..Config::default() };
+        let c = Config {
+            compensation: false,
+            ..Config::default()
+        };
         assert_eq!(eval(&c, 0), 0);
         assert_eq!(eval(&c, 255), 56);
         assert_eq!(eval(&c, 128), 28);

@@ -38,16 +38,32 @@ pub fn split(cfg: &Config, pos: u32) -> (u32, u32) {
 
 #[inline]
 #[allow(clippy::too_many_arguments)]
-pub fn eval(cfg: &Config, maps: &Maps, axis: u32, s_max: u32, s_u: u32, s_v: u32, p_u: u32, p_v: u32) -> Lookup {
+pub fn eval(
+    cfg: &Config,
+    maps: &Maps,
+    axis: u32,
+    s_max: u32,
+    s_u: u32,
+    s_v: u32,
+    p_u: u32,
+    p_v: u32,
+) -> Lookup {
     let (base_u, w_u) = split(cfg, p_u);
     let (base_v, w_v) = split(cfg, p_v);
-    let read = |du: u32, dv: u32| maps.get(axis, addr(cfg, s_max, s_u, base_u + du, s_v, base_v + dv));
+    let read =
+        |du: u32, dv: u32| maps.get(axis, addr(cfg, s_max, s_u, base_u + du, s_v, base_v + dv));
     let e = if cfg.interpolation {
         [read(0, 0), read(1, 0), read(0, 1), read(1, 1)]
     } else {
         [read(0, 0), 0, 0, 0]
     };
-    Lookup { base_u, base_v, w_u, w_v, e }
+    Lookup {
+        base_u,
+        base_v,
+        w_u,
+        w_v,
+        e,
+    }
 }
 
 #[cfg(test)]

@@ -5,6 +5,7 @@
 
 pub mod atan_rom;
 pub mod color_mul;
+pub mod fast;
 pub mod interpolate;
 pub mod linear_index;
 pub mod map_lookup;
@@ -79,15 +80,34 @@ impl Model {
         let norm = normalise::eval(cfg, &self.recip, sort.m, sort.a, sort.b);
         let p_u = self.position(norm.u);
         let p_v = self.position(norm.v);
-        let lookup = map_lookup::eval(cfg, maps, sort.axis, sort.s_max, sort.s_u, sort.s_v, p_u, p_v);
+        let lookup = map_lookup::eval(
+            cfg, maps, sort.axis, sort.s_max, sort.s_u, sort.s_v, p_u, p_v,
+        );
         let interp = if cfg.interpolation {
             interpolate::eval(cfg, lookup.e, lookup.w_u, lookup.w_v)
         } else {
             lookup.e[0]
         };
         let intensity = if zero { 0 } else { interp };
-        let rgb = if cfg.color { color_mul::eval(cfg, rgb, intensity) } else { [0; 3] };
-        Trace { zero, sort, norm, p_u, p_v, lookup, interp, out: Output { zero, intensity, rgb } }
+        let rgb = if cfg.color {
+            color_mul::eval(cfg, rgb, intensity)
+        } else {
+            [0; 3]
+        };
+        Trace {
+            zero,
+            sort,
+            norm,
+            p_u,
+            p_v,
+            lookup,
+            interp,
+            out: Output {
+                zero,
+                intensity,
+                rgb,
+            },
+        }
     }
 
     /// The output of one sample.

@@ -29,7 +29,11 @@ pub fn lane(cfg: &Config, c: u32, m: u32, recip: u32) -> u32 {
 #[inline]
 pub fn eval(cfg: &Config, recip_rom: &[u32], m: u32, a: u32, b: u32) -> Normalise {
     let recip = recip_rom[recip_rom::addr(cfg, m) as usize];
-    Normalise { recip, u: lane(cfg, a, m, recip), v: lane(cfg, b, m, recip) }
+    Normalise {
+        recip,
+        u: lane(cfg, a, m, recip),
+        v: lane(cfg, b, m, recip),
+    }
 }
 
 #[cfg(test)]

@@ -48,11 +48,19 @@ mod tests {
     fn entries_within_bound() {
         for red_bits in 6..=12 {
             for recip_bits in [8, 10, 14, 20] {
-                let c = crate::config::Config { red_bits, recip_bits, frac_bits: 7, ..Default::default() };
+                let c = crate::config::Config {
+                    red_bits,
+                    recip_bits,
+                    frac_bits: 7,
+                    ..Default::default()
+                };
                 for (i, &r) in contents(&c).iter().enumerate() {
                     let i = i as u32;
                     assert!(r < 1 << recip_bits);
-                    assert!((r as f64 - exact(&c, i)).abs() <= bound(&c, i), "R{red_bits} W{recip_bits} i{i}");
+                    assert!(
+                        (r as f64 - exact(&c, i)).abs() <= bound(&c, i),
+                        "R{red_bits} W{recip_bits} i{i}"
+                    );
                 }
             }
         }

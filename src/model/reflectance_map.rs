@@ -16,7 +16,10 @@ pub struct Maps {
 impl Maps {
     pub fn from_data(cfg: &Config, data: Vec<u32>) -> Maps {
         assert_eq!(data.len(), 3 * cfg.map_entries() as usize);
-        Maps { entries_per_map: cfg.map_entries() as usize, data }
+        Maps {
+            entries_per_map: cfg.map_entries() as usize,
+            data,
+        }
     }
     #[inline]
     pub fn get(&self, axis: u32, addr: u32) -> u32 {
@@ -39,7 +42,15 @@ pub fn entry_tangent(cfg: &Config, index: u32) -> f64 {
 }
 
 /// Unit direction of one map entry, given by its axis and address fields.
-pub fn entry_direction(cfg: &Config, axis: u32, s_max: u32, s_u: u32, i_u: u32, s_v: u32, i_v: u32) -> DVec3 {
+pub fn entry_direction(
+    cfg: &Config,
+    axis: u32,
+    s_max: u32,
+    s_u: u32,
+    i_u: u32,
+    s_v: u32,
+    i_v: u32,
+) -> DVec3 {
     let sgn = |s: u32| if s == 1 { -1.0 } else { 1.0 };
     let mx = sgn(s_max);
     let u = sgn(s_u) * entry_tangent(cfg, i_u);
@@ -49,12 +60,16 @@ pub fn entry_direction(cfg: &Config, axis: u32, s_max: u32, s_u: u32, i_u: u32, 
         1 => DVec3::new(u, mx, v),
         _ => DVec3::new(u, v, mx),
     };
-    d.normalize()
+    crate::scene::sym_normalize(d)
 }
 
 /// Quantises a light-model intensity (clamped to 0..=1) to `map_bits`, half up.
 pub fn quantise(cfg: &Config, intensity: f64) -> u32 {
-    let i = if intensity.is_nan() { 0.0 } else { intensity.clamp(0.0, 1.0) };
+    let i = if intensity.is_nan() {
+        0.0
+    } else {
+        intensity.clamp(0.0, 1.0)
+    };
     (i * cfg.map_max() as f64 + 0.5).floor() as u32
 }
 

@@ -63,10 +63,23 @@ pub fn eval(cfg: &Config, g: [i32; 3]) -> SortShift {
     };
     let gbits = cfg.grad_bits;
     // Leading zeros of the max inside grad_bits; a zero vector is not shifted.
-    let shift = if max == 0 { 0 } else { max.leading_zeros() - (32 - gbits) };
+    let shift = if max == 0 {
+        0
+    } else {
+        max.leading_zeros() - (32 - gbits)
+    };
     let drop = gbits - cfg.red_bits;
     let reduce = |v: u32| (v << shift) >> drop;
-    SortShift { axis, s_max, s_u, s_v, shift, m: reduce(max), a: reduce(mu), b: reduce(mv) }
+    SortShift {
+        axis,
+        s_max,
+        s_u,
+        s_v,
+        shift,
+        m: reduce(max),
+        a: reduce(mu),
+        b: reduce(mv),
+    }
 }
 
 #[cfg(test)]
@@ -91,6 +104,9 @@ mod tests {
         assert_eq!((one.axis, one.shift, one.m, one.a), (2, 11, 0x80, 0));
         // Full-range positive max.
         let f = eval(&c, [2047, 2047, -2047]);
-        assert_eq!((f.axis, f.shift, f.m, f.a, f.b, f.s_v), (0, 1, 0xff, 0xff, 0xff, 1));
+        assert_eq!(
+            (f.axis, f.shift, f.m, f.a, f.b, f.s_v),
+            (0, 1, 0xff, 0xff, 0xff, 1)
+        );
     }
 }

@@ -29,10 +29,83 @@ pub fn assert_error(out: &Output, needle: &str) {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "exit code; stderr: {err}");
     assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
-    assert!(err.contains(needle), "stderr {err:?} should contain {needle:?}");
+    assert!(
+        err.contains(needle),
+        "stderr {err:?} should contain {needle:?}"
+    );
 }
 
 /// Whether a directory exists and has entries.
 pub fn nonempty(p: &Path) -> bool {
-    p.read_dir().map(|mut d| d.next().is_some()).unwrap_or(false)
+    p.read_dir()
+        .map(|mut d| d.next().is_some())
+        .unwrap_or(false)
+}
+
+/// Every file under `dir`, by path relative to it ('/'-separated), with its bytes.
+pub fn tree(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
+    fn walk(base: &Path, d: &Path, out: &mut std::collections::BTreeMap<String, Vec<u8>>) {
+        for e in std::fs::read_dir(d).unwrap_or_else(|e| panic!("cannot read {}: {e}", d.display()))
+        {
+            let p = e.expect("dir entry").path();
+            if p.is_dir() {
+                walk(base, &p, out);
+            } else {
+                let rel = p.strip_prefix(base).expect("under base");
+                let rel = rel
+                    .components()
+                    .map(|c| c.as_os_str().to_string_lossy())
+                    .collect::<Vec<_>>()
+                    .join("/");
+                out.insert(rel, std::fs::read(&p).expect("readable"));
+            }
+        }
+    }
+    let mut out = std::collections::BTreeMap::new();
+    walk(dir, dir, &mut out);
+    out
+}
+
+/// The first difference between two directory trees (a file missing on either side, or
+/// different bytes, with the first differing line), or None when they are byte-identical.
+pub fn first_difference(a: &Path, b: &Path) -> Option<String> {
+    let (ta, tb) = (tree(a), tree(b));
+    for (name, bytes) in &ta {
+        match tb.get(name) {
+            None => {
+                return Some(format!(
+                    "{name} is in {} but not in {}",
+                    a.display(),
+                    b.display()
+                ))
+            }
+            Some(other) if other != bytes => {
+                let (la, lb) = (
+                    String::from_utf8_lossy(bytes),
+                    String::from_utf8_lossy(other),
+                );
+                let line = la
+                    .lines()
+                    .zip(lb.lines())
+                    .position(|(x, y)| x != y)
+                    .map(|i| i + 1);
+                return Some(match line {
+                    Some(n) => format!(
+                        "{name} differs at line {n}: {:?} vs {:?}",
+                        la.lines().nth(n - 1).unwrap_or(""),
+                        lb.lines().nth(n - 1).unwrap_or("")
+                    ),
+                    None => format!(
+                        "{name} differs in length ({} vs {} bytes)",
+                        bytes.len(),
+                        other.len()
+                    ),
+                });
+            }
+            Some(_) => {}
+        }
+    }
+    tb.keys()
+        .find(|name| !ta.contains_key(*name))
+        .map(|name| format!("{name} is in {} but not in {}", b.display(), a.display()))
 }

@@ -6,15 +6,31 @@ use rmapgen::model::{atan_rom, recip_rom, Model};
 use rmapgen::scene::Scene;
 
 fn entries(text: &str) -> Vec<u32> {
-    text.lines().filter(|l| !l.starts_with("//")).map(|l| u32::from_str_radix(l, 16).unwrap()).collect()
+    text.lines()
+        .filter(|l| !l.starts_with("//"))
+        .map(|l| u32::from_str_radix(l, 16).unwrap())
+        .collect()
 }
 
 #[test]
 fn hex_files_equal_model_tables() {
-    for cfg in [Config::default(), Config { compensation: false, interpolation: false, interp_bits: 0, ..Config::default() }] {
+    for cfg in [
+        Config::default(),
+        Config {
+            compensation: false,
+            interpolation: false,
+            interp_bits: 0,
+            ..Config::default()
+        },
+    ] {
         let scene = Scene::standard();
         let files = hexfile::all(&cfg, &scene);
-        let get = |name: &str| files.iter().find(|(n, _)| n == name).map(|(_, t)| entries(t));
+        let get = |name: &str| {
+            files
+                .iter()
+                .find(|(n, _)| n == name)
+                .map(|(_, t)| entries(t))
+        };
         let model = Model::new(&cfg);
         assert_eq!(get("recip_rom.hex").unwrap(), model.recip);
         assert_eq!(get("recip_rom.hex").unwrap(), recip_rom::contents(&cfg));
@@ -24,7 +40,10 @@ fn hex_files_equal_model_tables() {
         }
         let maps = hexfile::scene_maps(&cfg, &scene);
         for (axis, n) in ["x", "y", "z"].iter().enumerate() {
-            assert_eq!(get(&format!("map_{n}.hex")).unwrap(), maps.axis(axis as u32));
+            assert_eq!(
+                get(&format!("map_{n}.hex")).unwrap(),
+                maps.axis(axis as u32)
+            );
         }
     }
 }
@@ -34,6 +53,11 @@ fn hex_digits_fit_widths() {
     let cfg = Config::default();
     for (name, text) in hexfile::all(&cfg, &Scene::standard()) {
         let w = if name.starts_with("recip") { 3 } else { 2 };
-        assert!(text.lines().filter(|l| !l.starts_with("//")).all(|l| l.len() == w), "{name}");
+        assert!(
+            text.lines()
+                .filter(|l| !l.starts_with("//"))
+                .all(|l| l.len() == w),
+            "{name}"
+        );
     }
 }

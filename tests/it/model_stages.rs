@@ -4,13 +4,23 @@
 use proptest::prelude::*;
 use rmapgen::config::Config;
 use rmapgen::model::{
-    atan_rom, interpolate, linear_index, map_lookup, normalise, recip_rom, reflectance_map, sort_shift, zero_detect,
-    Maps, Model,
+    atan_rom, interpolate, linear_index, map_lookup, normalise, recip_rom, reflectance_map,
+    sort_shift, zero_detect, Maps, Model,
 };
 
 /// Random valid configurations across every range.
 pub fn any_config() -> impl Strategy<Value = Config> {
-    (8u32..=16, 6u32..=12, 4u32..=12, 0u32..=8, 2u32..=6, 0u32..=5, 6u32..=12, any::<bool>(), any::<bool>())
+    (
+        8u32..=16,
+        6u32..=12,
+        4u32..=12,
+        0u32..=8,
+        2u32..=6,
+        0u32..=5,
+        6u32..=12,
+        any::<bool>(),
+        any::<bool>(),
+    )
         .prop_filter_map("valid", |(g, r, f, wextra, i, p, m, comp, color)| {
             let c = Config {
                 grad_bits: g,
@@ -31,7 +41,10 @@ pub fn any_config() -> impl Strategy<Value = Config> {
 fn any_grad(cfg: &Config) -> impl Strategy<Value = [i32; 3]> {
     let half = 1i32 << (cfg.grad_bits - 1);
     // Mix full-range values with small ones so every shift amount is exercised.
-    let comp = prop_oneof![-half..half, (0u32..cfg.grad_bits).prop_flat_map(|k| -(1i32 << k)..=(1i32 << k))];
+    let comp = prop_oneof![
+        -half..half,
+        (0u32..cfg.grad_bits).prop_flat_map(|k| -(1i32 << k)..=(1i32 << k))
+    ];
     [comp.clone(), comp.clone(), comp].prop_map(move |g| g.map(|v| v.clamp(-half, half - 1)))
 }
 
@@ -103,7 +116,16 @@ fn zero_detect_corners() {
 
 #[test]
 fn normalise_corners() {
-    for cfg in [Config::default(), Config { red_bits: 12, grad_bits: 16, frac_bits: 12, recip_bits: 13, ..Config::default() }] {
+    for cfg in [
+        Config::default(),
+        Config {
+            red_bits: 12,
+            grad_bits: 16,
+            frac_bits: 12,
+            recip_bits: 13,
+            ..Config::default()
+        },
+    ] {
         let rom = recip_rom::contents(&cfg);
         let top = (1u32 << cfg.red_bits) - 1;
         let low = 1u32 << (cfg.red_bits - 1);
@@ -124,7 +146,10 @@ fn check_fraction(cfg: &Config, m: u32, a: u32, u: u32) {
     if a == m {
         assert_eq!(u, cfg.frac_max());
     } else {
-        assert!((u as f64 - exact.min(cfg.frac_max() as f64)).abs() <= 1.0, "m{m} a{a} u{u} exact{exact}");
+        assert!(
+            (u as f64 - exact.min(cfg.frac_max() as f64)).abs() <= 1.0,
+            "m{m} a{a} u{u} exact{exact}"
+        );
         assert!(u <= cfg.frac_max());
     }
 }
@@ -133,7 +158,12 @@ fn check_fraction(cfg: &Config, m: u32, a: u32, u: u32) {
 fn recip_rom_within_stated_bound() {
     for red_bits in 6..=12 {
         for recip_bits in [5, 9, 13, 20] {
-            let cfg = Config { red_bits, recip_bits, frac_bits: 4, ..Config::default() };
+            let cfg = Config {
+                red_bits,
+                recip_bits,
+                frac_bits: 4,
+                ..Config::default()
+            };
             let rom = recip_rom::contents(&cfg);
             assert_eq!(rom.len() as u32, cfg.recip_entries());
             for (i, &r) in rom.iter().enumerate() {
@@ -160,7 +190,11 @@ fn atan_rom_monotonic_in_range_and_rounded() {
             let rom = atan_rom::contents(&cfg);
             assert_eq!(rom.len(), 1 << frac_bits);
             assert_eq!(rom[0], 0);
-            assert_eq!(*rom.last().unwrap(), cfg.pos_max(), "all ones is the border");
+            assert_eq!(
+                *rom.last().unwrap(),
+                cfg.pos_max(),
+                "all ones is the border"
+            );
             assert!(rom.windows(2).all(|w| w[0] <= w[1]), "monotonic");
             for (u, &p) in rom.iter().enumerate() {
                 assert!(p < 1 << cfg.pos_bits());
@@ -174,7 +208,12 @@ fn atan_rom_monotonic_in_range_and_rounded() {
 #[test]
 fn linear_index_is_rounded_scale() {
     for frac_bits in 4..=12 {
-        let cfg = Config { frac_bits, recip_bits: frac_bits + 1, compensation: false, ..Config::default() };
+        let cfg = Config {
+            frac_bits,
+            recip_bits: frac_bits + 1,
+            compensation: false,
+            ..Config::default()
+        };
         for u in 0..=cfg.frac_max() {
             let p = linear_index::eval(&cfg, u);
             let want = if u == cfg.frac_max() {
@@ -190,7 +229,11 @@ fn linear_index_is_rounded_scale() {
 #[test]
 fn lookup_never_bases_on_the_outer_entry() {
     for (index_bits, interp_bits) in [(2, 1), (3, 3), (6, 5)] {
-        let cfg = Config { index_bits, interp_bits, ..Config::default() };
+        let cfg = Config {
+            index_bits,
+            interp_bits,
+            ..Config::default()
+        };
         for p in 0..=cfg.pos_max() {
             let (base, w) = map_lookup::split(&cfg, p);
             assert!(base <= cfg.entries() - 2);
@@ -202,7 +245,12 @@ fn lookup_never_bases_on_the_outer_entry() {
 
 fn numbered_maps(cfg: &Config) -> Maps {
     let n = 3 * cfg.map_entries() as usize;
-    Maps::from_data(cfg, (0..n).map(|k| (k as u32 * 2654435761u32 >> 7) & cfg.map_max()).collect())
+    Maps::from_data(
+        cfg,
+        (0..n)
+            .map(|k| (k as u32 * 2654435761u32 >> 7) & cfg.map_max())
+            .collect(),
+    )
 }
 
 #[test]
@@ -210,9 +258,18 @@ fn interpolate_corners() {
     let cfg = Config::default();
     let s = cfg.step();
     let top = cfg.map_max();
-    for e in [[0, 0, 0, 0], [top; 4], [0, top, 0, top], [top, 0, 0, top], [1, 2, 3, 4]] {
+    for e in [
+        [0, 0, 0, 0],
+        [top; 4],
+        [0, top, 0, top],
+        [top, 0, 0, top],
+        [1, 2, 3, 4],
+    ] {
         for (wu, wv) in [(0, 0), (s, 0), (0, s), (s, s), (1, s - 1)] {
-            assert_eq!(interpolate::eval(&cfg, e, wu, wv), interp_ref(&cfg, e, wu, wv));
+            assert_eq!(
+                interpolate::eval(&cfg, e, wu, wv),
+                interp_ref(&cfg, e, wu, wv)
+            );
         }
     }
 }
@@ -221,7 +278,9 @@ fn interpolate_corners() {
 fn interp_ref(cfg: &Config, e: [u32; 4], wu: u32, wv: u32) -> u32 {
     let s = cfg.step() as u64;
     let (wu, wv) = (wu as u64, wv as u64);
-    let num = e[0] as u64 * (s - wu) * (s - wv) + e[1] as u64 * wu * (s - wv) + e[2] as u64 * (s - wu) * wv
+    let num = e[0] as u64 * (s - wu) * (s - wv)
+        + e[1] as u64 * wu * (s - wv)
+        + e[2] as u64 * (s - wu) * wv
         + e[3] as u64 * wu * wv;
     let den = s * s;
     ((2 * num + den) / (2 * den)) as u32

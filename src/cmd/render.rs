@@ -1,0 +1,48 @@
+//! `rmapgen render`: the sphere test image shaded by the model and by the float reference,
+//! the error image and the error statistics.
+
+use super::config_args::ConfigArgs;
+use crate::output::StagedDir;
+use crate::render::{self, Options};
+use crate::scene::Scene;
+use anyhow::Result;
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    pub cfg: ConfigArgs,
+    /// Scene to shade [default: the standard scene].
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
+    /// Image width and height in pixels [1..=4096].
+    #[arg(long, value_name = "N", default_value_t = render::DEFAULT_SIZE)]
+    pub size: u32,
+    /// Scale the gradients down by 2^K, to exercise the leading-zero shift [0..=grad-bits - 1].
+    #[arg(long, value_name = "K", default_value_t = 0)]
+    pub shrink: u32,
+    /// Output directory for reference.png, model.png, error50.png and metrics.json (replaced
+    /// whole on success).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+}
+
+pub fn run(a: &RenderArgs) -> Result<()> {
+    let cfg = a.cfg.resolve()?;
+    let scene = match &a.scene {
+        Some(p) => Scene::from_toml_file(p)?,
+        None => Scene::standard(),
+    };
+    let options = Options {
+        size: a.size,
+        shrink: a.shrink,
+    };
+    options.validate(&cfg)?;
+    let out = StagedDir::new(&a.out)?;
+    let r = render::render(&cfg, &scene, options, None)?;
+    r.write(&out)?;
+    let p = out.commit()?;
+    println!("{} -> {}", r.summary(), p.display());
+    Ok(())
+}

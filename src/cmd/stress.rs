@@ -1,0 +1,128 @@
+//! `rmapgen stress`: the model over every gradient (`--exhaustive`) or a seeded sample that
+//! sweeps every magnitude, against the true direction and the float reference.
+
+use super::config_args::ConfigArgs;
+use crate::hexfile;
+use crate::scene::Scene;
+use crate::stress::{self, exhaustive, Report, Setup};
+use anyhow::{Context, Result};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct StressArgs {
+    #[command(flatten)]
+    pub cfg: ConfigArgs,
+    /// Scene whose light model fills the maps and the reference [default: the standard scene].
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
+    /// Every gradient (2^(3 grad-bits) inputs; grad-bits <= 12).
+    #[arg(long, conflicts_with = "samples")]
+    pub exhaustive: bool,
+    /// Gradients of a sampled run; the largest magnitude sweeps 1..=2^(grad-bits - 1).
+    #[arg(long, value_name = "N", default_value_t = 10_000_000)]
+    pub samples: u64,
+    /// Seed of a sampled run.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Also write the full report as JSON.
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+}
+
+pub fn run(a: &StressArgs) -> Result<()> {
+    let cfg = a.cfg.resolve()?;
+    let scene = match &a.scene {
+        Some(p) => Scene::from_toml_file(p)?,
+        None => Scene::standard(),
+    };
+    let setup = Setup::new(&cfg, &scene, hexfile::scene_maps(&cfg, &scene));
+    let report = if a.exhaustive {
+        let bar = ProgressBar::new(1u64 << (3 * cfg.grad_bits.min(exhaustive::MAX_GRAD_BITS)));
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{elapsed_precise} [{bar:40}] {percent}% {human_pos}/{human_len} inputs, eta {eta}",
+            )
+            .expect("valid template")
+            .progress_chars("=> "),
+        );
+        let r = exhaustive::run(&setup, &|n| bar.inc(n));
+        bar.finish_and_clear();
+        r?
+    } else {
+        stress::sampled(&setup, a.samples, a.seed)
+    };
+    print!("{}", summary(&report));
+    if let Some(p) = &a.json {
+        let text = serde_json::to_string_pretty(&report)?;
+        std::fs::write(p, text + "\n").with_context(|| format!("cannot write {}", p.display()))?;
+    }
+    anyhow::ensure!(
+        report.mismatches == 0,
+        "{} inputs disagreed between bit-exact evaluations",
+        report.mismatches
+    );
+    Ok(())
+}
+
+/// The report as text: a verdict, the worst cases and a Markdown table per magnitude class.
+pub fn summary(r: &Report) -> String {
+    let mut s = format!(
+        "rmapgen stress ({}): {} inputs of {} in {:.1} s on {} threads\n",
+        r.mode,
+        r.inputs,
+        r.config.summary(),
+        r.seconds,
+        rayon::current_num_threads()
+    );
+    s += &format!(
+        "no panic; {} mismatches between bit-exact evaluations; overflow checks {}\n",
+        r.mismatches,
+        if r.overflow_checks {
+            "on"
+        } else {
+            "off (release build; the test profile runs with them on)"
+        }
+    );
+    if let Some(st) = &r.search {
+        s += &format!(
+            "phases: positions {:.1} s, every input {:.1} s, error search {:.1} s ({} cells bounded, {} evaluated, {} reference evaluations)\n",
+            st.seconds_positions, st.seconds_inputs, st.seconds_search, st.cells, st.cells_evaluated, st.reference_evaluations
+        );
+    }
+    if let Some(w) = r.worst_angle {
+        s += &format!(
+            "worst angular error: {:.4} deg at {:?}\n",
+            w.degrees, w.gradient
+        );
+    }
+    if let Some(w) = r.worst_error {
+        s += &format!(
+            "worst intensity error: {:+} LSB at {:?}: model {}, reference {} ({:.3})\n",
+            w.error, w.gradient, w.model, w.reference, w.reference_exact
+        );
+    }
+    s += "\n| shift | max magnitude | inputs | max angle (deg) | at | max abs error (LSB) | at | model | reference |\n";
+    s += "|---:|---|---:|---:|---|---:|---|---:|---:|\n";
+    for c in &r.classes {
+        let (a, ag) = c.worst_angle.map_or(("-".into(), "-".into()), |w| {
+            (format!("{:.4}", w.degrees), format!("{:?}", w.gradient))
+        });
+        let (e, eg, m, rf) =
+            c.worst_error
+                .map_or(("-".into(), "-".into(), "-".into(), "-".into()), |w| {
+                    (
+                        w.abs().to_string(),
+                        format!("{:?}", w.gradient),
+                        w.model.to_string(),
+                        format!("{} ({:.2})", w.reference, w.reference_exact),
+                    )
+                });
+        s += &format!(
+            "| {} | {}..={} | {} | {a} | {ag} | {e} | {eg} | {m} | {rf} |\n",
+            c.shift, c.magnitudes.0, c.magnitudes.1, c.inputs
+        );
+    }
+    s
+}

@@ -1,0 +1,67 @@
+//! `rmapgen vectors`: a large top-level vector stream (`vectors/rmap_top.hex` format) for the
+//! Verilator C++ harness `tb/top_stream.cpp`, which checks millions of samples per run.
+
+use super::config_args::ConfigArgs;
+use crate::scene::Scene;
+use crate::vectors::{self, MapSet};
+use anyhow::{Context, Result};
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct VectorsArgs {
+    #[command(flatten)]
+    pub cfg: ConfigArgs,
+    /// Random vectors after the corner cases: the first half shaded with map 0, the rest with
+    /// map 1 (the corner cases come again before the map-1 part).
+    #[arg(long, value_name = "N", default_value_t = 1_000_000)]
+    pub count: usize,
+    /// Seed of the random vectors.
+    #[arg(long, value_name = "S", default_value_t = 1)]
+    pub seed: u64,
+    /// Take the maps from a generated directory (map_<axis>.hex and map2_<axis>.hex), so the
+    /// vectors match the scene it was generated with.
+    #[arg(long, value_name = "DIR", conflicts_with = "scene")]
+    pub maps: Option<PathBuf>,
+    /// Scene of map 0 [default: the standard scene]; map 1 is always the alternate scene.
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
+    /// Vector file to write (replaced only when complete).
+    #[arg(long, value_name = "FILE")]
+    pub out: PathBuf,
+}
+
+pub fn run(a: &VectorsArgs) -> Result<()> {
+    let cfg = a.cfg.resolve()?;
+    let maps = match (&a.maps, &a.scene) {
+        (Some(dir), _) => MapSet::from_dir(&cfg, dir)?,
+        (None, Some(p)) => {
+            MapSet::from_scenes(&cfg, &Scene::from_toml_file(p)?, &Scene::alternate())
+        }
+        (None, None) => MapSet::standard(&cfg),
+    };
+    let name = a
+        .out
+        .file_name()
+        .with_context(|| format!("{} is not a file name", a.out.display()))?;
+    let partial = a.out.with_file_name(format!(
+        ".{}.partial-{}",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
+    let n = match vectors::write_top_stream(&cfg, &maps, &partial, a.count, a.seed) {
+        Ok(n) => n,
+        Err(e) => {
+            std::fs::remove_file(&partial).ok();
+            return Err(e);
+        }
+    };
+    std::fs::rename(&partial, &a.out)
+        .with_context(|| format!("cannot write {}", a.out.display()))?;
+    eprintln!(
+        "rmapgen: wrote {n} top vectors ({}) to {}",
+        cfg.summary(),
+        a.out.display()
+    );
+    Ok(())
+}

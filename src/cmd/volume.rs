@@ -1,0 +1,353 @@
+//! `rmapgen volume`: a volume (raw, NRRD or the built-in synthetic part) ray cast and shaded
+//! by the float reference and by the bit-accurate model; the images, the 50x error image
+//! and the error statistics, and with `--timing` the render times with and without
+//! skipping.
+
+use super::config_args::ConfigArgs;
+use crate::config::Config;
+use crate::output::StagedDir;
+use crate::reference::Reference;
+use crate::scene::Scene;
+use crate::volume::cast::{self, CastOptions, Caster, ModelShader, Prepared, Stats};
+use crate::volume::load::{self, RawFormat};
+use crate::volume::report::{self, VolumeRender};
+use crate::volume::transfer::Transfer;
+use crate::volume::{synthetic, Volume, ENGINE_SCENE_TOML};
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use serde::Serialize;
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(Args, Debug)]
+pub struct VolumeArgs {
+    #[command(flatten)]
+    pub cfg: ConfigArgs,
+    /// Volume file: NRRD (.nrrd, or .nhdr with a detached data file) or raw voxels (give
+    /// --dims).
+    #[arg(
+        value_name = "FILE",
+        conflicts_with = "synthetic",
+        required_unless_present = "synthetic"
+    )]
+    pub input: Option<PathBuf>,
+    /// Render the built-in synthetic engine block (256x256x128 unless --dims).
+    #[arg(long)]
+    pub synthetic: bool,
+    /// Raw file (or synthetic) dimensions in voxels, x fastest.
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    pub dims: Option<String>,
+    /// Voxel spacing (world units per voxel along x, y, z) [default: 1,1,1 or the NRRD's].
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    pub spacing: Option<String>,
+    /// Raw voxel width: 8 or 16 bits (16-bit little-endian) [default: 8].
+    #[arg(long, value_name = "BITS")]
+    pub bits: Option<u32>,
+    /// Raw voxels are signed (two's complement).
+    #[arg(long)]
+    pub signed: bool,
+    /// Scene: view, lights, material and [transfer] opacity function [default: the engine
+    /// block scene, scenes/engine.toml].
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
+    /// Transfer function breakpoints value:opacity,... (replaces the scene's).
+    #[arg(long, value_name = "V:A,...", allow_hyphen_values = true)]
+    pub transfer: Option<String>,
+    /// View direction, from the volume towards the viewer (replaces the scene's).
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    pub view: Option<String>,
+    /// Image width and height in pixels [1..=4096].
+    #[arg(long, value_name = "N", default_value_t = 512)]
+    pub size: u32,
+    /// Sample step along a ray, in smallest voxel spacings [0.05..=4].
+    #[arg(long, value_name = "S", default_value_t = cast::DEFAULT_STEP)]
+    pub step: f64,
+    /// Early ray termination: accumulated opacity at which a pixel counts as opaque (0, 1].
+    #[arg(long, value_name = "A", default_value_t = cast::DEFAULT_ERT)]
+    pub ert: f64,
+    /// Brick side in cells for empty-space skipping [2..=64].
+    #[arg(long, value_name = "N", default_value_t = cast::DEFAULT_BRICK)]
+    pub brick: usize,
+    /// Turn skipping off (empty space, early termination, unshaded samples): same image,
+    /// more work.
+    #[arg(long)]
+    pub no_skip: bool,
+    /// Also time the model render with skipping on and off and the float render, write
+    /// timing.json and print a report.
+    #[arg(long)]
+    pub timing: bool,
+    /// Timed runs per measurement with --timing (the median is reported).
+    #[arg(long, value_name = "N", default_value_t = 5)]
+    pub repeat: u32,
+    /// Output directory for reference.png, model.png, error50.png and metrics.json (replaced
+    /// whole on success).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+}
+
+/// Parses `X,Y,Z` into three numbers.
+fn triple<T: std::str::FromStr>(flag: &str, s: &str) -> Result<[T; 3]> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        bail!("{flag} {s}: give three comma-separated values X,Y,Z");
+    }
+    let mut out = Vec::with_capacity(3);
+    for p in parts {
+        match p.parse::<T>() {
+            Ok(v) => out.push(v),
+            Err(_) => bail!("{flag} {s}: '{p}' is not a number"),
+        }
+    }
+    let [a, b, c]: [T; 3] = out.try_into().ok().expect("three values");
+    Ok([a, b, c])
+}
+
+/// The scene with --view and --transfer applied, validated, with a transfer function.
+fn scene(a: &VolumeArgs) -> Result<Scene> {
+    let mut scene = match &a.scene {
+        Some(p) => Scene::from_toml_file(p)?,
+        None => Scene::from_toml_str(ENGINE_SCENE_TOML).context("the built-in engine scene")?,
+    };
+    if let Some(v) = &a.view {
+        scene.view.direction = triple::<f64>("--view", v)?;
+    }
+    if let Some(t) = &a.transfer {
+        scene.transfer = Some(Transfer::parse(t)?);
+    }
+    scene.validate()?;
+    report::scene_transfer(&scene)?;
+    Ok(scene)
+}
+
+/// Loads the volume the arguments name.
+fn volume(a: &VolumeArgs) -> Result<Volume> {
+    let spacing = a
+        .spacing
+        .as_deref()
+        .map(|s| triple::<f64>("--spacing", s))
+        .transpose()?;
+    let dims = a
+        .dims
+        .as_deref()
+        .map(|s| triple::<i64>("--dims", s))
+        .transpose()?;
+    if a.synthetic {
+        if a.bits.is_some() || a.signed {
+            bail!("--bits and --signed are for raw files, not --synthetic");
+        }
+        let d =
+            crate::volume::check_dims(dims.unwrap_or(synthetic::DIMS.map(|n| n as i64)), "--dims")?;
+        let s = crate::volume::check_spacing(spacing.unwrap_or([1.0; 3]), "--spacing")?;
+        return synthetic::engine_block(d, s);
+    }
+    let path = a
+        .input
+        .as_ref()
+        .expect("clap requires FILE without --synthetic");
+    if load::is_nrrd(path) {
+        if a.dims.is_some() || a.bits.is_some() || a.signed {
+            bail!("--dims, --bits and --signed are for raw files; the NRRD header {} gives the layout", path.display());
+        }
+        let mut v = load::load_nrrd(path)?;
+        if let Some(s) = spacing {
+            v.spacing = crate::volume::check_spacing(s, "--spacing")?;
+        }
+        Ok(v)
+    } else {
+        let Some(dims) = dims else {
+            bail!(
+                "raw file {} needs --dims X,Y,Z (or give an .nrrd or .nhdr file)",
+                path.display()
+            );
+        };
+        let format = RawFormat {
+            bits: a.bits.unwrap_or(8),
+            signed: a.signed,
+        };
+        load::load_raw(path, dims, spacing.unwrap_or([1.0; 3]), format)
+    }
+}
+
+/// One timed measurement: the median and the fastest of `n` runs, in ms.
+#[derive(Clone, Debug, Serialize)]
+struct Timed {
+    median_ms: f64,
+    min_ms: f64,
+    runs: u32,
+}
+
+fn time(n: u32, mut f: impl FnMut()) -> Timed {
+    let mut v: Vec<f64> = (0..n.max(1))
+        .map(|_| {
+            let t = Instant::now();
+            f();
+            t.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    v.sort_by(f64::total_cmp);
+    Timed {
+        median_ms: v[v.len() / 2],
+        min_ms: v[0],
+        runs: v.len() as u32,
+    }
+}
+
+#[derive(Serialize)]
+struct Timing {
+    threads: usize,
+    load_ms: f64,
+    /// Gradients and brick ranges: once per volume and gradient width.
+    prepare_ms: f64,
+    /// Caster set-up (empty bricks for the transfer function) plus the image, model shader.
+    model_skipping_on: Timed,
+    float_skipping_on: Timed,
+    model_skipping_off: Timed,
+    speedup: f64,
+    skipping_on: Stats,
+    skipping_off: Stats,
+    skipped_fraction: f64,
+    unshaded_fraction: f64,
+}
+
+/// Times the renders and checks that skipping leaves the image unchanged.
+fn timing(
+    p: &Prepared,
+    cfg: &Config,
+    scene: &Scene,
+    opts: CastOptions,
+    repeat: u32,
+) -> Result<(Timing, String)> {
+    let tf = report::scene_transfer(scene)?;
+    let view = scene.view.direction;
+    let model = ModelShader::new(cfg, scene);
+    let reference = Reference::new(cfg, scene);
+    let on = CastOptions { skip: true, ..opts };
+    let off = CastOptions {
+        skip: false,
+        ..opts
+    };
+    let frame_on = Caster::new(p, tf, view, on)?.render(&model);
+    let frame_off = Caster::new(p, tf, view, off)?.render(&model);
+    if frame_on.value != frame_off.value || frame_on.alpha != frame_off.alpha {
+        bail!("internal error: the image with skipping differs from the image without");
+    }
+    let model_on = time(repeat, || {
+        Caster::new(p, tf, view, on)
+            .expect("checked")
+            .render(&model);
+    });
+    let float_on = time(repeat, || {
+        Caster::new(p, tf, view, on)
+            .expect("checked")
+            .render(&reference);
+    });
+    let model_off = time(repeat.min(2), || {
+        Caster::new(p, tf, view, off)
+            .expect("checked")
+            .render(&model);
+    });
+    let st = frame_on.stats;
+    let t = Timing {
+        threads: rayon::current_num_threads(),
+        load_ms: 0.0,
+        prepare_ms: 0.0,
+        speedup: model_off.median_ms / model_on.median_ms,
+        model_skipping_on: model_on,
+        float_skipping_on: float_on,
+        model_skipping_off: model_off,
+        skipping_on: st,
+        skipping_off: frame_off.stats,
+        skipped_fraction: st.skipped_fraction(),
+        unshaded_fraction: st.unshaded_fraction(),
+    };
+    let pct = |n: u64| 100.0 * n as f64 / st.samples.max(1) as f64;
+    let text = format!(
+        "  model, skipping on   {:8.1} ms (median of {}, fastest {:.1})\n  float, skipping on   {:8.1} ms (median of {}, fastest {:.1})\n  model, skipping off  {:8.1} ms (median of {}), speed-up {:.1}x, identical image\n  samples on rays {}: {:.1}% skipped ({:.1}% empty space, {:.1}% after termination), {:.2}% shaded, {:.1}% of bricks empty",
+        t.model_skipping_on.median_ms,
+        t.model_skipping_on.runs,
+        t.model_skipping_on.min_ms,
+        t.float_skipping_on.median_ms,
+        t.float_skipping_on.runs,
+        t.float_skipping_on.min_ms,
+        t.model_skipping_off.median_ms,
+        t.model_skipping_off.runs,
+        t.speedup,
+        st.samples,
+        pct(st.empty_skipped + st.terminated),
+        pct(st.empty_skipped),
+        pct(st.terminated),
+        pct(st.shaded),
+        100.0 * Caster::new(p, tf, view, on)?.empty_brick_fraction()
+    );
+    Ok((t, text))
+}
+
+pub fn run(a: &VolumeArgs) -> Result<()> {
+    let cfg = a.cfg.resolve()?;
+    let scene = scene(a)?;
+    let opts = CastOptions {
+        size: a.size,
+        step: a.step,
+        ert: a.ert,
+        brick: a.brick,
+        skip: !a.no_skip,
+    };
+    opts.validate()?;
+    if a.timing && a.repeat == 0 {
+        bail!("--repeat must be at least 1");
+    }
+    let t = Instant::now();
+    let vol = volume(a)?;
+    let load_ms = t.elapsed().as_secs_f64() * 1e3;
+
+    let out = StagedDir::new(&a.out)?;
+    let t = Instant::now();
+    let p = Prepared::new(&vol, cfg.grad_bits, opts.brick);
+    let prepare_ms = t.elapsed().as_secs_f64() * 1e3;
+    let r: VolumeRender = report::render(&p, &cfg, &scene, opts, None)?;
+    r.write(&out)?;
+    let timing = if a.timing {
+        let (mut t, text) = timing(&p, &cfg, &scene, opts, a.repeat)?;
+        t.load_ms = load_ms;
+        t.prepare_ms = prepare_ms;
+        out.write_text("timing.json", &serde_json::to_string_pretty(&t)?)?;
+        Some(text)
+    } else {
+        None
+    };
+    let dir = out.commit()?;
+    println!("{} -> {}", r.summary(), dir.display());
+    println!(
+        "  {}: load {load_ms:.1} ms, gradients and bricks {prepare_ms:.1} ms, model render {:.1} ms, float render {:.1} ms (skipping {})",
+        vol.info.source,
+        r.model_ms,
+        r.reference_ms,
+        if opts.skip { "on" } else { "off" }
+    );
+    if let Some(text) = timing {
+        println!(
+            "  timing, {} threads:\n{text}",
+            rayon::current_num_threads()
+        );
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn triples() {
+        assert_eq!(triple::<i64>("--dims", "4, 5,6").unwrap(), [4, 5, 6]);
+        assert_eq!(triple::<i64>("--dims", "4,-5,6").unwrap(), [4, -5, 6]);
+        assert!(triple::<i64>("--dims", "4,5")
+            .unwrap_err()
+            .to_string()
+            .contains("three"));
+        assert!(triple::<f64>("--view", "1,x,0")
+            .unwrap_err()
+            .to_string()
+            .contains("'x' is not a number"));
+    }
+}

@@ -1,0 +1,99 @@
+//! Error statistics of one image against another, in output LSBs. Pure functions of the two
+//! value lists, so tests, benchmarks and the RTL render share them.
+
+use serde::{Deserialize, Serialize};
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Metrics {
+    /// Samples compared (the inside pixels of a render).
+    pub pixels: usize,
+    /// Peak value of the PSNR, 2^map_bits - 1.
+    pub peak: u32,
+    /// Largest |a - b|.
+    pub max_abs_error: u32,
+    pub mean_abs_error: f64,
+    /// Mean of a - b: a bias of the first list against the second.
+    pub mean_error: f64,
+    pub rmse: f64,
+    /// 20 log10(peak / rmse); `None` (JSON null) when the lists are equal.
+    pub psnr_db: Option<f64>,
+    /// How many samples have |a - b| = 0, 1, 2, ..., up to `max_abs_error`.
+    pub abs_error_histogram: Vec<usize>,
+    /// Index of the first sample with the largest error; `None` for empty lists.
+    pub worst_index: Option<usize>,
+}
+
+/// Compares `a` (the design under test) with `b` (the reference) sample by sample; `peak` is
+/// the largest value of the output range.
+pub fn metrics(a: &[u32], b: &[u32], peak: u32) -> Metrics {
+    assert_eq!(a.len(), b.len(), "metrics of lists of different lengths");
+    let mut hist: Vec<usize> = vec![0];
+    let (mut sum, mut sum_abs, mut sum_sq) = (0i64, 0u64, 0u64);
+    let mut worst: Option<(usize, u32)> = None;
+    for (i, (&x, &y)) in a.iter().zip(b).enumerate() {
+        let e = x as i64 - y as i64;
+        let ae = e.unsigned_abs() as u32;
+        sum += e;
+        sum_abs += ae as u64;
+        sum_sq += ae as u64 * ae as u64;
+        if ae as usize >= hist.len() {
+            hist.resize(ae as usize + 1, 0);
+        }
+        hist[ae as usize] += 1;
+        if worst.map_or(true, |(_, w)| ae > w) {
+            worst = Some((i, ae));
+        }
+    }
+    let n = a.len();
+    let mean = |s: f64| if n == 0 { 0.0 } else { s / n as f64 };
+    let rmse = mean(sum_sq as f64).sqrt();
+    Metrics {
+        pixels: n,
+        peak,
+        max_abs_error: worst.map_or(0, |w| w.1),
+        mean_abs_error: mean(sum_abs as f64),
+        mean_error: mean(sum as f64),
+        rmse,
+        psnr_db: (rmse > 0.0).then(|| 20.0 * (peak as f64 / rmse).log10()),
+        abs_error_histogram: if n == 0 { Vec::new() } else { hist },
+        worst_index: worst.map(|w| w.0),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn by_hand() {
+        let m = metrics(&[10, 12, 7, 9], &[10, 10, 10, 9], 255);
+        assert_eq!(m.pixels, 4);
+        assert_eq!(m.max_abs_error, 3);
+        assert_eq!(m.worst_index, Some(2));
+        assert_eq!(m.mean_abs_error, 5.0 / 4.0);
+        assert_eq!(m.mean_error, -1.0 / 4.0);
+        assert_eq!(m.rmse, (13.0f64 / 4.0).sqrt());
+        let psnr = m.psnr_db.unwrap();
+        assert!((psnr - 20.0 * (255.0 / m.rmse).log10()).abs() < 1e-12);
+        assert_eq!(m.abs_error_histogram, vec![2, 0, 1, 1]);
+    }
+
+    #[test]
+    fn equal_and_empty() {
+        let m = metrics(&[1, 2, 3], &[1, 2, 3], 255);
+        assert_eq!(
+            (m.max_abs_error, m.rmse, m.psnr_db, m.worst_index),
+            (0, 0.0, None, Some(0))
+        );
+        assert_eq!(m.abs_error_histogram, vec![3]);
+        let e = metrics(&[], &[], 255);
+        assert_eq!((e.pixels, e.rmse, e.worst_index), (0, 0.0, None));
+        assert!(e.abs_error_histogram.is_empty());
+    }
+
+    #[test]
+    fn first_worst_wins() {
+        let m = metrics(&[0, 5, 0, 5], &[0, 0, 5, 0], 255);
+        assert_eq!((m.max_abs_error, m.worst_index), (5, Some(1)));
+    }
+}

@@ -1,0 +1,219 @@
+//! Volume rendering through the reflectance map, as in the paper's Figures 9 and 10 (a CT
+//! engine block shaded through the 1.5 KB map and compared with floating point).
+//!
+//! The pipeline, one module each:
+//! - [`load`]: raw files (8- or 16-bit little-endian) and NRRD (`.nrrd`, `.nhdr` + data
+//!   file; raw and gzip encodings); [`synthetic`]: the built-in machined part.
+//! - [`gradient`]: central differences on the voxel grid, scaled once per volume and
+//!   quantised to `grad_bits` two's complement: the shader's input, as hardware receives it.
+//! - [`bricks`]: per-brick value ranges for empty-space skipping.
+//! - [`transfer`]: the opacity transfer function of the scene file.
+//! - [`camera`] and [`cast`]: orthographic ray casting with trilinear sampling, front-to-back
+//!   compositing, empty-space skipping and early ray termination; each sample is shaded by a
+//!   [`cast::Shader`] (the float reference or the bit-accurate model), or its gradients are
+//!   collected for a batch shader (an RTL simulation, through
+//!   [`crate::render::IntensitySource`]).
+//! - [`report`]: one render with every shader, the images, the error statistics and
+//!   `metrics.json`.
+
+pub mod bricks;
+pub mod camera;
+pub mod cast;
+pub mod gradient;
+pub mod load;
+pub mod report;
+pub mod synthetic;
+pub mod transfer;
+
+use anyhow::{bail, Result};
+use serde::Serialize;
+
+/// The scene of the synthetic part (`scenes/engine.toml`): a view from the front left and
+/// above, one light, the standard material and a transfer function for its values.
+pub const ENGINE_SCENE_TOML: &str = include_str!("../../scenes/engine.toml");
+
+/// Largest number of voxels accepted (2^28: 1 GiB of values plus 1.5 GiB of gradients).
+pub const MAX_VOXELS: usize = 1 << 28;
+
+/// A scalar volume on a regular grid. Voxel (x, y, z) sits at world position
+/// (x * spacing[0], y * spacing[1], z * spacing[2]); x varies fastest in `data`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Volume {
+    pub dims: [usize; 3],
+    pub spacing: [f64; 3],
+    /// Voxel values in the file's own units (integers up to 2^24 are exact in f32).
+    pub data: Vec<f32>,
+    /// Where the volume came from and its voxel type, for reports.
+    pub info: VolumeInfo,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct VolumeInfo {
+    pub source: String,
+    pub voxel_type: String,
+}
+
+/// Checks volume dimensions: each at least 2 (a cell needs two voxels along every axis)
+/// and not too many voxels in all.
+pub fn check_dims(dims: [i64; 3], what: &str) -> Result<[usize; 3]> {
+    for (axis, &n) in dims.iter().enumerate() {
+        let name = ["x", "y", "z"][axis];
+        if n <= 0 {
+            bail!("{what}: size {n} along {name} is not positive; every size must be at least 2");
+        }
+        if n < 2 {
+            bail!("{what}: size {n} along {name} is too small; every size must be at least 2");
+        }
+    }
+    let total = dims.iter().try_fold(1i64, |acc, &n| acc.checked_mul(n));
+    match total {
+        Some(t) if t as u128 <= MAX_VOXELS as u128 => Ok(dims.map(|n| n as usize)),
+        _ => bail!(
+            "{what}: {} x {} x {} voxels is more than the limit of {MAX_VOXELS}",
+            dims[0],
+            dims[1],
+            dims[2]
+        ),
+    }
+}
+
+/// Checks a voxel spacing: three finite positive numbers.
+pub fn check_spacing(spacing: [f64; 3], what: &str) -> Result<[f64; 3]> {
+    for (axis, &s) in spacing.iter().enumerate() {
+        if !s.is_finite() || s <= 0.0 {
+            bail!(
+                "{what}: spacing {s} along {} must be a finite number > 0",
+                ["x", "y", "z"][axis]
+            );
+        }
+    }
+    Ok(spacing)
+}
+
+impl Volume {
+    /// A volume from its parts; checks the dimensions, the spacing, the length of `data` and
+    /// that every value is finite.
+    pub fn new(
+        dims: [usize; 3],
+        spacing: [f64; 3],
+        data: Vec<f32>,
+        info: VolumeInfo,
+    ) -> Result<Volume> {
+        check_dims(dims.map(|n| n as i64), &info.source)?;
+        check_spacing(spacing, &info.source)?;
+        let want = dims[0] * dims[1] * dims[2];
+        if data.len() != want {
+            bail!(
+                "{}: {} voxel values for {} x {} x {} voxels",
+                info.source,
+                data.len(),
+                dims[0],
+                dims[1],
+                dims[2]
+            );
+        }
+        if let Some(i) = data.iter().position(|v| !v.is_finite()) {
+            bail!(
+                "{}: voxel {} has the non-finite value {}",
+                info.source,
+                i,
+                data[i]
+            );
+        }
+        Ok(Volume {
+            dims,
+            spacing,
+            data,
+            info,
+        })
+    }
+
+    /// Index of voxel (x, y, z) in `data`.
+    #[inline]
+    pub fn index(&self, x: usize, y: usize, z: usize) -> usize {
+        x + self.dims[0] * (y + self.dims[1] * z)
+    }
+
+    #[inline]
+    pub fn at(&self, x: usize, y: usize, z: usize) -> f32 {
+        self.data[self.index(x, y, z)]
+    }
+
+    /// Smallest and largest voxel value.
+    pub fn range(&self) -> (f32, f32) {
+        use rayon::prelude::*;
+        self.data
+            .par_chunks(1 << 16)
+            .map(|c| {
+                c.iter()
+                    .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &v| {
+                        (lo.min(v), hi.max(v))
+                    })
+            })
+            .reduce(
+                || (f32::INFINITY, f32::NEG_INFINITY),
+                |a, b| (a.0.min(b.0), a.1.max(b.1)),
+            )
+    }
+
+    /// The smallest spacing: the unit of sample steps and of transfer-function opacities.
+    pub fn unit(&self) -> f64 {
+        self.spacing.iter().cloned().fold(f64::INFINITY, f64::min)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dims_are_checked() {
+        assert_eq!(check_dims([4, 5, 6], "t").unwrap(), [4, 5, 6]);
+        assert!(check_dims([4, 0, 6], "t")
+            .unwrap_err()
+            .to_string()
+            .contains("size 0 along y is not positive"));
+        assert!(check_dims([-3, 5, 6], "t")
+            .unwrap_err()
+            .to_string()
+            .contains("not positive"));
+        assert!(check_dims([1, 5, 6], "t")
+            .unwrap_err()
+            .to_string()
+            .contains("at least 2"));
+        assert!(check_dims([1 << 20, 1 << 20, 1 << 20], "t")
+            .unwrap_err()
+            .to_string()
+            .contains("limit"));
+        assert!(check_spacing([1.0, 0.0, 1.0], "t")
+            .unwrap_err()
+            .to_string()
+            .contains("along y"));
+        assert!(check_spacing([1.0, 1.0, f64::NAN], "t").is_err());
+    }
+
+    #[test]
+    fn new_checks_length_and_values() {
+        let info = VolumeInfo {
+            source: "t".into(),
+            voxel_type: "float".into(),
+        };
+        assert!(Volume::new([2, 2, 2], [1.0; 3], vec![0.0; 7], info.clone()).is_err());
+        let mut d = vec![0.0; 8];
+        d[5] = f32::NAN;
+        assert!(Volume::new([2, 2, 2], [1.0; 3], d, info.clone())
+            .unwrap_err()
+            .to_string()
+            .contains("voxel 5"));
+        let v = Volume::new(
+            [2, 3, 4],
+            [1.0, 0.5, 2.0],
+            (0..24).map(|i| i as f32).collect(),
+            info,
+        )
+        .unwrap();
+        assert_eq!(v.at(1, 2, 3), 23.0);
+        assert_eq!(v.range(), (0.0, 23.0));
+        assert_eq!(v.unit(), 0.5);
+    }
+}

@@ -1,0 +1,418 @@
+//! One volume render with every shader: the float reference and the bit-accurate model
+//! (fused path), and optionally a batch shader such as the Verilated RTL (two-pass path,
+//! through [`crate::render::IntensitySource`], the same hook as the sphere render). The
+//! images, the error statistics and `metrics.json` reuse the sphere render's
+//! [`crate::render::metrics`] and [`crate::render::images`]; the statistics are taken over
+//! the pixels the volume covers (accumulated opacity > 0), as the sphere's over its disc.
+
+use super::cast::{CastOptions, Caster, Frame, ModelShader, Prepared, Stats};
+use super::transfer::Transfer;
+use super::VolumeInfo;
+use crate::config::Config;
+use crate::output::StagedDir;
+use crate::reference::Reference;
+use crate::render::images::{display8, error50, png};
+use crate::render::{metrics, IntensitySource, Metrics};
+use crate::scene::Scene;
+use anyhow::{bail, Result};
+use image::GrayImage;
+use serde::Serialize;
+use std::time::Instant;
+
+/// A finished volume render.
+#[derive(Clone, Debug)]
+pub struct VolumeRender {
+    pub cfg: Config,
+    pub scene: Scene,
+    pub opts: CastOptions,
+    /// Pixels whose ray accumulated some opacity, raster order.
+    pub covered: Vec<bool>,
+    pub reference: Vec<u32>,
+    pub model: Vec<u32>,
+    pub rtl: Option<Vec<u32>>,
+    /// The model against the reference over the covered pixels.
+    pub metrics: Metrics,
+    /// Work of the model render.
+    pub stats: Stats,
+    pub context: Context,
+    /// Wall-clock times of the model and the reference render, in ms.
+    pub model_ms: f64,
+    pub reference_ms: f64,
+}
+
+/// What was rendered, for `metrics.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct Context {
+    #[serde(flatten)]
+    pub info: VolumeInfo,
+    pub dims: [usize; 3],
+    pub spacing: [f64; 3],
+    pub value_range: [f32; 2],
+    /// Quantisation scale of the gradients, LSB per (value unit per world unit).
+    pub gradient_scale: f64,
+    pub gradient_max_component: f64,
+    /// Unit vectors of the image's right and up directions, and a pixel's world width.
+    pub image_right: [f64; 3],
+    pub image_up: [f64; 3],
+    pub pixel: f64,
+    pub empty_brick_fraction: f64,
+}
+
+/// The pixel with the largest model error.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct WorstPixel {
+    pub x: u32,
+    pub y: u32,
+    pub model: u32,
+    pub reference: u32,
+}
+
+#[derive(Serialize)]
+struct Skipping {
+    #[serde(flatten)]
+    stats: Stats,
+    skipped_fraction: f64,
+    unshaded_fraction: f64,
+}
+
+/// `metrics.json`: the sphere render's fields (without its `shrink`), then the volume's.
+#[derive(Serialize)]
+struct Report<'a> {
+    generator: String,
+    size: u32,
+    #[serde(flatten)]
+    metrics: &'a Metrics,
+    worst: Option<WorstPixel>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rtl_equals_model: Option<bool>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rtl_mismatches: Option<usize>,
+    images: Vec<&'static str>,
+    config: &'a Config,
+    scene: &'a Scene,
+    volume: &'a Context,
+    cast: &'a CastOptions,
+    skipping: Skipping,
+}
+
+fn ms(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+/// The scene's transfer function, or an error saying where one is needed.
+pub fn scene_transfer(scene: &Scene) -> Result<&Transfer> {
+    match &scene.transfer {
+        Some(t) => Ok(t),
+        None => bail!("the scene has no [transfer] section; volume rendering needs an opacity transfer function (or give --transfer)"),
+    }
+}
+
+/// Renders a prepared volume with the scene's view direction and transfer function.
+pub fn render(
+    p: &Prepared,
+    cfg: &Config,
+    scene: &Scene,
+    opts: CastOptions,
+    rtl: Option<&dyn IntensitySource>,
+) -> Result<VolumeRender> {
+    scene.validate()?;
+    let transfer = scene_transfer(scene)?;
+    let t = Instant::now();
+    let model_shader = ModelShader::new(cfg, scene);
+    let caster = Caster::new(p, transfer, scene.view.direction, opts)?;
+    let model_frame = caster.render(&model_shader);
+    let model_ms = ms(t);
+    let t = Instant::now();
+    let reference_frame =
+        Caster::new(p, transfer, scene.view.direction, opts)?.render(&Reference::new(cfg, scene));
+    let reference_ms = ms(t);
+    let rtl = match rtl {
+        None => None,
+        Some(src) => Some(batch(&caster, src, cfg)?),
+    };
+
+    let covered: Vec<bool> = model_frame.alpha.iter().map(|&a| a > 0.0).collect();
+    let max = cfg.map_max();
+    let model = model_frame.pixels(max);
+    let reference = reference_frame.pixels(max);
+    let pick = |v: &[u32]| {
+        v.iter()
+            .zip(&covered)
+            .filter(|c| *c.1)
+            .map(|c| *c.0)
+            .collect::<Vec<u32>>()
+    };
+    let metrics = metrics(&pick(&model), &pick(&reference), max);
+    let (lo, hi) = p.vol.range();
+    let cam = caster.camera();
+    let context = Context {
+        info: p.vol.info.clone(),
+        dims: p.vol.dims,
+        spacing: p.vol.spacing,
+        value_range: [lo, hi],
+        gradient_scale: p.grads.scale,
+        gradient_max_component: p.grads.max_component,
+        image_right: cam.right.to_array(),
+        image_up: cam.up.to_array(),
+        pixel: cam.pixel,
+        empty_brick_fraction: caster.empty_brick_fraction(),
+    };
+    Ok(VolumeRender {
+        cfg: cfg.clone(),
+        scene: scene.clone(),
+        opts,
+        covered,
+        reference,
+        model,
+        rtl,
+        metrics,
+        stats: model_frame.stats,
+        context,
+        model_ms,
+        reference_ms,
+    })
+}
+
+/// A batch shader's image: the contributing samples' gradients shaded in one batch, then
+/// composited.
+pub fn batch(caster: &Caster, src: &dyn IntensitySource, cfg: &Config) -> Result<Vec<u32>> {
+    let samples = caster.collect();
+    let v = src.intensities(&samples.gradients)?;
+    if v.len() != samples.gradients.len() {
+        bail!(
+            "the batch shader gave {} intensities for {} samples",
+            v.len(),
+            samples.gradients.len()
+        );
+    }
+    if let Some(bad) = v.iter().find(|&&i| i > cfg.map_max()) {
+        bail!(
+            "the batch shader gave intensity {bad}, wider than map_bits = {}",
+            cfg.map_bits
+        );
+    }
+    let frame: Frame = samples.composite(&v)?;
+    Ok(frame.pixels(cfg.map_max()))
+}
+
+impl VolumeRender {
+    /// The worst pixel of the model against the reference.
+    pub fn worst(&self) -> Option<WorstPixel> {
+        let k = self.metrics.worst_index?;
+        let i = self.covered.iter().enumerate().filter(|c| *c.1).nth(k)?.0;
+        let n = self.opts.size as usize;
+        Some(WorstPixel {
+            x: (i % n) as u32,
+            y: (i / n) as u32,
+            model: self.model[i],
+            reference: self.reference[i],
+        })
+    }
+
+    /// Pixels where the RTL differs from the model; `None` without an RTL source.
+    pub fn rtl_mismatches(&self) -> Option<usize> {
+        let rtl = self.rtl.as_ref()?;
+        Some(rtl.iter().zip(&self.model).filter(|(a, b)| a != b).count())
+    }
+
+    pub fn image_names(&self) -> Vec<&'static str> {
+        let mut v = vec!["reference.png", "model.png", "error50.png"];
+        if self.rtl.is_some() {
+            v.push("rtl.png");
+        }
+        v
+    }
+
+    /// The images by file name: intensities shown as 8-bit grey (background black), and the
+    /// error |model - reference| in LSBs times 50.
+    pub fn images(&self) -> Vec<(&'static str, GrayImage)> {
+        let n = self.opts.size;
+        let m = self.cfg.map_bits;
+        let img = |px: Vec<u8>| GrayImage::from_raw(n, n, px).expect("n x n pixels");
+        let shown = |v: &[u32]| img(v.iter().map(|&i| display8(i, m)).collect());
+        let mut v = vec![
+            ("reference.png", shown(&self.reference)),
+            ("model.png", shown(&self.model)),
+            (
+                "error50.png",
+                img(self
+                    .model
+                    .iter()
+                    .zip(&self.reference)
+                    .map(|(&a, &b)| error50(a, b))
+                    .collect()),
+            ),
+        ];
+        if let Some(rtl) = &self.rtl {
+            v.push(("rtl.png", shown(rtl)));
+        }
+        v
+    }
+
+    pub fn metrics_json(&self) -> Result<String> {
+        let mismatches = self.rtl_mismatches();
+        let report = Report {
+            generator: format!("rmapgen {}", env!("CARGO_PKG_VERSION")),
+            size: self.opts.size,
+            metrics: &self.metrics,
+            worst: self.worst(),
+            rtl_equals_model: mismatches.map(|n| n == 0),
+            rtl_mismatches: mismatches,
+            images: self.image_names(),
+            config: &self.cfg,
+            scene: &self.scene,
+            volume: &self.context,
+            cast: &self.opts,
+            skipping: Skipping {
+                stats: self.stats,
+                skipped_fraction: self.stats.skipped_fraction(),
+                unshaded_fraction: self.stats.unshaded_fraction(),
+            },
+        };
+        Ok(serde_json::to_string_pretty(&report)?)
+    }
+
+    /// Writes the images and `metrics.json`.
+    pub fn write(&self, out: &StagedDir) -> Result<()> {
+        for (name, img) in self.images() {
+            out.write_bytes(name, &png(&img)?)?;
+        }
+        out.write_text("metrics.json", &self.metrics_json()?)
+    }
+
+    /// One line: what was rendered and the model's error against the reference.
+    pub fn summary(&self) -> String {
+        let m = &self.metrics;
+        let psnr = m.psnr_db.map_or("inf".to_string(), |p| format!("{p:.2}"));
+        let d = self.context.dims;
+        let mut s = format!(
+            "{}x{}x{} volume, {n}x{n} image, {px} covered pixels: max abs error {e} LSB, RMSE {r:.3} LSB, PSNR {psnr} dB; {sk:.1}% of samples skipped",
+            d[0],
+            d[1],
+            d[2],
+            n = self.opts.size,
+            px = m.pixels,
+            e = m.max_abs_error,
+            r = m.rmse,
+            sk = 100.0 * self.stats.skipped_fraction()
+        );
+        if let Some(n) = self.rtl_mismatches() {
+            s.push_str(&format!(
+                "; RTL {}",
+                if n == 0 {
+                    "equals the model".to_string()
+                } else {
+                    format!("differs from the model at {n} pixels")
+                }
+            ));
+        }
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::volume::synthetic;
+
+    struct Fixed(u32);
+    impl IntensitySource for Fixed {
+        fn intensities(&self, g: &[[i32; 3]]) -> Result<Vec<u32>> {
+            Ok(vec![self.0; g.len()])
+        }
+    }
+
+    struct AsModel(ModelShader);
+    impl IntensitySource for AsModel {
+        fn intensities(&self, g: &[[i32; 3]]) -> Result<Vec<u32>> {
+            use crate::volume::cast::Shader;
+            Ok(g.iter().map(|&g| self.0.intensity(g)).collect())
+        }
+    }
+
+    fn scene() -> Scene {
+        Scene::from_toml_str(super::super::ENGINE_SCENE_TOML).unwrap()
+    }
+
+    #[test]
+    fn render_metrics_and_rtl_hook() {
+        let vol = synthetic::engine_block([64, 64, 32], [1.0; 3]).unwrap();
+        let cfg = Config::default();
+        let p = Prepared::new(&vol, cfg.grad_bits, 8);
+        let o = CastOptions {
+            size: 64,
+            ..CastOptions::default()
+        };
+        let s = scene();
+        let r = render(&p, &cfg, &s, o, Some(&AsModel(ModelShader::new(&cfg, &s)))).unwrap();
+        assert_eq!(r.rtl_mismatches(), Some(0));
+        assert!(
+            r.metrics.pixels > 64 * 64 / 4 && r.metrics.pixels < 64 * 64,
+            "{}",
+            r.metrics.pixels
+        );
+        // The model is close to the reference but not identical.
+        assert!(
+            r.metrics.max_abs_error >= 1 && r.metrics.max_abs_error <= 12,
+            "{:?}",
+            r.metrics
+        );
+        let w = r.worst().unwrap();
+        assert_eq!(w.model.abs_diff(w.reference), r.metrics.max_abs_error);
+        let j: serde_json::Value = serde_json::from_str(&r.metrics_json().unwrap()).unwrap();
+        for k in [
+            "max_abs_error",
+            "rmse",
+            "psnr_db",
+            "pixels",
+            "worst",
+            "config",
+            "scene",
+            "volume",
+            "skipping",
+        ] {
+            assert!(!j[k].is_null(), "{k}");
+        }
+        assert_eq!(j["rtl_equals_model"], true);
+        assert_eq!(j["scene"]["transfer"]["points"][1][0], 1900.0);
+        let imgs = r.images();
+        assert_eq!(
+            imgs.iter().map(|i| i.0).collect::<Vec<_>>(),
+            r.image_names()
+        );
+        // Background stays black; the error image is 50 per LSB.
+        assert_eq!(imgs[1].1.get_pixel(0, 0).0[0], 0);
+        let e = &imgs[2].1;
+        let (x, y) = (w.x, w.y);
+        assert_eq!(
+            e.get_pixel(x, y).0[0] as u32,
+            (50 * r.metrics.max_abs_error).min(255)
+        );
+
+        // A batch shader that disagrees is reported; one that is out of range is refused.
+        let other = render(&p, &cfg, &s, o, Some(&Fixed(3))).unwrap();
+        assert!(
+            other.rtl_mismatches().unwrap() > 0
+                && other.summary().contains("differs from the model")
+        );
+        assert!(render(&p, &cfg, &s, o, Some(&Fixed(256)))
+            .unwrap_err()
+            .to_string()
+            .contains("wider than"));
+    }
+
+    #[test]
+    fn a_scene_without_transfer_is_refused() {
+        let vol = synthetic::engine_block([16, 16, 8], [1.0; 3]).unwrap();
+        let p = Prepared::new(&vol, 12, 8);
+        let e = render(
+            &p,
+            &Config::default(),
+            &Scene::standard(),
+            CastOptions::default(),
+            None,
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("no [transfer] section"));
+    }
+}

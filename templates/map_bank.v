@@ -1,0 +1,40 @@
+{= h.header =}
+`default_nettype none
+
+// One reflectance-map RAM bank: simple dual port, a synchronous write port for the host and
+// a read port through a register, so that it maps to block RAM. Initialised from INIT_FILE
+// (both buffers hold the scene's map), so the design shades out of reset. A read and a write
+// of the same address in one cycle return undefined data; the top never issues one, because
+// samples read the front buffer and the host writes the back one. Latency 1.
+module map_bank #(
+  parameter INIT_FILE = "{= init_file =}"  // $readmemh file, one M-bit entry per line
+) (
+{= h.ports =}
+);
+
+  localparam M       = {= m =};  // entry width
+  localparam ENTRIES = {= entries =};  // 2^BA
+
+  reg [M-1:0] mem [0:ENTRIES-1];
+  initial begin
+    $readmemh(INIT_FILE, mem);
+  end
+
+  always @(posedge clk_i) begin
+    if (wr_en_i) begin
+      mem[wr_addr_i] <= wr_data_i;
+    end
+  end
+
+  reg [M-1:0] rd_data_q;
+  always @(posedge clk_i) begin
+    if (en_i) begin
+      rd_data_q <= mem[rd_addr_i];
+    end
+  end
+
+  assign rd_data_o = rd_data_q;
+
+endmodule
+
+`default_nettype wire

@@ -1,0 +1,33 @@
+{= h.header =}
+`default_nettype none
+
+// Reciprocal ROM: entry i holds round(2^(R-1+W) / m) for m = 2^(R-1) + i, clipped to W bits
+// (contents: rmapgen's model, recip_rom::contents). The reduced max always has its MSB set,
+// so the address is the R-1 bits below it. Read through a register so that it maps to block
+// RAM. Latency 1.
+module recip_rom #(
+  parameter INIT_FILE = "{= init_file =}"  // $readmemh file, one W-bit entry per line
+) (
+{= h.ports =}
+);
+
+  localparam W       = {= w =};  // entry width
+  localparam ENTRIES = {= entries =};  // 2^(R-1)
+
+  reg [W-1:0] rom [0:ENTRIES-1];
+  initial begin
+    $readmemh(INIT_FILE, rom);
+  end
+
+  reg [W-1:0] data_q;
+  always @(posedge clk_i) begin
+    if (en_i) begin
+      data_q <= rom[addr_i];
+    end
+  end
+
+  assign data_o = data_q;
+
+endmodule
+
+`default_nettype wire

@@ -1,0 +1,315 @@
+{= h.header =}
+`default_nettype none
+
+// Reflectance-map shader: gradient in, intensity out, one sample per clock.
+// zero_detect runs beside sort_shift -> normalise -> {% if compensation %}atan_rom{% else %}linear_index{% endif %} -> map_lookup{% if interpolation %} -> interpolate{% endif %}{% if color %} -> color_mul{% endif %};
+// pipe_delay lines carry the sideband (signs, axis, buffer{% if color %}, colour{% endif %}, zero flag) beside the
+// stages, and one output register applies the zero flag.
+// Stage latencies: {= latency_list =}, output register 1: total {= total =}.
+// Map buffers: a sample accepted in the cycle of swap_i or later reads the new front buffer;
+// host writes go to the back buffer. After a swap, let the samples accepted before it leave
+// (LATENCY clocks) before writing into the old front buffer.
+module rmap_top (
+{= h.ports =}
+);
+
+  localparam R   = {= r =};  // reduced magnitude width
+  localparam F   = {= f =};  // fraction width
+  localparam POS = {= pos =};  // map position width
+  localparam M   = {= m =};  // map entry and intensity width
+{%- if interpolation %}
+  localparam P   = {= p =};  // interpolation weight fraction bits
+{%- endif %}
+{%- if color %}
+  localparam C   = {= c =};  // colour channel width
+{%- endif %}
+
+  // Sideband delays, from rmapgen::rtl::latency (the stage latencies above).
+  localparam SIGN_DELAY = {= sign_delay =};  // sort_shift out to map_lookup in
+  localparam BUF_DELAY  = {= buf_delay =};  // accept to map_lookup in
+  localparam ZERO_DELAY = {= zero_delay =};  // zero_detect out to the output register
+{%- if color %}
+  localparam RGB_DELAY  = {= rgb_delay =};  // accept to color_mul in
+  localparam I_DELAY    = {= i_delay =};  // intensity beside color_mul
+{%- endif %}
+
+  // The plain valid stream never stalls: every stage's clock enable is tied high.
+  wire en;
+  assign en = 1'b1;
+
+  // ---------------------------------------------------------------- map buffers
+  reg  front_q;
+  wire front_d;
+  assign front_d = front_q ^ swap_i;
+
+  always @(posedge clk_i or negedge rst_ni) begin
+    if (!rst_ni) begin
+      front_q <= 1'b0;
+    end else begin
+      front_q <= front_d;
+    end
+  end
+
+  // ---------------------------------------------------------------- zero_detect
+  wire unused_zd_valid;  // the valid bit travels through sort_shift
+  wire zd_zero;
+
+  zero_detect u_zero_detect (
+    .clk_i   (clk_i),
+    .rst_ni  (rst_ni),
+    .en_i    (en),
+    .valid_i (valid_i),
+    .gx_i    (gx_i),
+    .gy_i    (gy_i),
+    .gz_i    (gz_i),
+    .valid_o (unused_zd_valid),
+    .zero_o  (zd_zero)
+  );
+
+  // ---------------------------------------------------------------- sort_shift
+  wire         ss_valid;
+  wire [1:0]   ss_axis;
+  wire         ss_s_max, ss_s_u, ss_s_v;
+  wire [R-1:0] ss_m, ss_a, ss_b;
+
+  sort_shift u_sort_shift (
+    .clk_i   (clk_i),
+    .rst_ni  (rst_ni),
+    .en_i    (en),
+    .valid_i (valid_i),
+    .gx_i    (gx_i),
+    .gy_i    (gy_i),
+    .gz_i    (gz_i),
+    .valid_o (ss_valid),
+    .axis_o  (ss_axis),
+    .s_max_o (ss_s_max),
+    .s_u_o   (ss_s_u),
+    .s_v_o   (ss_s_v),
+    .m_o     (ss_m),
+    .a_o     (ss_a),
+    .b_o     (ss_b)
+  );
+
+  // ---------------------------------------------------------------- normalise
+  wire         nm_valid;
+  wire [F-1:0] nm_u, nm_v;
+
+  normalise u_normalise (
+    .clk_i   (clk_i),
+    .rst_ni  (rst_ni),
+    .en_i    (en),
+    .valid_i (ss_valid),
+    .m_i     (ss_m),
+    .a_i     (ss_a),
+    .b_i     (ss_b),
+    .valid_o (nm_valid),
+    .u_o     (nm_u),
+    .v_o     (nm_v)
+  );
+
+  // ---------------------------------------------------------------- {% if compensation %}atan_rom{% else %}linear_index{% endif %}
+  wire           ps_valid;
+  wire [POS-1:0] ps_u, ps_v;
+
+  {% if compensation %}atan_rom u_atan_rom{% else %}linear_index u_linear_index{% endif %} (
+    .clk_i   (clk_i),
+    .rst_ni  (rst_ni),
+    .en_i    (en),
+    .valid_i (nm_valid),
+    .u_i     (nm_u),
+    .v_i     (nm_v),
+    .valid_o (ps_valid),
+    .pu_o    (ps_u),
+    .pv_o    (ps_v)
+  );
+
+  // ---------------------------------------------------------------- map_lookup
+  wire [1:0] ml_axis;
+  wire       ml_s_max, ml_s_u, ml_s_v;
+  wire       ml_rd_buf;
+
+  pipe_delay #(
+    .WIDTH (5),
+    .DEPTH (SIGN_DELAY)
+  ) u_sign_delay (
+    .clk_i (clk_i),
+    .en_i  (en),
+    .d_i   ({ss_axis, ss_s_max, ss_s_u, ss_s_v}),
+    .q_o   ({ml_axis, ml_s_max, ml_s_u, ml_s_v})
+  );
+
+  pipe_delay #(
+    .WIDTH (1),
+    .DEPTH (BUF_DELAY)
+  ) u_buf_delay (
+    .clk_i (clk_i),
+    .en_i  (en),
+    .d_i   (front_d),
+    .q_o   (ml_rd_buf)
+  );
+
+  wire         ml_valid;
+  wire [M-1:0] ml_e00;
+{%- if interpolation %}
+  wire [M-1:0] ml_e10, ml_e01, ml_e11;
+  wire [P:0]   ml_wu, ml_wv;
+{%- endif %}
+
+  map_lookup u_map_lookup (
+    .clk_i     (clk_i),
+    .rst_ni    (rst_ni),
+    .en_i      (en),
+    .valid_i   (ps_valid),
+    .axis_i    (ml_axis),
+    .s_max_i   (ml_s_max),
+    .s_u_i     (ml_s_u),
+    .s_v_i     (ml_s_v),
+    .pu_i      (ps_u),
+    .pv_i      (ps_v),
+    .rd_buf_i  (ml_rd_buf),
+    .wr_en_i   (wr_en_i),
+    .wr_buf_i  (~front_d),
+    .wr_axis_i (wr_axis_i),
+    .wr_addr_i (wr_addr_i),
+    .wr_data_i (wr_data_i),
+    .valid_o   (ml_valid),
+{%- if interpolation %}
+    .e00_o     (ml_e00),
+    .e10_o     (ml_e10),
+    .e01_o     (ml_e01),
+    .e11_o     (ml_e11),
+    .wu_o      (ml_wu),
+    .wv_o      (ml_wv)
+{%- else %}
+    .e00_o     (ml_e00)
+{%- endif %}
+  );
+{%- if interpolation %}
+
+  // ---------------------------------------------------------------- interpolate
+  wire         ip_valid;
+  wire [M-1:0] ip_i;
+
+  interpolate u_interpolate (
+    .clk_i   (clk_i),
+    .rst_ni  (rst_ni),
+    .en_i    (en),
+    .valid_i (ml_valid),
+    .e00_i   (ml_e00),
+    .e10_i   (ml_e10),
+    .e01_i   (ml_e01),
+    .e11_i   (ml_e11),
+    .wu_i    (ml_wu),
+    .wv_i    (ml_wv),
+    .valid_o (ip_valid),
+    .i_o     (ip_i)
+  );
+{%- endif %}
+
+  // The intensity before the zero flag is applied.
+  wire         lk_valid;
+  wire [M-1:0] lk_i;
+{%- if interpolation %}
+  assign lk_valid = ip_valid;
+  assign lk_i     = ip_i;
+{%- else %}
+  assign lk_valid = ml_valid;
+  assign lk_i     = ml_e00;
+{%- endif %}
+
+  // ---------------------------------------------------------------- output
+  wire         out_valid;  // at the output register's input
+  wire [M-1:0] out_i;
+  wire         out_zero;
+{%- if color %}
+  wire [C-1:0] out_r, out_g, out_b;
+  wire [C-1:0] cm_r, cm_g, cm_b;  // the sample's colour, delayed to color_mul
+
+  pipe_delay #(
+    .WIDTH (3 * C),
+    .DEPTH (RGB_DELAY)
+  ) u_rgb_delay (
+    .clk_i (clk_i),
+    .en_i  (en),
+    .d_i   ({r_i, g_i, b_i}),
+    .q_o   ({cm_r, cm_g, cm_b})
+  );
+
+  // Colour times the intensity before zeroing: for a zero gradient the output register
+  // forces the colour to 0, which is also what the intensity 0 would give.
+  color_mul u_color_mul (
+    .clk_i   (clk_i),
+    .rst_ni  (rst_ni),
+    .en_i    (en),
+    .valid_i (lk_valid),
+    .i_i     (lk_i),
+    .r_i     (cm_r),
+    .g_i     (cm_g),
+    .b_i     (cm_b),
+    .valid_o (out_valid),
+    .r_o     (out_r),
+    .g_o     (out_g),
+    .b_o     (out_b)
+  );
+
+  pipe_delay #(
+    .WIDTH (M),
+    .DEPTH (I_DELAY)
+  ) u_i_delay (
+    .clk_i (clk_i),
+    .en_i  (en),
+    .d_i   (lk_i),
+    .q_o   (out_i)
+  );
+{%- else %}
+  assign out_valid = lk_valid;
+  assign out_i     = lk_i;
+{%- endif %}
+
+  pipe_delay #(
+    .WIDTH (1),
+    .DEPTH (ZERO_DELAY)
+  ) u_zero_delay (
+    .clk_i (clk_i),
+    .en_i  (en),
+    .d_i   (zd_zero),
+    .q_o   (out_zero)
+  );
+
+  reg         valid_q;
+  reg         zero_q;
+  reg [M-1:0] i_q;
+{%- if color %}
+  reg [C-1:0] r_q, g_q, b_q;
+{%- endif %}
+
+  always @(posedge clk_i or negedge rst_ni) begin
+    if (!rst_ni) begin
+      valid_q <= 1'b0;
+    end else begin
+      valid_q <= out_valid;
+    end
+  end
+
+  always @(posedge clk_i) begin
+    zero_q <= out_zero;
+    i_q    <= out_zero ? {M{1'b0}} : out_i;
+{%- if color %}
+    r_q    <= out_zero ? {C{1'b0}} : out_r;
+    g_q    <= out_zero ? {C{1'b0}} : out_g;
+    b_q    <= out_zero ? {C{1'b0}} : out_b;
+{%- endif %}
+  end
+
+  assign valid_o = valid_q;
+  assign zero_o  = zero_q;
+  assign i_o     = i_q;
+{%- if color %}
+  assign r_o     = r_q;
+  assign g_o     = g_q;
+  assign b_o     = b_q;
+{%- endif %}
+
+endmodule
+
+`default_nettype wire

@@ -1,0 +1,281 @@
+{= t.header =}
+//
+// Self-checking testbench of {= t.module =} (Verilog-2005; Icarus Verilog and Verilator --binary).
+{%- block description %}{% endblock %}
+//
+// Run from the generated directory, which holds vectors/ and the .hex files:
+//   iverilog -g2005 -Wall -Wno-timescale -s {= t.module =}_tb -o {= t.module =}_tb.vvp tb/{= t.module =}_tb.v *.v
+//   vvp -N {= t.module =}_tb.vvp      (-N: a failing run exits 1)
+// It reads {= t.vector_file =} (or the file of +vectors=FILE), one vector per line: {= t.field_list =}
+// (inputs, then expected outputs, hex). Inputs are driven and outputs sampled on the falling
+// edge, never right after the rising one. From the {= t.full_speed =}th accepted vector on it inserts random
+// bubbles (valid_i low){% if t.has_en %} and stalls (en_i low){% endif %}, and resets the design once mid-stream and
+// presents the samples then in flight again. Every output must appear once, in order, when
+// valid_o && {% if t.has_en %}en_i{% else %}the clock{% endif %}, exactly LATENCY enabled clocks after its input. Mismatches print the
+// vector's line; the last line of the run is `N passed, M failed`.
+`timescale 1ns / 1ps
+`default_nettype none
+
+module {= t.module =}_tb;
+
+  localparam LATENCY    = {= t.latency =};  // rmapgen::rtl::latency of {= t.module =}
+  localparam DEPTH      = {= t.depth =};  // ring of vectors read but not yet checked (> LATENCY + 2)
+  localparam DL         = {= t.depth_bits =};  // log2(DEPTH)
+  localparam NFIELDS    = {= t.fields.len() =};
+  localparam FULL_SPEED = {= t.full_speed =};  // vectors accepted back to back before bubbles{% if t.has_en %} and stalls{% endif %}
+  localparam RESET_AT   = {= t.reset_at =};  // accepted vectors before the mid-stream reset
+  localparam TIMEOUT    = {= t.timeout =};  // clocks without an output while samples are in flight
+  localparam SHOW       = 10;  // mismatches printed in full; later ones by line only
+
+  // ---------------------------------------------------------------- the design
+{%- for p in t.inputs %}
+  reg  {= p.range =} {= p.name =} = {= p.init =};
+{%- endfor %}
+{%- for p in t.outputs %}
+  wire {= p.range =} {= p.name =};
+{%- endfor %}
+
+  {= t.module =} dut (
+{%- for p in t.ports %}
+    .{= p.name =} ({= p.name =}){% if !loop.last %},{% endif %}
+{%- endfor %}
+  );
+
+  always #5 clk_i = ~clk_i;
+
+  // ---------------------------------------------------------------- vectors
+  // Slot k of each ring holds a field of vector k mod DEPTH. Vectors [nout, nin) are in the
+  // pipeline, [nin, nread) read but not yet accepted.
+{%- for f in t.fields %}
+  reg {= f.range =} v_{= f.name =} [0:DEPTH-1];
+  reg {= f.range =} s_{= f.name =};
+{%- endfor %}
+  integer v_line [0:DEPTH-1];  // line in the vector file
+  integer v_edge [0:DEPTH-1];  // enabled rising edges before the vector was accepted
+
+  reg [8*512-1:0] vector_file;
+  integer fd, {% if !t.hex_files.is_empty() %}fh, {% endif %}r;
+  integer nread, nin, nout;  // vectors read, accepted, checked
+  integer passed, failed, errors, shown;
+  integer edges;  // enabled rising edges since the stream began
+  integer idle;  // clocks since the last output while samples are in flight
+  integer seed;{% if !t.map2_files.is_empty() %}
+  integer k;{% endif %}
+  reg [31:0]   rnd;
+  reg          eof, en_next, present, ok, did_reset;
+  reg [DL-1:0] so, si;
+{%- block decls %}{% endblock %}
+
+  // Reads the next vector into slot nread mod DEPTH, or sets eof.
+  task read_vector;
+    begin
+      r = $fscanf(fd, "{= t.scan_format =}\n", {= t.scan_args =});
+      if (r == NFIELDS) begin
+        si = nread[DL-1:0];
+{%- for f in t.fields %}
+        v_{= f.name =}[si] = s_{= f.name =};
+{%- endfor %}
+        v_line[si] = nread + 1;
+        nread = nread + 1;
+      end else if (r <= 0 && $feof(fd) != 0) begin
+        eof = 1'b1;
+      end else begin
+        $fatal(1, "%0s line %0d: malformed vector (%0d of %0d fields)", vector_file, nread + 1, r, NFIELDS);
+      end
+    end
+  endtask
+
+  // Random values on the data inputs, for clocks without a valid sample.
+  task drive_garbage;
+    begin
+{%- for f in t.in_fields %}
+      rnd = $random(seed);
+      {= f.port =} = rnd[{= f.bits - 1 =}:0];
+{%- endfor %}
+    end
+  endtask
+
+  // Compares the outputs with vector nout (at slot so) and counts the result.
+  task check_output;
+    begin
+      ok = 1'b1;
+{%- for f in t.out_fields %}
+      if ({= f.port =} !== v_{= f.name =}[so]) ok = 1'b0;
+{%- endfor %}
+      if (edges - v_edge[so] != LATENCY) begin
+        $display("LATENCY line %0d: output after %0d enabled clocks, expected %0d",
+                 v_line[so], edges - v_edge[so], LATENCY);
+        ok = 1'b0;
+      end
+      if (ok) begin
+        passed = passed + 1;
+      end else begin
+        failed = failed + 1;
+        if (shown < SHOW) begin
+          $display("MISMATCH line %0d: in {= t.in_format =}", v_line[so],
+                   {= t.in_args =});
+          $display("  expected {= t.out_format =}", {= t.exp_args =});
+          $display("  got      {= t.out_format =}", {= t.got_args =});
+        end else begin
+          $display("MISMATCH line %0d", v_line[so]);
+        end
+        shown = shown + 1;
+      end
+    end
+  endtask
+
+  // A protocol error: counted as a failure, printed always.
+  task protocol_error;
+    input [8*64-1:0] what;
+    begin
+      errors = errors + 1;
+      $display("ERROR at %0t: %0s (vectors checked %0d, accepted %0d)", $time, what, nout, nin);
+    end
+  endtask
+
+  initial begin
+    seed = {= t.seed =};
+    nread = 0;
+    nin = 0;
+    nout = 0;
+    passed = 0;
+    failed = 0;
+    errors = 0;
+    shown = 0;
+    edges = 0;
+    idle = 0;
+    eof = 1'b0;
+    did_reset = 1'b0;
+
+    // Every file this run relies on must exist: a missing $readmemh file only warns and
+    // leaves X (Icarus) or 0 (Verilator), which a comparison may not notice.
+    if (!$value$plusargs("vectors=%s", vector_file)) vector_file = "{= t.vector_file =}";
+    fd = $fopen(vector_file, "r");
+    if (fd == 0) $fatal(1, "cannot open %0s: run from the generated directory", vector_file);
+{%- for h in t.hex_files %}
+    fh = $fopen("{= h =}", "r");
+    if (fh == 0) $fatal(1, "cannot open {= h =}: run from the generated directory");
+    $fclose(fh);
+{%- endfor %}
+    $display("{= t.module =}_tb: {= t.summary =}, latency %0d, vectors %0s", LATENCY, vector_file);
+{%- block init %}{% endblock %}
+
+    // Reset: valid_o low throughout.
+    repeat (3) begin
+      @(negedge clk_i);
+      if (valid_o !== 1'b0) protocol_error("valid_o not low in reset");
+    end
+    rst_ni = 1'b1;
+{%- block preload %}{% endblock %}
+
+    // After reset and before any input: no output.
+    repeat (LATENCY + 4) begin
+      @(negedge clk_i);
+      if (valid_o !== 1'b0) protocol_error("valid_o before any input");
+{%- if t.has_en %}
+      rnd = $random(seed);
+      en_i = rnd[0];
+{%- endif %}
+    end
+
+    read_vector;
+    while (!(eof && nout == nread)) begin
+      @(negedge clk_i);
+
+      // Once, mid-stream: reset with samples in flight. valid_o drops at once and stays low;
+      // the samples in flight are lost and presented again.
+      if (!did_reset && nin >= RESET_AT) begin
+        did_reset = 1'b1;
+        valid_i = 1'b0;
+{%- block reset_quiet %}{% endblock %}
+        rst_ni = 1'b0;
+        #1;
+        if (valid_o !== 1'b0) protocol_error("valid_o did not drop with rst_ni");
+        repeat (2) begin
+          @(negedge clk_i);
+          if (valid_o !== 1'b0) protocol_error("valid_o not low in reset");
+        end
+        rst_ni = 1'b1;
+        $display("reset mid-stream: %0d accepted, %0d in flight, presented again", nin, nin - nout);
+        nin = nout;
+      end
+
+      // Flow control for the coming rising edge.
+{%- if t.has_en %}
+      rnd = $random(seed);
+      en_next = (nin < FULL_SPEED) || (rnd[6:0] >= 7'd32);  // a stall one clock in four
+{%- else %}
+      en_next = 1'b1;  // {= t.module =} has no clock enable
+{%- endif %}
+
+      // The output leaves at the coming edge if valid_o && en_i.
+      if (valid_o === 1'b1) begin
+        if (en_next) begin
+          if (nout == nin) begin
+            protocol_error("valid_o with no sample in flight");
+          end else begin
+            so = nout[DL-1:0];
+            check_output;
+            nout = nout + 1;
+            idle = 0;
+          end
+        end
+      end else if (valid_o !== 1'b0) begin
+        protocol_error("valid_o is X");
+      end
+
+      // The next input, unless this clock is a bubble.
+      if (nin == nread && !eof) read_vector;
+      rnd = $random(seed);
+      present = (nin < nread) && ((nin < FULL_SPEED) || (rnd[6:0] >= 7'd32));  // a bubble one clock in four
+{%- block hold %}{% endblock %}
+      if (present) begin
+        si = nin[DL-1:0];
+{%- for f in t.in_fields %}
+        {= f.port =} = v_{= f.name =}[si];
+{%- endfor %}
+        valid_i = 1'b1;
+        if (en_next) begin
+          v_edge[si] = edges;
+{%- block accept %}{% endblock %}
+          nin = nin + 1;
+        end
+      end else begin
+        valid_i = 1'b0;
+        drive_garbage;
+      end
+{%- block host %}{% endblock %}
+{%- if t.has_en %}
+      en_i = en_next;
+{%- endif %}
+      if (en_next) edges = edges + 1;
+
+      if (nout < nin) idle = idle + 1;
+      if (idle > TIMEOUT) begin
+        $fatal(1, "timeout: no output for %0d clocks with %0d samples in flight (checked %0d)",
+               TIMEOUT, nin - nout, nout);
+      end
+    end
+
+    // Drain: with every sample out, no further output may appear.
+    valid_i = 1'b0;
+{%- if t.has_en %}
+    en_i = 1'b1;
+{%- endif %}
+    repeat (LATENCY + 4) begin
+      @(negedge clk_i);
+      if (valid_o !== 1'b0) protocol_error("valid_o after the last sample");
+    end
+{%- block finish %}{% endblock %}
+
+    $fclose(fd);
+    $display("%0d passed, %0d failed", passed, failed + errors);
+    if (failed + errors != 0 || passed == 0) begin
+      $stop;  // exit code 1 under vvp -N and under Verilator with tb/vl_user.cpp
+    end
+    $finish;
+  end
+
+endmodule
+
+`default_nettype wire

@@ -1,0 +1,205 @@
+//! `rmapgen render` from the command line: what it writes, and how it fails (exit 2, one
+//! line on stderr naming the problem, no output or staging directory left behind).
+
+use super::helpers::{assert_error, run, tempdir};
+use std::path::Path;
+
+const MATERIAL: &str =
+    "[material]\nambient = 0.1\ndiffuse = 0.6\nspecular = 0.3\nshininess = 20.0\n";
+
+fn entries(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = dir
+        .read_dir()
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn writes_images_and_metrics() {
+    let tmp = tempdir();
+    let out = tmp.path().join("sphere");
+    let o = run(&[
+        "render",
+        "--size",
+        "96",
+        "--shrink",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(stdout.lines().count(), 1, "{stdout}");
+    assert!(
+        stdout.contains("max abs error") && stdout.contains("RMSE") && stdout.contains("PSNR"),
+        "{stdout}"
+    );
+    assert_eq!(
+        entries(&out),
+        ["error50.png", "metrics.json", "model.png", "reference.png"]
+    );
+    assert_eq!(entries(tmp.path()), ["sphere"], "no staging directory left");
+    for name in ["error50.png", "model.png", "reference.png"] {
+        let img = image::open(out.join(name)).unwrap();
+        assert_eq!((img.width(), img.height()), (96, 96), "{name}");
+        assert_eq!(img.color(), image::ColorType::L8, "{name}");
+    }
+    let model = image::open(out.join("model.png")).unwrap().to_luma8();
+    assert_eq!(model.get_pixel(0, 0).0[0], 0, "background");
+    // The highlight is upper right: brighter than the mirrored lower-left point.
+    assert!(model.get_pixel(58, 38).0[0] > model.get_pixel(37, 57).0[0] + 50);
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(j["size"], 96);
+    assert_eq!(j["shrink"], 2);
+    assert_eq!(j["config"]["grad_bits"], 12);
+    assert_eq!(j["scene"]["material"]["shininess"], 20.0);
+    assert!(j["max_abs_error"].as_u64().unwrap() > 0 && j["rmse"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
+fn config_flags_and_scene_apply() {
+    let tmp = tempdir();
+    let scene = tmp.path().join("diffuse.toml");
+    std::fs::copy(super::helpers::root().join("scenes/diffuse.toml"), &scene).unwrap();
+    let out = tmp.path().join("o");
+    let o = run(&[
+        "render",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--size",
+        "40",
+        "--no-interpolation",
+        "--map-bits",
+        "10",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(j["config"]["interpolation"], false);
+    assert_eq!(j["peak"], 1023);
+    assert_eq!(j["scene"]["material"]["specular"], 0.0);
+}
+
+/// Runs a failing render whose output would go to a fresh directory, and checks the error
+/// and that nothing was left in that directory.
+fn fails(scene_text: Option<&str>, extra: &[&str], needle: &str) {
+    let inputs = tempdir();
+    let outs = tempdir();
+    let out = outs.path().join("out");
+    let mut args = vec![
+        "render".to_string(),
+        "--out".into(),
+        out.display().to_string(),
+    ];
+    if !extra.contains(&"--size") {
+        args.extend(["--size".into(), "32".into()]);
+    }
+    if let Some(t) = scene_text {
+        let p = inputs.path().join("scene.toml");
+        std::fs::write(&p, t).unwrap();
+        args.extend(["--scene".into(), p.display().to_string()]);
+    }
+    args.extend(extra.iter().map(|s| s.to_string()));
+    let o = run(&args.iter().map(|s| s.as_str()).collect::<Vec<_>>());
+    assert_error(&o, needle);
+    assert!(
+        entries(outs.path()).is_empty(),
+        "left behind: {:?}",
+        entries(outs.path())
+    );
+}
+
+#[test]
+fn malformed_scene() {
+    fails(Some("[material\nambient = 0.1\n"), &[], "unclosed table");
+}
+
+#[test]
+fn nan_light_direction() {
+    fails(
+        Some(&format!(
+            "{MATERIAL}[[light]]\ndirection = [nan, 0.0, 1.0]\n"
+        )),
+        &[],
+        "light 1 direction [NaN, 0.0, 1.0] is not finite",
+    );
+}
+
+#[test]
+fn zero_light_direction() {
+    fails(
+        Some(&format!(
+            "{MATERIAL}[[light]]\ndirection = [0.0, 0.0, 0.0]\n"
+        )),
+        &[],
+        "light 1 direction [0.0, 0.0, 0.0] has zero length",
+    );
+}
+
+#[test]
+fn negative_shininess() {
+    fails(
+        Some(&MATERIAL.replace("shininess = 20.0", "shininess = -2.0")),
+        &[],
+        "shininess = -2 must be a finite number >= 0",
+    );
+}
+
+#[test]
+fn out_of_range_width() {
+    fails(
+        None,
+        &["--grad-bits", "30"],
+        "grad_bits = 30 is out of range; allowed 8..=16",
+    );
+}
+
+#[test]
+fn out_of_range_size_and_shrink() {
+    fails(None, &["--size", "0"], "image size 0 is out of range");
+    fails(
+        None,
+        &["--shrink", "12"],
+        "shrink 12 is out of range; allowed 0..=11",
+    );
+}
+
+#[test]
+fn unwritable_output() {
+    let o = run(&["render", "--size", "32", "--out", "/proc/nonexistent/out"]);
+    assert_error(&o, "cannot write output directory /proc/nonexistent/out");
+    assert!(!Path::new("/proc/nonexistent").exists());
+}
+
+#[test]
+fn failure_keeps_an_existing_output() {
+    // A failing run must not touch what an earlier run wrote.
+    let tmp = tempdir();
+    let out = tmp.path().join("o");
+    assert!(
+        run(&["render", "--size", "16", "--out", out.to_str().unwrap()])
+            .status
+            .success()
+    );
+    let before = std::fs::read(out.join("metrics.json")).unwrap();
+    assert_error(
+        &run(&[
+            "render",
+            "--size",
+            "16",
+            "--red-bits",
+            "13",
+            "--out",
+            out.to_str().unwrap(),
+        ]),
+        "red_bits = 13",
+    );
+    assert_eq!(std::fs::read(out.join("metrics.json")).unwrap(), before);
+    assert_eq!(entries(tmp.path()), ["o"]);
+}

@@ -1,0 +1,320 @@
+//! The generated testbenches against the generated RTL: they pass on the model's vectors,
+//! and they CAN fail: one corrupted expected value gives `N passed, 1 failed` as the last line
+//! and a non-zero exit, a missing hex file is fatal, a wrong latency is caught.
+//!
+//! The simulators are required when CI=true (a missing tool fails the test there); elsewhere
+//! a missing tool skips with a message on stderr.
+
+use crate::helpers;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Whether `tool` is on PATH; panics when it is not and CI=true.
+fn require(tool: &str) -> bool {
+    let found = std::env::var_os("PATH")
+        .map(|p| std::env::split_paths(&p).any(|d| d.join(tool).is_file()))
+        .unwrap_or(false);
+    if !found {
+        if std::env::var("CI").map(|v| v == "true").unwrap_or(false) {
+            panic!("{tool} is not installed and CI=true: run `make tools`");
+        }
+        eprintln!("skipping: {tool} is not installed (make tools)");
+    }
+    found
+}
+
+/// Generates a design into `dir` with `flags` and a small random vector count.
+fn generate(dir: &Path, flags: &[&str]) {
+    let mut args = vec![
+        "generate",
+        "--out",
+        dir.to_str().unwrap(),
+        "--vectors",
+        "300",
+    ];
+    args.extend_from_slice(flags);
+    let o = helpers::run(&args);
+    assert!(
+        o.status.success(),
+        "generate {flags:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+fn design_files(dir: &Path) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "v"))
+        .collect();
+    v.sort();
+    v
+}
+
+/// Compiles `<dir>/tb/<module>_tb.v` with the design under Icarus; returns the .vvp path.
+fn icarus_compile(dir: &Path, module: &str, build: &Path) -> PathBuf {
+    let vvp = build.join(format!("{module}_tb.vvp"));
+    let o = Command::new("iverilog")
+        .args([
+            "-g2005",
+            "-Wall",
+            "-Wno-timescale",
+            "-s",
+            &format!("{module}_tb"),
+            "-o",
+        ])
+        .arg(&vvp)
+        .arg(dir.join(format!("tb/{module}_tb.v")))
+        .args(design_files(dir))
+        .output()
+        .expect("iverilog runs");
+    assert!(
+        o.status.success(),
+        "iverilog {module}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    vvp
+}
+
+/// Runs a simulation binary from the generated directory: (exit code, stdout + stderr).
+fn run_in(dir: &Path, mut cmd: Command) -> (Option<i32>, String) {
+    let o = cmd.current_dir(dir).output().expect("simulator runs");
+    let mut text = String::from_utf8_lossy(&o.stdout).into_owned();
+    text.push_str(&String::from_utf8_lossy(&o.stderr));
+    (o.status.code(), text)
+}
+
+fn vvp(dir: &Path, vvp: &Path, args: &[&str]) -> (Option<i32>, String) {
+    let mut c = Command::new("vvp");
+    c.arg("-N").arg(vvp).args(args);
+    run_in(dir, c)
+}
+
+fn last_line(text: &str) -> &str {
+    text.trim_end().lines().last().unwrap_or("")
+}
+
+fn vector_count(dir: &Path, module: &str) -> usize {
+    std::fs::read_to_string(dir.join(format!("vectors/{module}.hex")))
+        .unwrap()
+        .lines()
+        .count()
+}
+
+/// A copy of a vector file with the last field (an expected output) of line `line` (1-based)
+/// changed; returns the copy's path.
+fn corrupt(dir: &Path, module: &str, line: usize, into: &Path) -> PathBuf {
+    let text = std::fs::read_to_string(dir.join(format!("vectors/{module}.hex"))).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let mut f: Vec<String> = lines[line - 1].split(' ').map(String::from).collect();
+    let last = f.last_mut().unwrap();
+    let w = last.len();
+    let v = u64::from_str_radix(last, 16).unwrap() ^ 1;
+    *last = format!("{v:0w$x}");
+    lines[line - 1] = f.join(" ");
+    let p = into.join(format!("{module}_corrupt.hex"));
+    std::fs::write(&p, lines.join("\n") + "\n").unwrap();
+    p
+}
+
+#[test]
+fn every_testbench_passes_under_icarus() {
+    if !require("iverilog") || !require("vvp") {
+        return;
+    }
+    let configs: [&[&str]; 3] = [
+        &[],
+        &["--no-compensation", "--no-interpolation", "--color"],
+        &[
+            "--grad-bits",
+            "8",
+            "--red-bits",
+            "6",
+            "--frac-bits",
+            "4",
+            "--recip-bits",
+            "5",
+            "--index-bits",
+            "2",
+            "--interp-bits",
+            "1",
+            "--map-bits",
+            "6",
+        ],
+    ];
+    for flags in configs {
+        let tmp = helpers::tempdir();
+        let dir = tmp.path().join("d");
+        generate(&dir, flags);
+        let mut tbs: Vec<String> = std::fs::read_dir(dir.join("tb"))
+            .unwrap()
+            .filter_map(|e| {
+                e.unwrap()
+                    .file_name()
+                    .to_str()?
+                    .strip_suffix("_tb.v")
+                    .map(String::from)
+            })
+            .collect();
+        tbs.sort();
+        assert!(
+            tbs.contains(&"rmap_top".to_string()) && tbs.len() >= 7,
+            "{tbs:?}"
+        );
+        for m in &tbs {
+            let bin = icarus_compile(&dir, m, tmp.path());
+            let (code, out) = vvp(&dir, &bin, &[]);
+            let want = format!("{} passed, 0 failed", vector_count(&dir, m));
+            assert_eq!(last_line(&out), want, "{flags:?} {m}: {out}");
+            assert_eq!(code, Some(0), "{flags:?} {m}: {out}");
+        }
+    }
+}
+
+#[test]
+fn a_corrupted_vector_fails_under_icarus() {
+    if !require("iverilog") || !require("vvp") {
+        return;
+    }
+    let tmp = helpers::tempdir();
+    let dir = tmp.path().join("d");
+    generate(&dir, &[]);
+    for (m, line) in [
+        ("rmap_top", vector_count(&dir, "rmap_top") - 5),
+        ("sort_shift", 3),
+        ("map_lookup", 400),
+    ] {
+        let bin = icarus_compile(&dir, m, tmp.path());
+        let bad = corrupt(&dir, m, line, tmp.path());
+        let (code, out) = vvp(&dir, &bin, &[&format!("+vectors={}", bad.display())]);
+        let n = vector_count(&dir, m);
+        assert_eq!(
+            last_line(&out),
+            format!("{} passed, 1 failed", n - 1),
+            "{m}: {out}"
+        );
+        assert_eq!(code, Some(1), "{m}: {out}");
+        assert!(
+            out.contains(&format!("MISMATCH line {line}: in ")),
+            "{m}: {out}"
+        );
+        assert!(
+            out.contains("  expected ") && out.contains("  got      "),
+            "{m}: {out}"
+        );
+    }
+}
+
+#[test]
+fn a_missing_hex_file_is_fatal() {
+    if !require("iverilog") || !require("vvp") {
+        return;
+    }
+    let tmp = helpers::tempdir();
+    let dir = tmp.path().join("d");
+    generate(&dir, &[]);
+    let bin = icarus_compile(&dir, "rmap_top", tmp.path());
+    for f in [
+        "map_bank_01.hex",
+        "map2_y.hex",
+        "recip_rom.hex",
+        "atan_rom.hex",
+        "vectors/rmap_top.hex",
+    ] {
+        let p = dir.join(f);
+        let keep = tmp.path().join("kept");
+        std::fs::rename(&p, &keep).unwrap();
+        let (code, out) = vvp(&dir, &bin, &[]);
+        std::fs::rename(&keep, &p).unwrap();
+        assert_eq!(code, Some(1), "{f}: {out}");
+        assert!(out.contains(&format!("cannot open {f}")), "{f}: {out}");
+        assert!(!out.contains(" passed, 0 failed"), "{f}: {out}");
+    }
+}
+
+#[test]
+fn a_wrong_latency_or_a_short_map_is_caught() {
+    if !require("iverilog") || !require("vvp") {
+        return;
+    }
+    let tmp = helpers::tempdir();
+    let dir = tmp.path().join("d");
+    generate(&dir, &[]);
+    // A testbench expecting one clock more than the design has: every vector fails.
+    let tb = dir.join("tb/zero_detect_tb.v");
+    let text = std::fs::read_to_string(&tb).unwrap();
+    assert!(text.contains("localparam LATENCY    = 1;"));
+    std::fs::write(
+        &tb,
+        text.replace("localparam LATENCY    = 1;", "localparam LATENCY    = 2;"),
+    )
+    .unwrap();
+    let bin = icarus_compile(&dir, "zero_detect", tmp.path());
+    let (code, out) = vvp(&dir, &bin, &[]);
+    let n = vector_count(&dir, "zero_detect");
+    assert_eq!(last_line(&out), format!("0 passed, {n} failed"), "{out}");
+    assert_eq!(code, Some(1));
+    assert!(
+        out.contains("LATENCY line 1: output after 1 enabled clocks, expected 2"),
+        "{out}"
+    );
+    // A second map with an entry missing is fatal before any vector.
+    let m2 = dir.join("map2_z.hex");
+    let t = std::fs::read_to_string(&m2).unwrap();
+    std::fs::write(&m2, &t[..t.trim_end().rfind('\n').unwrap() + 1]).unwrap();
+    let bin = icarus_compile(&dir, "map_lookup", tmp.path());
+    let (code, out) = vvp(&dir, &bin, &[]);
+    assert_eq!(code, Some(1), "{out}");
+    assert!(out.contains("map2_*.hex: entry"), "{out}");
+}
+
+#[test]
+fn verilator_passes_and_fails_the_same_way() {
+    if !require("verilator") {
+        return;
+    }
+    let tmp = helpers::tempdir();
+    let dir = tmp.path().join("d");
+    generate(&dir, &["--color"]);
+    let mdir = tmp.path().join("obj");
+    let o = Command::new("verilator")
+        .args([
+            "--binary",
+            "-j",
+            "2",
+            "--top-module",
+            "rmap_top_tb",
+            "-o",
+            "sim",
+            "--Mdir",
+        ])
+        .arg(&mdir)
+        .arg(dir.join("tb/rmap_top_tb.v"))
+        .args(design_files(&dir))
+        .arg(helpers::root().join("tb/vl_user.cpp"))
+        .args(["-CFLAGS", "-DVL_USER_FINISH", "-CFLAGS", "-DVL_USER_STOP"])
+        .output()
+        .expect("verilator runs");
+    assert!(
+        o.status.success(),
+        "verilator: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let sim = mdir.join("sim");
+    let n = vector_count(&dir, "rmap_top");
+    let (code, out) = run_in(&dir, Command::new(&sim));
+    assert_eq!(
+        (code, last_line(&out)),
+        (Some(0), format!("{n} passed, 0 failed").as_str()),
+        "{out}"
+    );
+    let bad = corrupt(&dir, "rmap_top", 2, tmp.path());
+    let mut c = Command::new(&sim);
+    c.arg(format!("+vectors={}", bad.display()));
+    let (code, out) = run_in(&dir, c);
+    assert_eq!(
+        (code, last_line(&out)),
+        (Some(1), format!("{} passed, 1 failed", n - 1).as_str()),
+        "{out}"
+    );
+}
