@@ -33,10 +33,12 @@ roms: build
 
 test: tools cargo-test
 
-# ---- Simulation (tb/run_sims.sh): every testbench of $(OUT), generated with $(GEN_FLAGS),
-# under Verilator (sim), Icarus (sim-icarus) or both (sim-all); build products in build/sim/.
-# sim-matrix runs both simulators over the configuration list of tb/sim_matrix.sh.
+# ---- Simulation (tb/run_sims.sh): every testbench of the design generated with $(GEN_FLAGS)
+# into $(SIM_OUT) (not the committed rtl_out/), under Verilator (sim), Icarus (sim-icarus) or
+# both (sim-all); build products in build/sim/. sim-matrix runs both simulators over the
+# configuration list of tb/sim_matrix.sh (into build/matrix/).
 GEN_FLAGS     ?=
+SIM_OUT       ?= build/rtl_sim
 SIM_STREAM    ?= 1000000
 SIM_TB_STREAM ?= 100000
 SIM_ENV        = IVERILOG=$(IVERILOG) VVP=$(VVP) VERILATOR=$(VERILATOR) RMAPGEN=$(abspath $(RMAPGEN))
@@ -44,18 +46,18 @@ SIM_ENV        = IVERILOG=$(IVERILOG) VVP=$(VVP) VERILATOR=$(VERILATOR) RMAPGEN=
 .PHONY: sim sim-icarus sim-all sim-matrix sim-gen
 
 sim-gen: build
-	$(RMAPGEN) generate --out $(OUT) $(GEN_FLAGS)
+	$(RMAPGEN) generate --out $(SIM_OUT) $(GEN_FLAGS)
 
 # Verilator: every testbench, the top's on $(SIM_TB_STREAM) more vectors, and the C++ harness
 # on $(SIM_STREAM) random vectors.
 sim: sim-gen
-	$(SIM_ENV) tb/run_sims.sh --verilator --stream $(SIM_STREAM) --tb-stream $(SIM_TB_STREAM) $(OUT)
+	$(SIM_ENV) tb/run_sims.sh --verilator --stream $(SIM_STREAM) --tb-stream $(SIM_TB_STREAM) $(SIM_OUT)
 
 sim-icarus: sim-gen
-	$(SIM_ENV) tb/run_sims.sh --icarus --tb-stream $(SIM_TB_STREAM) $(OUT)
+	$(SIM_ENV) tb/run_sims.sh --icarus --tb-stream $(SIM_TB_STREAM) $(SIM_OUT)
 
 sim-all: sim-gen
-	$(SIM_ENV) tb/run_sims.sh --icarus --verilator --stream $(SIM_STREAM) --tb-stream $(SIM_TB_STREAM) $(OUT)
+	$(SIM_ENV) tb/run_sims.sh --icarus --verilator --stream $(SIM_STREAM) --tb-stream $(SIM_TB_STREAM) $(SIM_OUT)
 
 sim-matrix: build
 	$(SIM_ENV) STREAM=$(SIM_STREAM) tb/sim_matrix.sh

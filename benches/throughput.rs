@@ -6,7 +6,8 @@ use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughpu
 use rmapgen::config::Config;
 use rmapgen::hexfile;
 use rmapgen::model::fast::FastShader;
-use rmapgen::model::Model;
+use rmapgen::model::map_fit::LsqFit;
+use rmapgen::model::{reflectance_map, Model};
 use rmapgen::reference::Reference;
 use rmapgen::scene::Scene;
 use rmapgen::vectors::rng::SplitMix64;
@@ -79,6 +80,23 @@ fn throughput(c: &mut Criterion) {
     });
     g.bench_function("fast_new", |b| {
         b.iter(|| FastShader::new(black_box(&model), black_box(&maps)))
+    });
+    // Host map build of one frame on the standard scene: sampled, and the least-squares fits
+    // (their configuration-only part, LsqFit::new, done once outside the loop).
+    let standard = Scene::standard().prepared();
+    g.bench_function("map_sample", |b| {
+        b.iter(|| reflectance_map::contents(&cfg, |n| standard.shade(black_box(n))))
+    });
+    let fit = LsqFit::new(&cfg);
+    g.bench_function("map_lsq", |b| {
+        b.iter(|| fit.fit(|n| standard.shade(black_box(n))))
+    });
+    let plain = LsqFit::plain(&cfg);
+    g.bench_function("map_lsq_plain", |b| {
+        b.iter(|| plain.fit(|n| standard.shade(black_box(n))))
+    });
+    g.bench_function("lsq_precompute_per_config", |b| {
+        b.iter(|| LsqFit::new(black_box(&cfg)))
     });
     g.finish();
 }

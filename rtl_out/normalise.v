@@ -4,12 +4,11 @@
 `default_nettype none
 
 // Normalise: u = a / m and v = b / m as F-bit fractions, computed as a * (1/m) with the
-// reciprocal ROM and two multipliers, rounded half up: u = min(2^F-1, (a*recip + 2^(SH-1))
-// >> SH). A component equal to the max saturates to all ones, which the index stages read as
-// exactly 1.
-// Stage 1 reads the ROM and compares; stage 2 multiplies by the two halves of a; stage 3
-// adds the halves, rounds and saturates.
-// Latency 3.
+// reciprocal ROM and two multipliers, rounded half up:
+//   u = min(2^F-1, (a*recip + 2^(SH-1)) >> SH).
+// A component equal to the max saturates to all ones, which the index stages read as exactly
+// 1. Stage 1 reads the ROM and compares; stage 2 multiplies by the two halves of a; stage 3
+// adds the halves, rounds and saturates. Latency 3.
 module normalise (
   input  wire       clk_i,
   input  wire       rst_ni,   // asynchronous, active low: clears valid bits only

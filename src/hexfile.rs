@@ -2,7 +2,7 @@
 //! configuration (Icarus, Verilator and Yosys all accept them), then one entry per line.
 
 use crate::config::Config;
-use crate::model::{atan_rom, recip_rom, reflectance_map, Maps};
+use crate::model::{atan_rom, map_fit, recip_rom, Maps};
 use crate::scene::Scene;
 
 /// Hex digits of a `bits`-wide value.
@@ -25,10 +25,10 @@ pub fn format(cfg: &Config, what: &str, bits: u32, entries: &[u32]) -> String {
     s
 }
 
-/// The maps of a scene for a configuration.
+/// The maps of a scene for a configuration, filled as the scene's `map_fit` says.
 pub fn scene_maps(cfg: &Config, scene: &Scene) -> Maps {
     let p = scene.prepared();
-    reflectance_map::contents(cfg, |n| p.shade(n))
+    map_fit::contents(cfg, scene.map_fit, |n| p.shade(n))
 }
 
 /// The fixed ROMs and the scene's maps, as (file name, contents).

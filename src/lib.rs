@@ -1,6 +1,7 @@
 //! rmapgen: a generator of synthesizable Verilog for the on-chip reflectance-map shader of
 //! Terwisscha van Scheltinga, Smit and Bosma, with the bit-accurate model that checks it.
 
+pub mod bench;
 pub mod cmd;
 pub mod config;
 pub mod hexfile;

@@ -31,6 +31,9 @@ enum Command {
     /// Run the model over every gradient (--exhaustive) or a sample sweeping every magnitude,
     /// and report the worst angular and intensity errors per magnitude class.
     Stress(cmd::stress::StressArgs),
+    /// Measure error against run time and hardware cost over configurations, scenes and map
+    /// fits; write a Markdown table, a CSV and plots.
+    Bench(cmd::bench::BenchArgs),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -40,6 +43,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Render(a) => cmd::render::run(&a),
         Command::Vectors(a) => cmd::vectors::run(&a),
         Command::Stress(a) => cmd::stress::run(&a),
+        Command::Bench(a) => cmd::bench::run(&a),
         Command::Volume(a) => cmd::volume::run(&a),
     }
 }

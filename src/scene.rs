@@ -20,6 +20,11 @@ pub struct Scene {
     /// shading itself, so sphere scenes leave it out.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub transfer: Option<crate::volume::transfer::Transfer>,
+    /// How the host fills the maps from the light model: `"sample"` (the light model at each
+    /// entry's direction, the paper) or `"lsq"` (least squares over a dense grid of
+    /// directions, `model::map_fit`). A top-level key; commands' `--map-fit` overrides it.
+    #[serde(default)]
+    pub map_fit: crate::model::map_fit::MapFit,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -169,6 +169,8 @@ pub struct Report {
     /// "exhaustive" or "sampled".
     pub mode: String,
     pub config: Config,
+    /// How the maps were filled.
+    pub map_fit: crate::model::map_fit::MapFit,
     /// Gradients evaluated, the zero gradient included.
     pub inputs: u64,
     /// Inputs on which two bit-exact evaluations disagreed (must be 0): the fast path against
@@ -338,6 +340,7 @@ impl Acc {
         Report {
             mode: mode.to_string(),
             config: cfg.clone(),
+            map_fit: Default::default(),
             inputs: classes.iter().map(|c| c.inputs).sum::<u64>() + extra_inputs,
             mismatches: self.mismatches,
             first_mismatch: self.first_mismatch.map(|(_, g)| g),
@@ -411,7 +414,8 @@ pub fn sampled(setup: &Setup, samples: u64, seed: u64) -> Report {
                     .reference
                     .exact(g)
                     .expect("sampled gradients are never zero");
-                let reference = setup.reference.intensity(g);
+                // Reference::intensity is exactly this quantisation of Reference::exact.
+                let reference = crate::model::reflectance_map::quantise(cfg, exact);
                 let w = WorstError {
                     error: out as i64 - reference as i64,
                     gradient: g,
@@ -424,7 +428,9 @@ pub fn sampled(setup: &Setup, samples: u64, seed: u64) -> Report {
             acc
         })
         .reduce(|| Acc::new(cfg), Acc::merge);
-    acc.report(cfg, "sampled", 0, start.elapsed().as_secs_f64())
+    let mut r = acc.report(cfg, "sampled", 0, start.elapsed().as_secs_f64());
+    r.map_fit = setup.scene.map_fit;
+    r
 }
 
 #[cfg(test)]

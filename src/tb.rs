@@ -22,8 +22,11 @@ use askama::Template;
 pub struct Sig {
     pub name: &'static str,
     /// `[n-1:0]`, or empty for one bit.
+    /// `[n-1:0]`, or blanks for one bit, padded so the names line up.
     pub range: String,
     pub init: String,
+    /// The instance connection, `.name (name)`, names padded.
+    pub pin: String,
 }
 
 /// A vector field as the testbench stores and drives or checks it.
@@ -150,12 +153,18 @@ pub fn data(cfg: &Config, stage: Stage) -> Result<TbData> {
     let mut inputs = Vec::new();
     let mut outputs = Vec::new();
     let mut sigs = Vec::new();
+    let mut rw = 0;
+    for p in &ports {
+        rw = rw.max(range(bits_of(p)?).len());
+    }
+    let nw = ports.iter().map(|p| p.name.len()).max().unwrap_or(0);
     for p in &ports {
         let b = bits_of(p)?;
         let s = || Sig {
             name: p.name,
-            range: range(b),
+            range: format!("{:rw$}", range(b)),
             init: format!("{b}'d0"),
+            pin: format!(".{:nw$} ({})", p.name, p.name),
         };
         match p.dir {
             rtl::Dir::Input => inputs.push(s()),

@@ -15,6 +15,9 @@ module map_bank #(
   localparam M       = {= m =};  // entry width
   localparam ENTRIES = {= entries =};  // 2^BA
 
+  // no_rw_check: a same-address read and write never happen (see above), so Yosys need not
+  // add logic to define their result.
+  (* no_rw_check *)
   reg [M-1:0] mem [0:ENTRIES-1];
   initial begin
     $readmemh(INIT_FILE, mem);

@@ -10,13 +10,15 @@
 // Run from the generated directory, which holds vectors/ and the .hex files:
 //   iverilog -g2005 -Wall -Wno-timescale -s atan_rom_tb -o atan_rom_tb.vvp tb/atan_rom_tb.v *.v
 //   vvp -N atan_rom_tb.vvp      (-N: a failing run exits 1)
-// It reads vectors/atan_rom.hex (or the file of +vectors=FILE), one vector per line: u v pu pv
+// It reads vectors/atan_rom.hex (or the file of +vectors=FILE), one vector per line:
+//   u v pu pv
 // (inputs, then expected outputs, hex). Inputs are driven and outputs sampled on the falling
-// edge, never right after the rising one. From the 64th accepted vector on it inserts random
-// bubbles (valid_i low) and stalls (en_i low), and resets the design once mid-stream and
-// presents the samples then in flight again. Every output must appear once, in order, when
-// valid_o && en_i, exactly LATENCY enabled clocks after its input. Mismatches print the
-// vector's line; the last line of the run is `N passed, M failed`.
+// edge, never right after the rising one. The first 64 vectors are accepted back to back;
+// then random bubbles (valid_i low) and stalls (en_i low) follow.
+// The design is reset once mid-stream and the samples then in flight are presented again.
+// Every output must leave once, in order, when valid_o && en_i at a rising edge, exactly
+// LATENCY enabled clocks after its input. Mismatches print the vector's line; the last line
+// of a run is `N passed, M failed`.
 `timescale 1ns / 1ps
 `default_nettype none
 
@@ -32,26 +34,26 @@ module atan_rom_tb;
   localparam SHOW       = 10;  // mismatches printed in full; later ones by line only
 
   // ---------------------------------------------------------------- the design
-  reg   clk_i = 1'd0;
-  reg   rst_ni = 1'd0;
-  reg   en_i = 1'd0;
-  reg   valid_i = 1'd0;
+  reg        clk_i = 1'd0;
+  reg        rst_ni = 1'd0;
+  reg        en_i = 1'd0;
+  reg        valid_i = 1'd0;
   reg  [7:0] u_i = 8'd0;
   reg  [7:0] v_i = 8'd0;
-  wire  valid_o;
+  wire       valid_o;
   wire [5:0] pu_o;
   wire [5:0] pv_o;
 
   atan_rom dut (
-    .clk_i (clk_i),
-    .rst_ni (rst_ni),
-    .en_i (en_i),
+    .clk_i   (clk_i),
+    .rst_ni  (rst_ni),
+    .en_i    (en_i),
     .valid_i (valid_i),
-    .u_i (u_i),
-    .v_i (v_i),
+    .u_i     (u_i),
+    .v_i     (v_i),
     .valid_o (valid_o),
-    .pu_o (pu_o),
-    .pv_o (pv_o)
+    .pu_o    (pu_o),
+    .pv_o    (pv_o)
   );
 
   always #5 clk_i = ~clk_i;

@@ -10,13 +10,15 @@
 // Run from the generated directory, which holds vectors/ and the .hex files:
 //   iverilog -g2005 -Wall -Wno-timescale -s interpolate_tb -o interpolate_tb.vvp tb/interpolate_tb.v *.v
 //   vvp -N interpolate_tb.vvp      (-N: a failing run exits 1)
-// It reads vectors/interpolate.hex (or the file of +vectors=FILE), one vector per line: e00 e10 e01 e11 wu wv i
+// It reads vectors/interpolate.hex (or the file of +vectors=FILE), one vector per line:
+//   e00 e10 e01 e11 wu wv i
 // (inputs, then expected outputs, hex). Inputs are driven and outputs sampled on the falling
-// edge, never right after the rising one. From the 64th accepted vector on it inserts random
-// bubbles (valid_i low) and stalls (en_i low), and resets the design once mid-stream and
-// presents the samples then in flight again. Every output must appear once, in order, when
-// valid_o && en_i, exactly LATENCY enabled clocks after its input. Mismatches print the
-// vector's line; the last line of the run is `N passed, M failed`.
+// edge, never right after the rising one. The first 64 vectors are accepted back to back;
+// then random bubbles (valid_i low) and stalls (en_i low) follow.
+// The design is reset once mid-stream and the samples then in flight are presented again.
+// Every output must leave once, in order, when valid_o && en_i at a rising edge, exactly
+// LATENCY enabled clocks after its input. Mismatches print the vector's line; the last line
+// of a run is `N passed, M failed`.
 `timescale 1ns / 1ps
 `default_nettype none
 
@@ -32,32 +34,32 @@ module interpolate_tb;
   localparam SHOW       = 10;  // mismatches printed in full; later ones by line only
 
   // ---------------------------------------------------------------- the design
-  reg   clk_i = 1'd0;
-  reg   rst_ni = 1'd0;
-  reg   en_i = 1'd0;
-  reg   valid_i = 1'd0;
+  reg        clk_i = 1'd0;
+  reg        rst_ni = 1'd0;
+  reg        en_i = 1'd0;
+  reg        valid_i = 1'd0;
   reg  [7:0] e00_i = 8'd0;
   reg  [7:0] e10_i = 8'd0;
   reg  [7:0] e01_i = 8'd0;
   reg  [7:0] e11_i = 8'd0;
   reg  [3:0] wu_i = 4'd0;
   reg  [3:0] wv_i = 4'd0;
-  wire  valid_o;
+  wire       valid_o;
   wire [7:0] i_o;
 
   interpolate dut (
-    .clk_i (clk_i),
-    .rst_ni (rst_ni),
-    .en_i (en_i),
+    .clk_i   (clk_i),
+    .rst_ni  (rst_ni),
+    .en_i    (en_i),
     .valid_i (valid_i),
-    .e00_i (e00_i),
-    .e10_i (e10_i),
-    .e01_i (e01_i),
-    .e11_i (e11_i),
-    .wu_i (wu_i),
-    .wv_i (wv_i),
+    .e00_i   (e00_i),
+    .e10_i   (e10_i),
+    .e01_i   (e01_i),
+    .e11_i   (e11_i),
+    .wu_i    (wu_i),
+    .wv_i    (wv_i),
     .valid_o (valid_o),
-    .i_o (i_o)
+    .i_o     (i_o)
   );
 
   always #5 clk_i = ~clk_i;

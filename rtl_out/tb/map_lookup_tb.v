@@ -14,13 +14,15 @@
 // Run from the generated directory, which holds vectors/ and the .hex files:
 //   iverilog -g2005 -Wall -Wno-timescale -s map_lookup_tb -o map_lookup_tb.vvp tb/map_lookup_tb.v *.v
 //   vvp -N map_lookup_tb.vvp      (-N: a failing run exits 1)
-// It reads vectors/map_lookup.hex (or the file of +vectors=FILE), one vector per line: axis s_max s_u s_v pu pv buf e00 e10 e01 e11 wu wv
+// It reads vectors/map_lookup.hex (or the file of +vectors=FILE), one vector per line:
+//   axis s_max s_u s_v pu pv buf e00 e10 e01 e11 wu wv
 // (inputs, then expected outputs, hex). Inputs are driven and outputs sampled on the falling
-// edge, never right after the rising one. From the 64th accepted vector on it inserts random
-// bubbles (valid_i low) and stalls (en_i low), and resets the design once mid-stream and
-// presents the samples then in flight again. Every output must appear once, in order, when
-// valid_o && en_i, exactly LATENCY enabled clocks after its input. Mismatches print the
-// vector's line; the last line of the run is `N passed, M failed`.
+// edge, never right after the rising one. The first 64 vectors are accepted back to back;
+// then random bubbles (valid_i low) and stalls (en_i low) follow.
+// The design is reset once mid-stream and the samples then in flight are presented again.
+// Every output must leave once, in order, when valid_o && en_i at a rising edge, exactly
+// LATENCY enabled clocks after its input. Mismatches print the vector's line; the last line
+// of a run is `N passed, M failed`.
 `timescale 1ns / 1ps
 `default_nettype none
 
@@ -36,23 +38,23 @@ module map_lookup_tb;
   localparam SHOW       = 10;  // mismatches printed in full; later ones by line only
 
   // ---------------------------------------------------------------- the design
-  reg   clk_i = 1'd0;
-  reg   rst_ni = 1'd0;
-  reg   en_i = 1'd0;
-  reg   valid_i = 1'd0;
+  reg        clk_i = 1'd0;
+  reg        rst_ni = 1'd0;
+  reg        en_i = 1'd0;
+  reg        valid_i = 1'd0;
   reg  [1:0] axis_i = 2'd0;
-  reg   s_max_i = 1'd0;
-  reg   s_u_i = 1'd0;
-  reg   s_v_i = 1'd0;
+  reg        s_max_i = 1'd0;
+  reg        s_u_i = 1'd0;
+  reg        s_v_i = 1'd0;
   reg  [5:0] pu_i = 6'd0;
   reg  [5:0] pv_i = 6'd0;
-  reg   rd_buf_i = 1'd0;
-  reg   wr_en_i = 1'd0;
-  reg   wr_buf_i = 1'd0;
+  reg        rd_buf_i = 1'd0;
+  reg        wr_en_i = 1'd0;
+  reg        wr_buf_i = 1'd0;
   reg  [1:0] wr_axis_i = 2'd0;
   reg  [8:0] wr_addr_i = 9'd0;
   reg  [7:0] wr_data_i = 8'd0;
-  wire  valid_o;
+  wire       valid_o;
   wire [7:0] e00_o;
   wire [7:0] e10_o;
   wire [7:0] e01_o;
@@ -61,29 +63,29 @@ module map_lookup_tb;
   wire [3:0] wv_o;
 
   map_lookup dut (
-    .clk_i (clk_i),
-    .rst_ni (rst_ni),
-    .en_i (en_i),
-    .valid_i (valid_i),
-    .axis_i (axis_i),
-    .s_max_i (s_max_i),
-    .s_u_i (s_u_i),
-    .s_v_i (s_v_i),
-    .pu_i (pu_i),
-    .pv_i (pv_i),
-    .rd_buf_i (rd_buf_i),
-    .wr_en_i (wr_en_i),
-    .wr_buf_i (wr_buf_i),
+    .clk_i     (clk_i),
+    .rst_ni    (rst_ni),
+    .en_i      (en_i),
+    .valid_i   (valid_i),
+    .axis_i    (axis_i),
+    .s_max_i   (s_max_i),
+    .s_u_i     (s_u_i),
+    .s_v_i     (s_v_i),
+    .pu_i      (pu_i),
+    .pv_i      (pv_i),
+    .rd_buf_i  (rd_buf_i),
+    .wr_en_i   (wr_en_i),
+    .wr_buf_i  (wr_buf_i),
     .wr_axis_i (wr_axis_i),
     .wr_addr_i (wr_addr_i),
     .wr_data_i (wr_data_i),
-    .valid_o (valid_o),
-    .e00_o (e00_o),
-    .e10_o (e10_o),
-    .e01_o (e01_o),
-    .e11_o (e11_o),
-    .wu_o (wu_o),
-    .wv_o (wv_o)
+    .valid_o   (valid_o),
+    .e00_o     (e00_o),
+    .e10_o     (e10_o),
+    .e01_o     (e01_o),
+    .e11_o     (e11_o),
+    .wu_o      (wu_o),
+    .wv_o      (wv_o)
   );
 
   always #5 clk_i = ~clk_i;
@@ -131,6 +133,7 @@ module map_lookup_tb;
   reg [31:0]   rnd;
   reg          eof, en_next, present, ok, did_reset;
   reg [DL-1:0] so, si;
+
   // The second map (map2_<axis>.hex, logical address order), written through the host port.
   localparam MAP_ENTRIES = 512;  // per axis, 2^A
   localparam A           = 9;  // logical map address bits

@@ -14,13 +14,15 @@
 // Run from the generated directory, which holds vectors/ and the .hex files:
 //   iverilog -g2005 -Wall -Wno-timescale -s rmap_top_tb -o rmap_top_tb.vvp tb/rmap_top_tb.v *.v
 //   vvp -N rmap_top_tb.vvp      (-N: a failing run exits 1)
-// It reads vectors/rmap_top.hex (or the file of +vectors=FILE), one vector per line: map gx gy gz zero i
+// It reads vectors/rmap_top.hex (or the file of +vectors=FILE), one vector per line:
+//   map gx gy gz zero i
 // (inputs, then expected outputs, hex). Inputs are driven and outputs sampled on the falling
-// edge, never right after the rising one. From the 64th accepted vector on it inserts random
-// bubbles (valid_i low), and resets the design once mid-stream and
-// presents the samples then in flight again. Every output must appear once, in order, when
-// valid_o && the clock, exactly LATENCY enabled clocks after its input. Mismatches print the
-// vector's line; the last line of the run is `N passed, M failed`.
+// edge, never right after the rising one. The first 64 vectors are accepted back to back;
+// then random bubbles (valid_i low) follow (rmap_top has no clock enable).
+// The design is reset once mid-stream and the samples then in flight are presented again.
+// Every output must leave once, in order, when valid_o at a rising edge, exactly
+// LATENCY enabled clocks after its input. Mismatches print the vector's line; the last line
+// of a run is `N passed, M failed`.
 `timescale 1ns / 1ps
 `default_nettype none
 
@@ -36,36 +38,36 @@ module rmap_top_tb;
   localparam SHOW       = 10;  // mismatches printed in full; later ones by line only
 
   // ---------------------------------------------------------------- the design
-  reg   clk_i = 1'd0;
-  reg   rst_ni = 1'd0;
-  reg   valid_i = 1'd0;
+  reg         clk_i = 1'd0;
+  reg         rst_ni = 1'd0;
+  reg         valid_i = 1'd0;
   reg  [11:0] gx_i = 12'd0;
   reg  [11:0] gy_i = 12'd0;
   reg  [11:0] gz_i = 12'd0;
-  reg   swap_i = 1'd0;
-  reg   wr_en_i = 1'd0;
-  reg  [1:0] wr_axis_i = 2'd0;
-  reg  [8:0] wr_addr_i = 9'd0;
-  reg  [7:0] wr_data_i = 8'd0;
-  wire  valid_o;
-  wire  zero_o;
-  wire [7:0] i_o;
+  reg         swap_i = 1'd0;
+  reg         wr_en_i = 1'd0;
+  reg  [1:0]  wr_axis_i = 2'd0;
+  reg  [8:0]  wr_addr_i = 9'd0;
+  reg  [7:0]  wr_data_i = 8'd0;
+  wire        valid_o;
+  wire        zero_o;
+  wire [7:0]  i_o;
 
   rmap_top dut (
-    .clk_i (clk_i),
-    .rst_ni (rst_ni),
-    .valid_i (valid_i),
-    .gx_i (gx_i),
-    .gy_i (gy_i),
-    .gz_i (gz_i),
-    .swap_i (swap_i),
-    .wr_en_i (wr_en_i),
+    .clk_i     (clk_i),
+    .rst_ni    (rst_ni),
+    .valid_i   (valid_i),
+    .gx_i      (gx_i),
+    .gy_i      (gy_i),
+    .gz_i      (gz_i),
+    .swap_i    (swap_i),
+    .wr_en_i   (wr_en_i),
     .wr_axis_i (wr_axis_i),
     .wr_addr_i (wr_addr_i),
     .wr_data_i (wr_data_i),
-    .valid_o (valid_o),
-    .zero_o (zero_o),
-    .i_o (i_o)
+    .valid_o   (valid_o),
+    .zero_o    (zero_o),
+    .i_o       (i_o)
   );
 
   always #5 clk_i = ~clk_i;
@@ -99,6 +101,7 @@ module rmap_top_tb;
   reg [31:0]   rnd;
   reg          eof, en_next, present, ok, did_reset;
   reg [DL-1:0] so, si;
+
   // The second map (map2_<axis>.hex, logical address order), written through the host port.
   localparam MAP_ENTRIES = 512;  // per axis, 2^A
   localparam A           = 9;  // logical map address bits

@@ -12,13 +12,15 @@
 // Run from the generated directory, which holds vectors/ and the .hex files:
 //   iverilog -g2005 -Wall -Wno-timescale -s sort_shift_tb -o sort_shift_tb.vvp tb/sort_shift_tb.v *.v
 //   vvp -N sort_shift_tb.vvp      (-N: a failing run exits 1)
-// It reads vectors/sort_shift.hex (or the file of +vectors=FILE), one vector per line: gx gy gz axis s_max s_u s_v m a b
+// It reads vectors/sort_shift.hex (or the file of +vectors=FILE), one vector per line:
+//   gx gy gz axis s_max s_u s_v m a b
 // (inputs, then expected outputs, hex). Inputs are driven and outputs sampled on the falling
-// edge, never right after the rising one. From the 64th accepted vector on it inserts random
-// bubbles (valid_i low) and stalls (en_i low), and resets the design once mid-stream and
-// presents the samples then in flight again. Every output must appear once, in order, when
-// valid_o && en_i, exactly LATENCY enabled clocks after its input. Mismatches print the
-// vector's line; the last line of the run is `N passed, M failed`.
+// edge, never right after the rising one. The first 64 vectors are accepted back to back;
+// then random bubbles (valid_i low) and stalls (en_i low) follow.
+// The design is reset once mid-stream and the samples then in flight are presented again.
+// Every output must leave once, in order, when valid_o && en_i at a rising edge, exactly
+// LATENCY enabled clocks after its input. Mismatches print the vector's line; the last line
+// of a run is `N passed, M failed`.
 `timescale 1ns / 1ps
 `default_nettype none
 
@@ -34,38 +36,38 @@ module sort_shift_tb;
   localparam SHOW       = 10;  // mismatches printed in full; later ones by line only
 
   // ---------------------------------------------------------------- the design
-  reg   clk_i = 1'd0;
-  reg   rst_ni = 1'd0;
-  reg   en_i = 1'd0;
-  reg   valid_i = 1'd0;
+  reg         clk_i = 1'd0;
+  reg         rst_ni = 1'd0;
+  reg         en_i = 1'd0;
+  reg         valid_i = 1'd0;
   reg  [11:0] gx_i = 12'd0;
   reg  [11:0] gy_i = 12'd0;
   reg  [11:0] gz_i = 12'd0;
-  wire  valid_o;
-  wire [1:0] axis_o;
-  wire  s_max_o;
-  wire  s_u_o;
-  wire  s_v_o;
-  wire [7:0] m_o;
-  wire [7:0] a_o;
-  wire [7:0] b_o;
+  wire        valid_o;
+  wire [1:0]  axis_o;
+  wire        s_max_o;
+  wire        s_u_o;
+  wire        s_v_o;
+  wire [7:0]  m_o;
+  wire [7:0]  a_o;
+  wire [7:0]  b_o;
 
   sort_shift dut (
-    .clk_i (clk_i),
-    .rst_ni (rst_ni),
-    .en_i (en_i),
+    .clk_i   (clk_i),
+    .rst_ni  (rst_ni),
+    .en_i    (en_i),
     .valid_i (valid_i),
-    .gx_i (gx_i),
-    .gy_i (gy_i),
-    .gz_i (gz_i),
+    .gx_i    (gx_i),
+    .gy_i    (gy_i),
+    .gz_i    (gz_i),
     .valid_o (valid_o),
-    .axis_o (axis_o),
+    .axis_o  (axis_o),
     .s_max_o (s_max_o),
-    .s_u_o (s_u_o),
-    .s_v_o (s_v_o),
-    .m_o (m_o),
-    .a_o (a_o),
-    .b_o (b_o)
+    .s_u_o   (s_u_o),
+    .s_v_o   (s_v_o),
+    .m_o     (m_o),
+    .a_o     (a_o),
+    .b_o     (b_o)
   );
 
   always #5 clk_i = ~clk_i;

@@ -1,5 +1,6 @@
 //! One file per subcommand; each owns its clap arguments and its `run`.
 
+pub mod bench;
 pub mod config_args;
 pub mod generate;
 pub mod render;

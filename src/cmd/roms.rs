@@ -15,6 +15,9 @@ pub struct RomsArgs {
     /// Scene whose light model fills the maps [default: the standard scene].
     #[arg(long, value_name = "FILE")]
     pub scene: Option<PathBuf>,
+    /// How the maps are filled from the light model [default: the scene's `map_fit`, else sample].
+    #[arg(long, value_enum)]
+    pub map_fit: Option<crate::model::map_fit::MapFit>,
     /// Output directory (replaced whole on success).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
@@ -22,10 +25,13 @@ pub struct RomsArgs {
 
 pub fn run(a: &RomsArgs) -> Result<()> {
     let cfg = a.cfg.resolve()?;
-    let scene = match &a.scene {
+    let mut scene = match &a.scene {
         Some(p) => Scene::from_toml_file(p)?,
         None => Scene::standard(),
     };
+    if let Some(f) = a.map_fit {
+        scene.map_fit = f;
+    }
     let out = StagedDir::new(&a.out)?;
     for (name, text) in hexfile::all(&cfg, &scene) {
         out.write_text(&name, &text)?;

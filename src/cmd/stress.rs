@@ -17,6 +17,9 @@ pub struct StressArgs {
     /// Scene whose light model fills the maps and the reference [default: the standard scene].
     #[arg(long, value_name = "FILE")]
     pub scene: Option<PathBuf>,
+    /// How the maps are filled from the light model [default: the scene's `map_fit`, else sample].
+    #[arg(long, value_enum)]
+    pub map_fit: Option<crate::model::map_fit::MapFit>,
     /// Every gradient (2^(3 grad-bits) inputs; grad-bits <= 12).
     #[arg(long, conflicts_with = "samples")]
     pub exhaustive: bool,
@@ -33,10 +36,13 @@ pub struct StressArgs {
 
 pub fn run(a: &StressArgs) -> Result<()> {
     let cfg = a.cfg.resolve()?;
-    let scene = match &a.scene {
+    let mut scene = match &a.scene {
         Some(p) => Scene::from_toml_file(p)?,
         None => Scene::standard(),
     };
+    if let Some(f) = a.map_fit {
+        scene.map_fit = f;
+    }
     let setup = Setup::new(&cfg, &scene, hexfile::scene_maps(&cfg, &scene));
     let report = if a.exhaustive {
         let bar = ProgressBar::new(1u64 << (3 * cfg.grad_bits.min(exhaustive::MAX_GRAD_BITS)));
@@ -69,10 +75,11 @@ pub fn run(a: &StressArgs) -> Result<()> {
 /// The report as text: a verdict, the worst cases and a Markdown table per magnitude class.
 pub fn summary(r: &Report) -> String {
     let mut s = format!(
-        "rmapgen stress ({}): {} inputs of {} in {:.1} s on {} threads\n",
+        "rmapgen stress ({}): {} inputs of {}, {} map, in {:.1} s on {} threads\n",
         r.mode,
         r.inputs,
         r.config.summary(),
+        r.map_fit.name(),
         r.seconds,
         rayon::current_num_threads()
     );

@@ -65,7 +65,7 @@ pub struct VolumeArgs {
     /// Early ray termination: accumulated opacity at which a pixel counts as opaque (0, 1].
     #[arg(long, value_name = "A", default_value_t = cast::DEFAULT_ERT)]
     pub ert: f64,
-    /// Brick side in cells for empty-space skipping [2..=64].
+    /// Brick side in cells for empty-space skipping [a power of two, 2..=64].
     #[arg(long, value_name = "N", default_value_t = cast::DEFAULT_BRICK)]
     pub brick: usize,
     /// Turn skipping off (empty space, early termination, unshaded samples): same image,
@@ -198,7 +198,8 @@ struct Timing {
     load_ms: f64,
     /// Gradients and brick ranges: once per volume and gradient width.
     prepare_ms: f64,
-    /// Caster set-up (empty bricks for the transfer function) plus the image, model shader.
+    /// One frame: the shader (maps and model tables), the caster (empty bricks for the
+    /// transfer function) and the image, model shader.
     model_skipping_on: Timed,
     float_skipping_on: Timed,
     model_skipping_off: Timed,
@@ -220,7 +221,6 @@ fn timing(
     let tf = report::scene_transfer(scene)?;
     let view = scene.view.direction;
     let model = ModelShader::new(cfg, scene);
-    let reference = Reference::new(cfg, scene);
     let on = CastOptions { skip: true, ..opts };
     let off = CastOptions {
         skip: false,
@@ -231,20 +231,19 @@ fn timing(
     if frame_on.value != frame_off.value || frame_on.alpha != frame_off.alpha {
         bail!("internal error: the image with skipping differs from the image without");
     }
+    // Each timed run builds the frame's shader (the maps and the model's tables, or the
+    // reference) and the caster (empty bricks for the transfer function), then renders.
     let model_on = time(repeat, || {
-        Caster::new(p, tf, view, on)
-            .expect("checked")
-            .render(&model);
+        let m = ModelShader::new(cfg, scene);
+        Caster::new(p, tf, view, on).expect("checked").render(&m);
     });
     let float_on = time(repeat, || {
-        Caster::new(p, tf, view, on)
-            .expect("checked")
-            .render(&reference);
+        let r = Reference::new(cfg, scene);
+        Caster::new(p, tf, view, on).expect("checked").render(&r);
     });
     let model_off = time(repeat.min(2), || {
-        Caster::new(p, tf, view, off)
-            .expect("checked")
-            .render(&model);
+        let m = ModelShader::new(cfg, scene);
+        Caster::new(p, tf, view, off).expect("checked").render(&m);
     });
     let st = frame_on.stats;
     let t = Timing {

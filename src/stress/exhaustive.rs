@@ -70,7 +70,8 @@ fn sign_codes(mags: [u32; 3], full: u32) -> impl Iterator<Item = u32> {
     (0..8u32).filter(move |code| {
         (0..3).all(|k| {
             let neg = (code >> k) & 1 == 1;
-            !(mags[k] == 0 && neg) && !(mags[k] == full && !neg)
+            // Zero is never negative; 2^(G-1) is always negative.
+            (mags[k] != 0 || !neg) && (mags[k] != full || neg)
         })
     })
 }
@@ -144,16 +145,20 @@ pub fn run(setup: &Setup, progress: &(dyn Fn(u64) + Sync)) -> Result<Report> {
         .map(|p| encoded_tangent(cfg, p))
         .collect();
     let drop = cfg.grad_bits - cfg.red_bits;
-    // The fused output table, [axis][sign code][p_u][p_v].
-    let ps = cfg.pos_max() + 1;
-    let per_axis_code = ps * ps;
-    let map_max = cfg.map_max() as u16;
-    let outputs: Vec<u16> = (0..24 * per_axis_code)
+    // The fused output table's flags, [axis][sign code][p_u][p_v]: zero + full scale << 16.
+    let ps = cfg.pos_max() as usize + 1;
+    let flags: Vec<u32> = (0..24 * ps * ps)
         .map(|k| {
-            let (ac, pu, pv) = (k / per_axis_code, (k % per_axis_code) / ps, k % ps);
-            setup.fast.intensity_at(ac / 8, ac % 8, pu, pv) as u16
+            let (ac, pu, pv) = (
+                (k / (ps * ps)) as u32,
+                ((k / ps) % ps) as u32,
+                (k % ps) as u32,
+            );
+            let o = setup.fast.intensity_at(ac / 8, ac % 8, pu, pv);
+            (o == 0) as u32 | ((o == cfg.map_max()) as u32) << 16
         })
         .collect();
+    let no_flags = vec![0u32; ps];
     type AngleBest = Vec<Option<(f64, [u32; 3])>>;
     let (inputs_acc, angles) = (1..=full)
         .into_par_iter()
@@ -189,7 +194,7 @@ pub fn run(setup: &Setup, progress: &(dyn Fn(u64) + Sync)) -> Result<Report> {
                         .enumerate()
                         .fold((0, &-1.0), |b, x| if x.1 > b.1 { x } else { b });
                 let best = &mut angles[shift as usize];
-                if best.is_none_or_smaller(s) {
+                if best.map_or(true, |(b, _)| s > b) {
                     *best = Some((s, [max, c_u, c_v as u32]));
                 }
                 for axis in 0..3u32 {
@@ -219,34 +224,42 @@ pub fn run(setup: &Setup, progress: &(dyn Fn(u64) + Sync)) -> Result<Report> {
                             mismatch.get_or_insert(g);
                         }
                     }
-                    // Every input: each sign pattern of each triple reads its own output.
-                    for code in 0..8u32 {
-                        let (s_max, s_u, s_v) = ordered_signs(axis, code);
-                        // A zero component is never negative, one of 2^(G-1) always is.
-                        let valid = |c: u32, s: u32| !(c == 0 && s == 1) && !(c == full && s == 0);
-                        if !valid(max, s_max) || !valid(c_u, s_u) {
+                    // Every input: each sign pattern of each triple reads its own output's
+                    // flags from the fused table at its address (axis, signs, p_u, p_v).
+                    let valid = |c: u32, s: u32| (c != 0 || s == 0) && (c != full || s == 1);
+                    let mut live = [false; 8];
+                    let blocks: [&[u32]; 8] = std::array::from_fn(|code| {
+                        let (s_max, s_u, _) = ordered_signs(axis, code as u32);
+                        live[code] = valid(max, s_max) && valid(c_u, s_u);
+                        if live[code] {
+                            &flags[((axis as usize * 8 + code) * ps + p_u as usize) * ps..][..ps]
+                        } else {
+                            &no_flags[..]
+                        }
+                    });
+                    // c_v = 0 and c_v = 2^(G-1) allow one sign; the rest allow both.
+                    let top = c_v_top.min(full - 1);
+                    let mut sum = 0u32;
+                    for &p_v in &row[1..=top as usize] {
+                        let p = (p_v as usize).min(ps - 1);
+                        sum += blocks.iter().map(|b| b[p]).sum::<u32>();
+                    }
+                    let n_live = live.iter().filter(|&&l| l).count() as u64;
+                    inputs += n_live * top as u64;
+                    for (c_v, s_v_needed) in [(0, 0), (full, 1)] {
+                        if c_v > c_v_top {
                             continue;
                         }
-                        let c_v_lo = s_v;
-                        let c_v_hi = if s_v == 0 && c_v_top == full {
-                            full - 1
-                        } else {
-                            c_v_top
-                        };
-                        let block = &outputs
-                            [((axis * 8 + code) * per_axis_code + p_u * ps) as usize..]
-                            [..ps as usize];
-                        // u32 counts vectorise better; a row has at most 2^(G-1) + 1 inputs.
-                        let (mut z, mut f) = (0u32, 0u32);
-                        for &p_v in &row[c_v_lo as usize..=c_v_hi as usize] {
-                            let out = block[p_v as usize];
-                            z += (out == 0) as u32;
-                            f += (out == map_max) as u32;
+                        let p = row[c_v as usize] as usize;
+                        for code in 0..8 {
+                            if live[code] && ordered_signs(axis, code as u32).2 == s_v_needed {
+                                sum += blocks[code][p];
+                                inputs += 1;
+                            }
                         }
-                        zero += z as u64;
-                        saturated += f as u64;
-                        inputs += (c_v_hi + 1 - c_v_lo) as u64;
                     }
+                    zero += (sum & 0xffff) as u64;
+                    saturated += (sum >> 16) as u64;
                 }
             }
             class.inputs = inputs;
@@ -303,13 +316,14 @@ pub fn run(setup: &Setup, progress: &(dyn Fn(u64) + Sync)) -> Result<Report> {
 
     // 3. The exact maximum intensity error per class.
     let t_search = Instant::now();
-    let (worst, stats) = search(setup, &pos);
+    let (worst, stats) = search(setup, &pos)?;
     for (class, w) in worst.into_iter().enumerate() {
         if let Some(w) = w {
             acc.classes[class].error(w, 0);
         }
     }
     let mut report = acc.report(cfg, "exhaustive", 1, start.elapsed().as_secs_f64());
+    report.map_fit = setup.scene.map_fit;
     report.search = Some(SearchStats {
         seconds_positions,
         seconds_inputs,
@@ -323,16 +337,6 @@ pub fn run(setup: &Setup, progress: &(dyn Fn(u64) + Sync)) -> Result<Report> {
         3 * cfg.grad_bits
     );
     Ok(report)
-}
-
-trait SmallerThan {
-    fn is_none_or_smaller(&self, s: f64) -> bool;
-}
-
-impl SmallerThan for Option<(f64, [u32; 3])> {
-    fn is_none_or_smaller(&self, s: f64) -> bool {
-        self.map_or(true, |(b, _)| s > b)
-    }
 }
 
 /// One cell of the error search: the output is `out` for every input in it.
@@ -349,22 +353,64 @@ struct Cell {
 }
 
 /// Cells evaluated per parallel wave of the search.
-const WAVE: usize = 8;
+const WAVE: usize = 16;
+
+/// For every (M, position): the first and last c with that position (positions are
+/// monotonic in c for a fixed M, so each is one run), or lo > hi when there is none.
+struct Runs {
+    ps: usize,
+    run: Vec<(u16, u16)>,
+}
+
+impl Runs {
+    fn new(cfg: &crate::config::Config, pos: &PairPositions) -> Result<Runs> {
+        let full = 1u32 << (cfg.grad_bits - 1);
+        let ps = cfg.pos_max() as usize + 1;
+        let mut run = vec![(1u16, 0u16); (full as usize + 1) * ps];
+        for max in 1..=full {
+            let row = pos.row(max);
+            ensure!(
+                row.windows(2).all(|w| w[0] <= w[1]),
+                "positions are not monotonic for max {max}"
+            );
+            for (c, &p) in row.iter().enumerate() {
+                let r = &mut run[max as usize * ps + p as usize];
+                if r.0 > r.1 {
+                    *r = (c as u16, c as u16);
+                } else {
+                    r.1 = c as u16;
+                }
+            }
+        }
+        Ok(Runs { ps, run })
+    }
+
+    fn get(&self, max: u32, p: u32) -> (u32, u32) {
+        let (lo, hi) = self.run[max as usize * self.ps + p as usize];
+        (lo as u32, hi as u32)
+    }
+}
 
 /// The exact worst error of every class, by bounding and then evaluating cells.
-fn search(setup: &Setup, pos: &PairPositions) -> (Vec<Option<WorstError>>, SearchStats) {
+fn search(setup: &Setup, pos: &PairPositions) -> Result<(Vec<Option<WorstError>>, SearchStats)> {
     let cfg = &setup.cfg;
     let full = 1u32 << (cfg.grad_bits - 1);
     let pm = cfg.pos_max() as usize;
+    let runs = Runs::new(cfg, pos)?;
     // Tangent range covered by each (class, position).
     let nclass = classes(cfg) as usize;
     let mut tbox = vec![(f64::INFINITY, f64::NEG_INFINITY); nclass * (pm + 1)];
     for max in 1..=full {
         let class = class_of(cfg, max) as usize;
-        for (c, &p) in pos.row(max).iter().enumerate() {
-            let t = c as f64 / max as f64;
-            let b = &mut tbox[class * (pm + 1) + p as usize];
-            *b = (b.0.min(t), b.1.max(t));
+        for p in 0..=pm as u32 {
+            let (lo, hi) = runs.get(max, p);
+            if lo <= hi {
+                let b = &mut tbox[class * (pm + 1) + p as usize];
+                *b = (
+                    b.0.min(lo as f64 / max as f64),
+                    b.1.max(hi as f64 / max as f64),
+                );
+            }
         }
     }
     let scene = setup.scene.prepared();
@@ -388,13 +434,10 @@ fn search(setup: &Setup, pos: &PairPositions) -> (Vec<Option<WorstError>>, Searc
             .into_par_iter()
             .flat_map_iter(|k| {
                 let (axis, code) = (k / 8, k % 8);
-                let signs = ordered_signs(axis, code);
                 boxes.iter().flat_map(move |&(p_u, bu)| {
                     boxes.iter().map(move |&(p_v, bv)| {
                         let out = setup.fast.intensity_at(axis, code, p_u, p_v);
-                        let b = shade_bounds(scene, &DirBox::on_face(axis, signs, bu, bv));
-                        let (lo, hi) = (quantise(cfg, b.lo) as i64, quantise(cfg, b.hi) as i64);
-                        let bound = (out as i64 - lo).max(hi - out as i64);
+                        let bound = error_bound(setup, scene, axis, code, bu, bv, out);
                         Cell {
                             class,
                             axis,
@@ -412,16 +455,18 @@ fn search(setup: &Setup, pos: &PairPositions) -> (Vec<Option<WorstError>>, Searc
         cells.sort_unstable_by_key(|c| (-c.bound, c.axis, c.code, c.p_u, c.p_v));
         let mut best: Option<WorstError> = None;
         let mut i = 0;
-        let beats =
-            |c: &Cell, best: &Option<WorstError>| best.map_or(true, |w| c.bound > w.abs() as i64);
-        while i < cells.len() && beats(&cells[i], &best) {
+        let floor = |best: &Option<WorstError>| best.map_or(-1, |w| w.abs() as i64);
+        while i < cells.len() && cells[i].bound > floor(&best) {
             let mut j = i;
-            while j < cells.len() && j - i < WAVE && beats(&cells[j], &best) {
+            while j < cells.len() && j - i < WAVE && cells[j].bound > floor(&best) {
                 j += 1;
             }
+            // Every cell of a wave prunes against the same floor, so results do not depend on
+            // scheduling.
+            let f = floor(&best);
             let found: Vec<(Option<WorstError>, u64)> = cells[i..j]
                 .par_iter()
-                .map(|c| evaluate_cell(setup, pos, full, c))
+                .map(|c| evaluate_cell(setup, scene, &runs, full, c, f))
                 .collect();
             for (w, n) in found {
                 stats.cells_evaluated += 1;
@@ -436,15 +481,41 @@ fn search(setup: &Setup, pos: &PairPositions) -> (Vec<Option<WorstError>>, Searc
         }
         worst[class as usize] = best;
     }
-    (worst, stats)
+    Ok((worst, stats))
 }
 
-/// Every input of one cell against the reference: the worst error and the inputs evaluated.
+/// No input whose direction lies in the box (tangent ranges `tu`, `tv` on the face of
+/// `axis`, signs `code`) has |out - reference| above this.
+fn error_bound(
+    setup: &Setup,
+    scene: &crate::scene::PreparedScene,
+    axis: u32,
+    code: u32,
+    tu: (f64, f64),
+    tv: (f64, f64),
+    out: u32,
+) -> i64 {
+    let b = shade_bounds(
+        scene,
+        &DirBox::on_face(axis, ordered_signs(axis, code), tu, tv),
+    );
+    let (lo, hi) = (
+        quantise(&setup.cfg, b.lo) as i64,
+        quantise(&setup.cfg, b.hi) as i64,
+    );
+    (out as i64 - lo).max(hi - out as i64)
+}
+
+/// The inputs of one cell against the reference, one max magnitude M at a time: each M's
+/// slice is bounded first and evaluated only if its bound exceeds `floor`. Returns the
+/// worst error above `floor` (if any) and the inputs evaluated.
 fn evaluate_cell(
     setup: &Setup,
-    pos: &PairPositions,
+    scene: &crate::scene::PreparedScene,
+    runs: &Runs,
     full: u32,
     c: &Cell,
+    floor: i64,
 ) -> (Option<WorstError>, u64) {
     let cfg = &setup.cfg;
     let (s_max, s_u, s_v) = ordered_signs(c.axis, c.code);
@@ -455,26 +526,45 @@ fn evaluate_cell(
         if max == full && s_max == 0 {
             continue;
         }
-        let row = pos.row(max);
-        let members = |p: u32, strict: bool, s: u32| {
-            (0..=max).filter(move |&k| {
-                row[k as usize] as u32 == p
-                    && !(strict && k == max)
-                    && !(k == 0 && s == 1)
-                    && !(k == full && s == 0)
-            })
+        // The run of c with this position, cut to what the tie rule and signs allow: a lower
+        // axis holds less than M, a negative component is not 0, a positive one not 2^(G-1).
+        let run = |p: u32, strict: bool, s: u32| {
+            let (mut a, mut b) = runs.get(max, p);
+            if strict {
+                b = b.min(max.saturating_sub(1));
+            }
+            if s == 1 {
+                a = a.max(1);
+            } else {
+                b = b.min(full - 1);
+            }
+            (a, b)
         };
-        let us: Vec<u32> = members(c.p_u, c.axis >= 1, s_u).collect();
-        if us.is_empty() {
+        let (u0, u1) = run(c.p_u, c.axis >= 1, s_u);
+        let (v0, v1) = run(c.p_v, c.axis == 2, s_v);
+        if u0 > u1 || v0 > v1 || (c.axis >= 1 && max == 0) {
             continue;
         }
-        for c_v in members(c.p_v, c.axis == 2, s_v) {
-            for &c_u in &us {
+        let m = max as f64;
+        let bound = error_bound(
+            setup,
+            scene,
+            c.axis,
+            c.code,
+            (u0 as f64 / m, u1 as f64 / m),
+            (v0 as f64 / m, v1 as f64 / m),
+            c.out,
+        );
+        if bound <= floor {
+            continue;
+        }
+        for c_v in v0..=v1 {
+            for c_u in u0..=u1 {
                 let g = signed(place(c.axis, max, c_u, c_v), c.code);
                 n += 1;
                 let reference = setup.reference.intensity(g);
                 let error = c.out as i64 - reference as i64;
-                if worst.map_or(true, |w| error.unsigned_abs() > w.abs()) {
+                if error.abs() > floor && worst.map_or(true, |w| error.unsigned_abs() > w.abs()) {
                     let exact = setup.reference.exact(g).expect("not the zero gradient");
                     debug_assert_eq!(setup.fast.shade(g), c.out, "{g:?}");
                     worst = Some(WorstError {

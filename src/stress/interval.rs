@@ -222,7 +222,10 @@ mod tests {
                     let i = p.shade(d.normalize());
                     assert!(bound.lo <= i && i <= bound.hi, "{i} outside {bound:?}");
                 }
-                assert!(bound.hi - bound.lo < 2.0);
+                // Tiny boxes get tight bounds.
+                if w < 0.01 {
+                    assert!(bound.hi - bound.lo < 0.05, "{bound:?}");
+                }
             }
         }
     }

@@ -392,24 +392,46 @@ pub fn stage_inputs(
     v
 }
 
-/// The top's inputs, in two parts: with map 0 the corners and the first half of the random
-/// vectors (rounded up), then with map 1 the corners again and the rest. Calls `emit` per
-/// vector so a large stream never sits in memory.
+/// The top's inputs, in two parts: with map 0 the corners, the first half of the random
+/// vectors (rounded up) and the swap witness; then with map 1 the witness again, the other
+/// corners and the rest of the random vectors. The witness is the first corner gradient whose
+/// result differs between the two maps, so the vectors on both sides of the swap tell the
+/// buffers apart: the testbench swaps with the first map-1 vector. Calls `emit` per vector so
+/// a large stream never sits in memory.
 pub fn top_inputs(
-    cfg: &Config,
+    model: &Model,
+    maps: &MapSet,
     random: usize,
     seed: u64,
     mut emit: impl FnMut(&[u64]) -> Result<()>,
 ) -> Result<()> {
+    let cfg = &model.cfg;
     let mut rng = SplitMix64::for_stream(seed, Stage::Top.name());
     let first = random.div_ceil(2);
-    for (map, count) in [(0, first), (1, random - first)] {
-        for c in inputs::top_corners(cfg, map) {
-            emit(&c)?;
-        }
-        for _ in 0..count {
-            emit(&inputs::top_random(cfg, &mut rng, map))?;
-        }
+    let mut corners1 = inputs::top_corners(cfg, 1);
+    let witness = corners1
+        .iter()
+        .position(|c| {
+            expected(Stage::Top, model, maps, c)
+                != expected(Stage::Top, model, maps, &[&[0], &c[1..]].concat())
+        })
+        .unwrap_or(0);
+    let w1 = corners1.remove(witness);
+    let mut w0 = w1.clone();
+    w0[0] = 0;
+    for c in inputs::top_corners(cfg, 0) {
+        emit(&c)?;
+    }
+    for _ in 0..first {
+        emit(&inputs::top_random(cfg, &mut rng, 0))?;
+    }
+    emit(&w0)?;
+    emit(&w1)?;
+    for c in corners1 {
+        emit(&c)?;
+    }
+    for _ in first..random {
+        emit(&inputs::top_random(cfg, &mut rng, 1))?;
     }
     Ok(())
 }
@@ -426,7 +448,7 @@ pub fn stage_text(stage: Stage, model: &Model, maps: &MapSet, random: usize, see
         format_line(&fields, &row, s);
     };
     if stage == Stage::Top {
-        top_inputs(&model.cfg, random, seed, |inp| {
+        top_inputs(model, maps, random, seed, |inp| {
             line(inp, &mut s);
             Ok(())
         })
@@ -484,7 +506,7 @@ pub fn write_top_stream(
         std::fs::File::create(path).with_context(|| format!("cannot write {}", path.display()))?;
     let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
     let (mut n, mut line, mut row) = (0usize, String::new(), Vec::new());
-    top_inputs(cfg, random, seed, |inp| {
+    top_inputs(&model, maps, random, seed, |inp| {
         row.clear();
         row.extend_from_slice(inp);
         row.extend(expected(Stage::Top, &model, maps, inp));

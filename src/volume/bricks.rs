@@ -3,6 +3,8 @@
 //! with a margin. A brick on which the transfer function is zero over that whole range
 //! holds no sample with a non-zero opacity, and the ray caster jumps over it.
 //!
+//! The brick size is a power of two, so a sample's brick is found with shifts.
+//!
 //! Brick (bx, by, bz) covers the cells `b * size .. (b + 1) * size` along each axis (cell c
 //! spans voxels c and c + 1). Its range is taken over the voxels `b * size - 1 ..= (b + 1) *
 //! size + 1` (clipped to the volume): one voxel more on each side than the cells need, so a
@@ -29,8 +31,9 @@ pub struct Bricks {
 }
 
 impl Bricks {
+    /// Brick ranges for bricks of `size` cells per side, a power of two.
     pub fn new(vol: &Volume, size: usize) -> Bricks {
-        assert!(size >= 1);
+        assert!(size.is_power_of_two(), "brick size {size}");
         let counts = vol.dims.map(|n| (n - 1).div_ceil(size));
         let [cx, cy, cz] = counts;
         let span = |b: usize, n: usize| {
@@ -70,7 +73,8 @@ impl Bricks {
     /// The brick holding cell (cx, cy, cz).
     #[inline]
     pub fn of_cell(&self, c: [usize; 3]) -> usize {
-        let b = c.map(|v| v / self.size);
+        let shift = self.size.trailing_zeros();
+        let b = c.map(|v| v >> shift);
         b[0] + self.counts[0] * (b[1] + self.counts[1] * b[2])
     }
 

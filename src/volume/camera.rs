@@ -1,13 +1,14 @@
 //! The orthographic camera: parallel rays along minus the scene's view direction (the
-//! direction from the surface towards the viewer, as the shading assumes), framing the
-//! volume's bounding box.
+//! direction from the surface towards the viewer, as the shading assumes), framing a box
+//! (the ray caster gives it the volume's), whatever the transfer function shows of it.
 //!
 //! World coordinates: voxel (x, y, z) at (x sx, y sy, z sz). Image axes: `right` and `up`
 //! with right x up = view (right-handed, like x, y, z for the default view along +z, which
 //! gives the sphere render's orientation: x to the right, y up). `up` is the projection of
 //! world +z, or of world +y when the view is within about 8 degrees of the z axis. Row 0 is
 //! the top of the image. The square image spans the larger of the box's projected width and
-//! height, plus 2%.
+//! height, plus 2%. Rays start on the plane through the box's centre moved back along the view
+//! by half the box's diagonal plus one.
 
 use anyhow::{bail, Result};
 use glam::DVec3;
@@ -28,8 +29,8 @@ pub struct Camera {
 }
 
 impl Camera {
-    /// A camera for a box of `dims` voxels with `spacing`, looking along `-view`.
-    pub fn new(dims: [usize; 3], spacing: [f64; 3], view: [f64; 3], size: u32) -> Result<Camera> {
+    /// A camera framing the world box `lo..=hi`, looking along `-view`.
+    pub fn new(lo: [f64; 3], hi: [f64; 3], view: [f64; 3], size: u32) -> Result<Camera> {
         let v = DVec3::from_array(view);
         if !v.is_finite() || v.length() < 1e-12 {
             bail!("view direction {view:?} must be a finite, non-zero vector");
@@ -45,18 +46,15 @@ impl Camera {
         };
         let right = hint.cross(view).normalize();
         let up = view.cross(right);
-        let extent = DVec3::new(
-            (dims[0] - 1) as f64 * spacing[0],
-            (dims[1] - 1) as f64 * spacing[1],
-            (dims[2] - 1) as f64 * spacing[2],
-        );
-        let centre = extent * 0.5;
+        let (lo, hi) = (DVec3::from_array(lo), DVec3::from_array(hi));
+        let extent = hi - lo;
+        let centre = (lo + hi) * 0.5;
         let (mut hw, mut hh) = (0.0f64, 0.0f64);
         for i in 0..8 {
             let corner = DVec3::new(
-                if i & 1 == 0 { 0.0 } else { extent.x },
-                if i & 2 == 0 { 0.0 } else { extent.y },
-                if i & 4 == 0 { 0.0 } else { extent.z },
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
             ) - centre;
             hw = hw.max(corner.dot(right).abs());
             hh = hh.max(corner.dot(up).abs());
@@ -91,7 +89,7 @@ mod tests {
 
     #[test]
     fn default_view_matches_the_sphere_orientation() {
-        let c = Camera::new([11, 11, 5], [1.0; 3], [0.0, 0.0, 1.0], 10).unwrap();
+        let c = Camera::new([0.0; 3], [10.0, 10.0, 4.0], [0.0, 0.0, 1.0], 10).unwrap();
         assert_eq!((c.right, c.up), (DVec3::X, DVec3::Y));
         // The top-right pixel's ray starts at high x, high y, above the box, going down.
         let (o, d) = c.ray(9, 0);
@@ -104,7 +102,7 @@ mod tests {
 
     #[test]
     fn oblique_views_keep_z_up_and_are_right_handed() {
-        let c = Camera::new([9, 9, 9], [1.0, 1.0, 2.0], [-0.5, -0.7, 0.5], 64).unwrap();
+        let c = Camera::new([0.0; 3], [8.0, 8.0, 16.0], [-0.5, -0.7, 0.5], 64).unwrap();
         assert!(c.up.z > 0.0 && c.right.z.abs() < 1e-12);
         assert!((c.right.cross(c.up) - c.view).length() < 1e-12);
         // Every corner of the box projects inside the image.
@@ -117,6 +115,9 @@ mod tests {
             ) - c.centre;
             assert!(p.dot(c.right).abs() <= half && p.dot(c.up).abs() <= half);
         }
-        assert!(Camera::new([9, 9, 9], [1.0; 3], [0.0, 0.0, 0.0], 64).is_err());
+        assert!(Camera::new([0.0; 3], [8.0; 3], [0.0, 0.0, 0.0], 64).is_err());
+        // A box away from the origin is centred.
+        let c = Camera::new([10.0, 20.0, 30.0], [12.0, 22.0, 32.0], [0.0, 0.0, 1.0], 8).unwrap();
+        assert_eq!(c.centre, DVec3::new(11.0, 21.0, 31.0));
     }
 }

@@ -39,6 +39,7 @@ use super::transfer::{Tf, Transfer};
 use super::Volume;
 use crate::config::Config;
 use crate::hexfile;
+use crate::model::fast::FastShader;
 use crate::model::{Maps, Model};
 use crate::reference::Reference;
 use crate::scene::Scene;
@@ -46,18 +47,11 @@ use anyhow::{bail, ensure, Result};
 use rayon::prelude::*;
 use serde::Serialize;
 
-/// Rounds half away from zero, like `f32::round` but without a libm call on baseline x86-64.
+/// Rounds half away from zero, like `f32::round` for |v| < 2^23, without a libm call on
+/// baseline x86-64: adds the largest float below 0.5 with v's sign and truncates.
 #[inline]
 pub fn round_half_away(v: f32) -> i32 {
-    let t = v as i32;
-    let f = v - t as f32;
-    if f >= 0.5 {
-        t + 1
-    } else if f <= -0.5 {
-        t - 1
-    } else {
-        t
-    }
+    (v + 0.499_999_97f32.copysign(v)) as i32
 }
 
 /// Default early-ray-termination threshold.
@@ -79,25 +73,28 @@ impl Shader for Reference {
     }
 }
 
-/// The bit-accurate model with a scene's maps.
+/// The bit-accurate model with a scene's maps. Shades through the model's fused-table path
+/// ([`FastShader`], equal to [`Model::intensity`] by construction and by its tests; the
+/// tests here check it again on rendered samples through the batch path).
 pub struct ModelShader {
     pub model: Model,
     pub maps: Maps,
+    fast: FastShader,
 }
 
 impl ModelShader {
     pub fn new(cfg: &Config, scene: &Scene) -> ModelShader {
-        ModelShader {
-            model: Model::new(cfg),
-            maps: hexfile::scene_maps(cfg, scene),
-        }
+        let model = Model::new(cfg);
+        let maps = hexfile::scene_maps(cfg, scene);
+        let fast = FastShader::new(&model, &maps);
+        ModelShader { model, maps, fast }
     }
 }
 
 impl Shader for ModelShader {
     #[inline]
     fn intensity(&self, g: [i32; 3]) -> u32 {
-        self.model.intensity(&self.maps, g)
+        self.fast.shade(g)
     }
 }
 
@@ -147,8 +144,8 @@ impl CastOptions {
             self.ert
         );
         ensure!(
-            (2..=64).contains(&self.brick),
-            "brick {} is out of range; allowed 2..=64",
+            (2..=64).contains(&self.brick) && self.brick.is_power_of_two(),
+            "brick {} is not allowed; give a power of two in 2..=64",
             self.brick
         );
         Ok(())
@@ -277,9 +274,10 @@ impl Samples {
         let value = (0..self.alpha.len())
             .into_par_iter()
             .map(|p| {
+                let range = self.start[p]..self.start[p + 1];
                 let mut c = 0.0f32;
-                for i in self.start[p]..self.start[p + 1] {
-                    c += self.weights[i] * intensities[i] as f32;
+                for (w, &i) in self.weights[range.clone()].iter().zip(&intensities[range]) {
+                    c += w * i as f32;
                 }
                 c
             })
@@ -321,12 +319,10 @@ impl<'a> Caster<'a> {
             opts.brick
         );
         let tf = transfer.compile(opts.step as f32);
-        let camera = Camera::new(p.vol.dims, p.vol.spacing, view, opts.size)?;
-        let empty = if opts.skip {
-            p.bricks.empty(&tf)
-        } else {
-            Vec::new()
-        };
+        let empty = p.bricks.empty(&tf);
+        let s = p.vol.spacing;
+        let hi = [0, 1, 2].map(|a| (p.vol.dims[a] - 1) as f64 * s[a]);
+        let camera = Camera::new([0.0; 3], hi, view, opts.size)?;
         Ok(Caster {
             vol: p.vol,
             grads: &p.grads.data,
@@ -346,13 +342,9 @@ impl<'a> Caster<'a> {
         &self.opts
     }
 
-    /// Fraction of bricks that are empty for the transfer function (0 with skipping off).
+    /// Fraction of bricks that are empty for the transfer function.
     pub fn empty_brick_fraction(&self) -> f64 {
-        if self.empty.is_empty() {
-            0.0
-        } else {
-            self.empty.iter().filter(|&&e| e).count() as f64 / self.empty.len() as f64
-        }
+        self.empty.iter().filter(|&&e| e).count() as f64 / self.empty.len() as f64
     }
 
     /// The samples of pixel (x, y), or `None` when its ray misses the box.
@@ -409,8 +401,8 @@ impl<'a> Caster<'a> {
     fn brick_exit(&self, r: &Ray, cell: [usize; 3]) -> u32 {
         let b = self.bricks.size;
         let mut exit = f32::INFINITY;
-        for a in 0..3 {
-            let lo = (cell[a] / b * b) as f32;
+        for (a, &c) in cell.iter().enumerate() {
+            let lo = (c & !(b - 1)) as f32;
             let face = if r.delta[a] > 0.0 {
                 lo + b as f32
             } else if r.delta[a] < 0.0 {
@@ -542,7 +534,9 @@ impl<'a> Caster<'a> {
     /// Every sample the fused path would shade, for a batch shader.
     pub fn collect(&self) -> Samples {
         let n = self.opts.size as usize;
-        let rows: Vec<(Vec<f32>, Vec<usize>, Vec<f32>, Vec<[i32; 3]>, Stats)> = (0..n)
+        // Per row: opacities, sample counts per pixel, weights, gradients, work.
+        type Row = (Vec<f32>, Vec<usize>, Vec<f32>, Vec<[i32; 3]>, Stats);
+        let rows: Vec<Row> = (0..n)
             .into_par_iter()
             .map(|y| {
                 let mut st = Stats::default();
@@ -606,58 +600,91 @@ mod tests {
 
     #[test]
     fn skipping_does_not_change_the_image() {
-        let vol = synthetic::engine_block([64, 64, 32], [1.0; 3]).unwrap();
         let cfg = Config::default();
-        let p = Prepared::new(&vol, cfg.grad_bits, 4);
         let model = ModelShader::new(&cfg, &Scene::standard());
-        for view in [
+        let views = [
             [-0.5, -0.7, 0.5],
             [0.0, 0.0, 1.0],
             [1.0, 0.0, 0.0],
             [0.3, 0.8, -0.6],
-        ] {
-            let o = CastOptions {
-                brick: 4,
-                ..opts(48, true)
-            };
-            let on = Caster::new(&p, &transfer(), view, o)
-                .unwrap()
-                .render(&model);
-            let off = Caster::new(&p, &transfer(), view, CastOptions { skip: false, ..o })
-                .unwrap()
-                .render(&model);
-            assert_eq!(on.value, off.value, "view {view:?}");
-            assert_eq!(on.alpha, off.alpha, "view {view:?}");
-            // Skipping did skip, and the image is not empty.
-            assert!(on.stats.skipped_fraction() > 0.5, "{:?}", on.stats);
-            assert_eq!(off.stats.evaluated, off.stats.samples);
-            assert_eq!(on.stats.samples, off.stats.samples);
-            assert!(on.alpha.iter().filter(|&&a| a == 1.0).count() > 200);
+        ];
+        // (spacing, step, ert, brick) per case; each case with every view.
+        let cases = [
+            ([1.0; 3], DEFAULT_STEP, DEFAULT_ERT, 4),
+            ([1.0, 1.0, 1.5], 0.37, 0.95, 2),
+            ([0.8, 1.0, 1.0], 1.0, 1.0, 16),
+        ];
+        for (spacing, step, ert, brick) in cases {
+            let vol = synthetic::engine_block([64, 64, 32], spacing).unwrap();
+            let p = Prepared::new(&vol, cfg.grad_bits, brick);
+            for view in views {
+                let o = CastOptions {
+                    size: 48,
+                    step,
+                    ert,
+                    brick,
+                    skip: true,
+                };
+                let on = Caster::new(&p, &transfer(), view, o)
+                    .unwrap()
+                    .render(&model);
+                let off = Caster::new(&p, &transfer(), view, CastOptions { skip: false, ..o })
+                    .unwrap()
+                    .render(&model);
+                let what = format!("view {view:?} options {o:?}");
+                assert_eq!(on.value, off.value, "{what}");
+                assert_eq!(on.alpha, off.alpha, "{what}");
+                // Skipping did skip, and the image is not empty.
+                assert!(on.stats.skipped_fraction() > 0.3, "{what} {:?}", on.stats);
+                assert_eq!(off.stats.evaluated, off.stats.samples);
+                assert_eq!(on.stats.samples, off.stats.samples);
+                assert!(
+                    on.alpha.iter().filter(|&&a| a >= 0.95).count() > 200,
+                    "{what}"
+                );
+            }
         }
     }
 
     #[test]
     fn batch_path_equals_fused_path() {
+        // The batch path is shaded by `Model::intensity` (the definition), the fused path by
+        // the model's fast tables: equal images also check the two agree on real samples.
         let vol = synthetic::engine_block([64, 64, 32], [1.0, 1.0, 1.5]).unwrap();
-        let cfg = Config::default();
-        let p = Prepared::new(&vol, cfg.grad_bits, 8);
-        let c = Caster::new(&p, &transfer(), [-0.4, -0.8, 0.45], opts(40, true)).unwrap();
-        let model = ModelShader::new(&cfg, &Scene::standard());
-        let fused = c.render(&model);
-        let samples = c.collect();
-        assert_eq!(samples.stats, fused.stats);
-        let shaded: Vec<u32> = samples
-            .gradients
-            .iter()
-            .map(|&g| model.intensity(g))
-            .collect();
-        assert_eq!(samples.composite(&shaded).unwrap(), fused);
-        assert!(samples.composite(&shaded[1..]).is_err());
-        // A batch that differs in one sample changes the image.
-        let mut off = shaded.clone();
-        let i = samples.weights.iter().position(|&w| w > 0.2).unwrap();
-        off[i] = off[i].wrapping_add(9) % 256;
-        assert_ne!(samples.composite(&off).unwrap().value, fused.value);
+        let small = Config {
+            grad_bits: 10,
+            red_bits: 7,
+            compensation: false,
+            interpolation: false,
+            interp_bits: 0,
+            ..Config::default()
+        };
+        for cfg in [Config::default(), small] {
+            let p = Prepared::new(&vol, cfg.grad_bits, 8);
+            let c = Caster::new(&p, &transfer(), [-0.4, -0.8, 0.45], opts(40, true)).unwrap();
+            let model = ModelShader::new(&cfg, &Scene::standard());
+            let fused = c.render(&model);
+            let samples = c.collect();
+            assert_eq!(samples.stats, fused.stats);
+            assert!(samples.gradients.len() > 1000);
+            let shaded: Vec<u32> = samples
+                .gradients
+                .iter()
+                .map(|&g| model.model.intensity(&model.maps, g))
+                .collect();
+            assert_eq!(
+                samples.composite(&shaded).unwrap(),
+                fused,
+                "{}",
+                cfg.summary()
+            );
+            assert!(samples.composite(&shaded[1..]).is_err());
+            // A batch that differs in one sample changes the image.
+            let mut off = shaded.clone();
+            let i = samples.weights.iter().position(|&w| w > 0.2).unwrap();
+            off[i] = off[i].wrapping_add(9) % 256;
+            assert_ne!(samples.composite(&off).unwrap().value, fused.value);
+        }
     }
 
     #[test]
@@ -762,5 +789,16 @@ mod tests {
             ..CastOptions::default()
         })
         .contains("brick"));
+        assert!(bad(CastOptions {
+            brick: 12,
+            ..CastOptions::default()
+        })
+        .contains("power of two"));
+        CastOptions {
+            brick: 16,
+            ..CastOptions::default()
+        }
+        .validate()
+        .unwrap();
     }
 }

@@ -11,7 +11,8 @@
 //! **Scale.** One scale per volume, `scale = (2^(G-1) - 1) / gmax`, where `gmax` is the
 //! largest |component| of any voxel's gradient: the steepest edge of the volume uses the
 //! full range of the G-bit input, every component is `round(-scale * g)` (half away from
-//! zero), so it always lies in `-(2^(G-1) - 1) ..= 2^(G-1) - 1`. Gradients are **not**
+//! zero; computed as the value difference times `-scale / (2 spacing)` in f64), so it
+//! always lies in `-(2^(G-1) - 1) ..= 2^(G-1) - 1`. Gradients are **not**
 //! normalised: a weak edge or a noisy flat region gives small integers, and the hardware's
 //! leading-zero shift has to deal with them, exactly as with gradients from a gradient unit
 //! on real data. A gradient that rounds to (0, 0, 0) reaches the shader as the zero case.
@@ -39,92 +40,122 @@ pub fn limit(grad_bits: u32) -> i32 {
     (1 << (grad_bits - 1)) - 1
 }
 
-/// Calls `f(x, g)` with the float density gradient g (value units per world unit) of every
-/// voxel of row (y, z). `inv[axis]` holds 1 / (2 spacing) for central and 1 / spacing for
-/// one-sided differences.
+/// The five rows a row's differences need: itself, its y neighbours and its z neighbours
+/// (clamped at the borders), and whether the y and z differences are central.
 #[inline]
-fn row_gradients(
-    vol: &Volume,
-    y: usize,
-    z: usize,
-    inv: &[[f64; 2]; 3],
-    mut f: impl FnMut(usize, [f64; 3]),
-) {
+fn rows(vol: &Volume, y: usize, z: usize) -> ([&[f32]; 5], bool, bool) {
     let [nx, ny, nz] = vol.dims;
-    let span = |i: usize, n: usize| (i.saturating_sub(1), (i + 1).min(n - 1));
-    let k = |lo: usize, hi: usize| if hi - lo == 2 { 0 } else { 1 };
-    let row = |y: usize, z: usize| &vol.data[vol.index(0, y, z)..vol.index(0, y, z) + nx];
-    let (y0, y1) = span(y, ny);
-    let (z0, z1) = span(z, nz);
-    let (r, ym, yp, zm, zp) = (row(y, z), row(y0, z), row(y1, z), row(y, z0), row(y, z1));
-    let (iy, iz) = (inv[1][k(y0, y1)], inv[2][k(z0, z1)]);
-    let diff = |a: f32, b: f32| a as f64 - b as f64;
-    for x in 0..nx {
-        let (x0, x1) = span(x, nx);
-        f(
-            x,
-            [
-                diff(r[x1], r[x0]) * inv[0][k(x0, x1)],
-                diff(yp[x], ym[x]) * iy,
-                diff(zp[x], zm[x]) * iz,
-            ],
-        );
-    }
+    let row = |y: usize, z: usize| {
+        let i = vol.index(0, y, z);
+        &vol.data[i..i + nx]
+    };
+    let (y0, y1) = (y.saturating_sub(1), (y + 1).min(ny - 1));
+    let (z0, z1) = (z.saturating_sub(1), (z + 1).min(nz - 1));
+    (
+        [row(y, z), row(y0, z), row(y1, z), row(y, z0), row(y, z1)],
+        y1 - y0 == 2,
+        z1 - z0 == 2,
+    )
 }
 
-/// Rounds half away from zero (without a libm call on baseline x86-64).
+/// Largest |difference| of one row, as [central, one-sided] for x, y and z.
+fn row_max(vol: &Volume, y: usize, z: usize) -> [[f32; 2]; 3] {
+    let ([r, ym, yp, zm, zp], cy, cz) = rows(vol, y, z);
+    let nx = r.len();
+    let mut m = [[0.0f32; 2]; 3];
+    let mut mx = 0.0f32;
+    for (a, b) in r[2..].iter().zip(&r[..nx - 2]) {
+        let d = (a - b).abs();
+        mx = if d > mx { d } else { mx };
+    }
+    m[0] = [mx, (r[1] - r[0]).abs().max((r[nx - 1] - r[nx - 2]).abs())];
+    let max_diff = |p: &[f32], q: &[f32]| {
+        p.iter().zip(q).fold(
+            0.0f32,
+            |m, (a, b)| if (a - b).abs() > m { (a - b).abs() } else { m },
+        )
+    };
+    m[1][usize::from(!cy)] = max_diff(yp, ym);
+    m[2][usize::from(!cz)] = max_diff(zp, zm);
+    m
+}
+
+/// Rounds half away from zero, for |v| < 2^52: adds the largest double below 0.5 with v's
+/// sign and truncates (the sum rounds up exactly when v's fraction is at least 0.5). No
+/// libm call on baseline x86-64, and it vectorises.
 #[inline]
 pub fn round_half_away(v: f64) -> i64 {
-    let t = v as i64;
-    let f = v - t as f64;
-    if f >= 0.5 {
-        t + 1
-    } else if f <= -0.5 {
-        t - 1
-    } else {
-        t
-    }
+    (v + HALF_BELOW_F64.copysign(v)) as i64
 }
 
-/// `round(-scale * g)` (half away from zero), clamped to the G-bit range (the clamp only
-/// guards rounding of the product for the steepest component).
-#[inline]
-pub fn quantise(g: f64, scale: f64, grad_bits: u32) -> i32 {
-    let l = limit(grad_bits) as i64;
-    round_half_away(-g * scale).clamp(-l, l) as i32
-}
+const HALF_BELOW_F64: f64 = 0.499_999_999_999_999_94;
 
 /// The quantised outward normal of every voxel for `grad_bits`-wide shader inputs.
+///
+/// Differences of the f32 values are exact for integer data below 2^24; each is multiplied
+/// in f64 by the per-axis factor `scale / (2 spacing)` (or `scale / spacing` one-sided), and
+/// the largest component is found from the largest |difference| per axis, which gives the
+/// same maximum as comparing every gradient.
 pub fn gradients(vol: &Volume, grad_bits: u32) -> Gradients {
     assert!((2..=16).contains(&grad_bits), "grad_bits {grad_bits}");
     let [nx, ny, _] = vol.dims;
     let inv = vol.spacing.map(|s| [1.0 / (2.0 * s), 1.0 / s]);
-    let max_component = (0..vol.dims[2])
+    let m = (0..vol.dims[2])
         .into_par_iter()
         .map(|z| {
-            let mut m = 0.0f64;
+            let mut m = [[0.0f32; 2]; 3];
             for y in 0..ny {
-                row_gradients(vol, y, z, &inv, |_, g| {
-                    m = m.max(g[0].abs()).max(g[1].abs()).max(g[2].abs())
-                });
+                let r = row_max(vol, y, z);
+                for a in 0..3 {
+                    for k in 0..2 {
+                        m[a][k] = m[a][k].max(r[a][k]);
+                    }
+                }
             }
             m
         })
-        .reduce(|| 0.0, f64::max);
+        .reduce(
+            || [[0.0f32; 2]; 3],
+            |a, b| [0, 1, 2].map(|i| [a[i][0].max(b[i][0]), a[i][1].max(b[i][1])]),
+        );
+    let max_component = (0..3)
+        .flat_map(|a| (0..2).map(move |k| (a, k)))
+        .fold(0.0f64, |acc, (a, k)| acc.max(m[a][k] as f64 * inv[a][k]));
     let scale = if max_component > 0.0 {
         limit(grad_bits) as f64 / max_component
     } else {
         0.0
     };
+    // Per-axis factors, negated: the shader gets minus the density gradient.
+    let f = inv.map(|i| [-i[0] * scale, -i[1] * scale]);
+    let l = limit(grad_bits) as f64;
+    let q = |d: f32, k: f64| round_half_away((d as f64 * k).clamp(-l, l)) as i16;
     let mut data = vec![[0i16; 3]; vol.data.len()];
     data.par_chunks_mut(nx * ny)
         .enumerate()
         .for_each(|(z, out)| {
+            let mut t = [vec![0i16; nx], vec![0i16; nx], vec![0i16; nx]];
             for y in 0..ny {
-                let o = &mut out[nx * y..nx * (y + 1)];
-                row_gradients(vol, y, z, &inv, |x, g| {
-                    o[x] = g.map(|c| quantise(c, scale, grad_bits) as i16)
-                });
+                let ([r, ym, yp, zm, zp], cy, cz) = rows(vol, y, z);
+                let (ky, kz) = (f[1][usize::from(!cy)], f[2][usize::from(!cz)]);
+                // One component at a time, so each loop vectorises.
+                t[0][0] = q(r[1] - r[0], f[0][1]);
+                t[0][nx - 1] = q(r[nx - 1] - r[nx - 2], f[0][1]);
+                for (o, (a, b)) in t[0][1..nx - 1]
+                    .iter_mut()
+                    .zip(r[2..].iter().zip(&r[..nx - 2]))
+                {
+                    *o = q(a - b, f[0][0]);
+                }
+                for (o, (a, b)) in t[1].iter_mut().zip(yp.iter().zip(ym)) {
+                    *o = q(a - b, ky);
+                }
+                for (o, (a, b)) in t[2].iter_mut().zip(zp.iter().zip(zm)) {
+                    *o = q(a - b, kz);
+                }
+                for (x, o) in out[nx * y..nx * (y + 1)].iter_mut().enumerate() {
+                    *o = [t[0][x], t[1][x], t[2][x]];
+                }
             }
         });
     Gradients {
@@ -229,8 +260,6 @@ mod tests {
             assert_eq!(round_half_away(v), r, "{v}");
             assert_eq!(round_half_away(v), v.round() as i64, "{v}");
         }
-        assert_eq!(quantise(-300.0, 2047.0 / 300.0, 12), 2047);
-        assert_eq!(quantise(1e9, 1.0, 12), -2047);
     }
 
     #[test]

@@ -404,7 +404,7 @@ pub fn load_nrrd(path: &Path) -> Result<Volume> {
     let decoded;
     let body: &[u8] = if gzip {
         let skip = byte_skip as usize;
-        let mut out = Vec::with_capacity(want + skip);
+        let mut out = Vec::new();
         flate2::read::MultiGzDecoder::new(raw)
             .take((skip + want + 1) as u64)
             .read_to_end(&mut out)

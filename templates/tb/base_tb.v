@@ -6,13 +6,19 @@
 // Run from the generated directory, which holds vectors/ and the .hex files:
 //   iverilog -g2005 -Wall -Wno-timescale -s {= t.module =}_tb -o {= t.module =}_tb.vvp tb/{= t.module =}_tb.v *.v
 //   vvp -N {= t.module =}_tb.vvp      (-N: a failing run exits 1)
-// It reads {= t.vector_file =} (or the file of +vectors=FILE), one vector per line: {= t.field_list =}
+// It reads {= t.vector_file =} (or the file of +vectors=FILE), one vector per line:
+//   {= t.field_list =}
 // (inputs, then expected outputs, hex). Inputs are driven and outputs sampled on the falling
-// edge, never right after the rising one. From the {= t.full_speed =}th accepted vector on it inserts random
-// bubbles (valid_i low){% if t.has_en %} and stalls (en_i low){% endif %}, and resets the design once mid-stream and
-// presents the samples then in flight again. Every output must appear once, in order, when
-// valid_o && {% if t.has_en %}en_i{% else %}the clock{% endif %}, exactly LATENCY enabled clocks after its input. Mismatches print the
-// vector's line; the last line of the run is `N passed, M failed`.
+// edge, never right after the rising one. The first {= t.full_speed =} vectors are accepted back to back;
+{%- if t.has_en %}
+// then random bubbles (valid_i low) and stalls (en_i low) follow.
+{%- else %}
+// then random bubbles (valid_i low) follow ({= t.module =} has no clock enable).
+{%- endif %}
+// The design is reset once mid-stream and the samples then in flight are presented again.
+// Every output must leave once, in order, {% if t.has_en %}when valid_o && en_i{% else %}when valid_o{% endif %} at a rising edge, exactly
+// LATENCY enabled clocks after its input. Mismatches print the vector's line; the last line
+// of a run is `N passed, M failed`.
 `timescale 1ns / 1ps
 `default_nettype none
 
@@ -37,7 +43,7 @@ module {= t.module =}_tb;
 
   {= t.module =} dut (
 {%- for p in t.ports %}
-    .{= p.name =} ({= p.name =}){% if !loop.last %},{% endif %}
+    {= p.pin =}{% if !loop.last %},{% endif %}
 {%- endfor %}
   );
 

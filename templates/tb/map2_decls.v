@@ -1,4 +1,5 @@
 
+
   // The second map (map2_<axis>.hex, logical address order), written through the host port.
   localparam MAP_ENTRIES = {= t.map_entries =};  // per axis, 2^A
   localparam A           = {= t.map_addr_bits =};  // logical map address bits

@@ -1,12 +1,17 @@
 //! One integration-test binary; modules mirror the source tree.
 
+mod bench;
 mod cmd_render;
 mod fast;
 mod helpers;
 mod hexfile;
+mod map_fit;
 mod model_stages;
 mod render;
 mod rtl_generate;
 mod sim;
+mod stability;
+mod stress;
 mod symmetry;
 mod vectors;
+mod volume;

@@ -248,7 +248,7 @@ fn numbered_maps(cfg: &Config) -> Maps {
     Maps::from_data(
         cfg,
         (0..n)
-            .map(|k| (k as u32 * 2654435761u32 >> 7) & cfg.map_max())
+            .map(|k| ((k as u32).wrapping_mul(2654435761u32) >> 7) & cfg.map_max())
             .collect(),
     )
 }

@@ -272,10 +272,10 @@ fn failed_generate_keeps_the_existing_output() {
     );
 }
 
-/// `name: [direction, width]` of each port declaration in a generated module file.
+/// (direction, range, name) of each port declaration in a generated module file.
 fn declared_ports(text: &str) -> Vec<(String, String, String)> {
-    let head =
-        &text[text.find("module ").expect("a module")..text.find(");").expect("end of ports")];
+    let start = text.find("\nmodule ").expect("a module");
+    let head = &text[start..start + text[start..].find("\n);").expect("end of ports")];
     head.lines()
         .map(str::trim)
         .filter(|l| l.starts_with("input ") || l.starts_with("output "))

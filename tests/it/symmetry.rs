@@ -271,3 +271,105 @@ fn boundary_witness_agrees_after_an_x_z_swap() {
     );
     assert_eq!(a, b);
 }
+
+// Saturation, added with the stress work: the most negative input, fractions that round up
+// to all ones without a tie, and outputs clamped at 0 and at full scale.
+
+/// -2^(G-1) has no mirror image in range, but it shades as its half does (sort & shift
+/// shifts the leading zero out, and at shift 0 the low bits a halving drops are truncated
+/// anyway), and the half has all 48 mirror images: so the most negative value is as symmetric
+/// as the rest, ties with it included.
+#[test]
+fn most_negative_value_shades_as_its_mirrored_half() {
+    let cfg = Config::default();
+    let full = 1i32 << (cfg.grad_bits - 1);
+    let model = Model::new(&cfg);
+    let mut rng = SplitMix64::new(0x5a7);
+    let mut grads = Vec::new();
+    for i in 0..600 {
+        let mut r = || rng.range(0, 2 * full as u64 - 1) as i32 - full;
+        let (y, z) = match i % 6 {
+            0 => (-full, r()),
+            1 => (-full, -full),
+            2 => (full - 1, r()),
+            _ => (r(), r()),
+        };
+        let mut g = [-full, y, z];
+        g.rotate_right(i % 3);
+        grads.push(g);
+    }
+    // Halving: the magnitude >> 1 with the sign kept.
+    let half = |g: [i32; 3]| g.map(|c| c.signum() * (c.abs() >> 1));
+    for s in scenes() {
+        let maps = hexfile::scene_maps(&cfg, &s);
+        let transformed: Vec<_> = Transform::all()
+            .into_iter()
+            .map(|t| (t, hexfile::scene_maps(&cfg, &t.scene(&s))))
+            .collect();
+        for &g in &grads {
+            let want = model.intensity(&maps, g);
+            let h = half(g);
+            assert_eq!(
+                model.intensity(&maps, h),
+                want,
+                "{g:?} against its half {h:?}"
+            );
+            for (t, tmaps) in &transformed {
+                assert_eq!(
+                    model.intensity(tmaps, t.gradient(h)),
+                    want,
+                    "{g:?} via {t:?}"
+                );
+            }
+        }
+    }
+}
+
+/// A scene bright enough to clamp at full scale over a wide region and dark enough to give 0
+/// elsewhere, with gradients whose fraction rounds up to all ones without a tie (a = m - 1 at
+/// the largest m): still symmetric under all 48 transforms, and both clamps are reached.
+#[test]
+fn saturated_outputs_and_fractions_are_symmetric() {
+    let cfg = Config::default();
+    let model = Model::new(&cfg);
+    let mut s = Scene::standard();
+    s.material = Material {
+        ambient: 0.0,
+        diffuse: 1.3,
+        specular: 0.8,
+        shininess: 8.0,
+    };
+    s.lights = vec![Light {
+        direction: [0.4, -0.3, 1.0],
+        intensity: 1.0,
+    }];
+    let mut gs = gradients(&cfg, 1500);
+    // 2040 and 2032 reduce to m = 255 and a = 254, whose fraction rounds up to all ones.
+    for (a, b, c) in [
+        (2040, 2032, 700),
+        (2040, -2032, -3),
+        (-2032, 2040, 0),
+        (17, -2032, 2040),
+    ] {
+        gs.push([a, b, c]);
+        gs.push([c, a, b]);
+    }
+    let near = model.trace(&hexfile::scene_maps(&cfg, &s), [2040, 2032, 700], [0; 3]);
+    assert_eq!(
+        (near.sort.m, near.sort.a, near.norm.u),
+        (255, 254, cfg.frac_max())
+    );
+    let maps = hexfile::scene_maps(&cfg, &s);
+    let want: Vec<u32> = gs.iter().map(|&g| model.intensity(&maps, g)).collect();
+    assert!(
+        want.iter().filter(|&&w| w == cfg.map_max()).count() > 50,
+        "clamps at full scale"
+    );
+    assert!(want.iter().filter(|&&w| w == 0).count() > 50, "clamps at 0");
+    for t in Transform::all() {
+        let tmaps = hexfile::scene_maps(&cfg, &t.scene(&s));
+        for (&g, &w) in gs.iter().zip(&want) {
+            assert_eq!(model.intensity(&tmaps, t.gradient(g)), w, "{t:?}: {g:?}");
+        }
+    }
+}

@@ -258,12 +258,13 @@ fn corner_cases_come_first() {
             "{}: {differ} of 200 random lines differ",
             stage.name()
         );
-        assert_eq!(
-            la.len(),
-            ncorners * if stage == Stage::Top { 2 } else { 1 } + 200,
-            "{}",
-            stage.name()
-        );
+        // The top has each corner once per map and the swap witness once more.
+        let want = if stage == Stage::Top {
+            2 * ncorners + 1 + 200
+        } else {
+            ncorners + 200
+        };
+        assert_eq!(la.len(), want, "{}", stage.name());
     }
     // The first corner of the gradient stages is the zero vector.
     for stage in [Stage::ZeroDetect, Stage::SortShift] {
@@ -359,10 +360,19 @@ fn top_vectors_are_map_0_then_map_1() {
     let first1 = maps.iter().position(|&m| m == 1).expect("a map-1 part");
     assert!(maps[..first1].iter().all(|&m| m == 0) && maps[first1..].iter().all(|&m| m == 1));
     let nc = inputs::top_corners(&cfg, 0).len();
-    assert_eq!((first1, maps.len() - first1), (nc + 501, nc + 500));
-    // The two maps differ, so a missing swap cannot pass.
-    let m = MapSet::standard(&cfg);
-    assert_ne!(m.scene, m.second);
+    assert_eq!((first1, maps.len() - first1), (nc + 501 + 1, nc + 500));
+    // The vectors on both sides of the swap are the same gradient with different results, so
+    // a swap one sample early or late cannot pass.
+    let text = read(&dir, Stage::Top);
+    let lines: Vec<&str> = text.lines().collect();
+    let (a, b) = (
+        fields(&cfg, Stage::Top, lines[first1 - 1]),
+        fields(&cfg, Stage::Top, lines[first1]),
+    );
+    for g in ["gx", "gy", "gz"] {
+        assert_eq!(a[g], b[g]);
+    }
+    assert_ne!(a["i"], b["i"], "{} / {}", lines[first1 - 1], lines[first1]);
 }
 
 #[test]

@@ -1,0 +1,70 @@
+//! `rmapgen bench`: error against run time and hardware cost, as a Markdown table, a CSV and
+//! plots.
+
+use crate::bench::{self, Options};
+use crate::output::StagedDir;
+use anyhow::Result;
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Output directory for bench.md, bench.csv, bench.json and the plots (replaced whole).
+    #[arg(long, value_name = "DIR", default_value = "out/bench")]
+    pub out: PathBuf,
+    /// Sphere image side for the error figures [16..=4096].
+    #[arg(long, value_name = "N", default_value_t = 512)]
+    pub size: u32,
+    /// Seconds spent timing each throughput figure.
+    #[arg(long, value_name = "S", default_value_t = 0.3)]
+    pub seconds: f64,
+    /// Skip Yosys synthesis even when yosys is installed.
+    #[arg(long)]
+    pub no_yosys: bool,
+    /// Only the paper's configuration (and the octahedral map).
+    #[arg(long)]
+    pub quick: bool,
+}
+
+pub fn run(a: &BenchArgs) -> Result<()> {
+    anyhow::ensure!(
+        (16..=4096).contains(&a.size),
+        "size {} is out of range; allowed 16..=4096",
+        a.size
+    );
+    anyhow::ensure!(
+        a.seconds > 0.0 && a.seconds <= 60.0,
+        "seconds {} is out of range; allowed (0, 60]",
+        a.seconds
+    );
+    let out = StagedDir::new(&a.out)?;
+    let opts = Options {
+        size: a.size,
+        seconds: a.seconds,
+        yosys: !a.no_yosys,
+        quick: a.quick,
+    };
+    let steps = bench::configurations(a.quick).len() * (1 + 2 * bench::scenes().len())
+        + 2 * bench::scenes().len();
+    let bar = ProgressBar::new(steps as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} {msg}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    let rows = bench::run(&opts, &|msg| {
+        bar.set_message(msg.to_string());
+        bar.inc(1);
+    });
+    bar.finish_and_clear();
+    let rows = rows?;
+    bench::write(&rows, &out)?;
+    let p = out.commit()?;
+    print!("{}", bench::markdown(&rows));
+    eprintln!(
+        "rmapgen: wrote bench.md, bench.csv, bench.json and plots to {}",
+        p.display()
+    );
+    Ok(())
+}

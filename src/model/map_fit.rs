@@ -1,0 +1,567 @@
+//! Map entries fitted to the light model: instead of sampling the light model at each entry's
+//! direction ([`reflectance_map::contents`], the paper's map), choose the entries whose
+//! interpolated values best match the light model over a dense grid of directions, then round
+//! and clamp them. The result is an ordinary [`Maps`]: it loads into the same RTL and the same
+//! model unchanged.
+//!
+//! Each quadrant of a cube face (max axis, its sign and the signs of u and v) is an independent
+//! N x N grid of entries (N = 2^index_bits). Its dense grid has K = (N - 1) Q + 1 tangents per
+//! component (Q = [`SAMPLES_PER_ENTRY`] per entry spacing, at the encoded tangents of evenly
+//! spaced positions), so K^2 directions per quadrant, none of them a test image's. The model's
+//! value at a direction is linear in the entries. Its weights are measured through the
+//! pipeline: for each dense tangent, the position the model computes for a component of that
+//! tangent under [`PIPELINE_MAXES`] largest magnitudes spread over the top magnitude class
+//! (every other class shades as a subset of it), and the bilinear (or nearest-entry) weights of
+//! those positions, averaged. So the fit sees the pipeline's rounding and truncation of
+//! directions, not ideal positions.
+//!
+//! 1. **Least squares** with uniform weights: the basis is a tensor product, so the normal
+//!    matrix is A (x) A for the N x N matrix A = P^T P of one component (P: K x N), and the
+//!    solution is E = A^-1 P^T F P A^-1 for the K x K light-model values F. A^-1 and P depend
+//!    only on the configuration ([`LsqFit::new`], once); a frame costs K^2 light-model
+//!    evaluations and small matrix products per quadrant ([`LsqFit::fit`]).
+//! 2. **Peak refinement**: in a quadrant whose fit misses some dense sample by more than
+//!    [`REFINE_TAU`] LSB (a highlight narrower than the entry spacing), the samples are
+//!    reweighted by 1 + (|residual| / tau)^[`REFINE_POWER`] and the full N^2 x N^2 weighted
+//!    problem is solved again, [`REFINE_ITERATIONS`] times (iteratively reweighted least
+//!    squares towards the minimax fit). This trades a little RMS error for a lower maximum at
+//!    highlights; quadrants without a sharp feature skip it, and a refinement is kept only if
+//!    it lowers the quadrant's worst residual at a cost of at most [`REFINE_RMS_GROWTH`] times
+//!    its RMS residual (with few entries it can trade badly). It is off without interpolation,
+//!    where it was measured to raise the maximum. [`MapFit::LsqPlain`] leaves it out.
+
+use super::{map_lookup, reflectance_map, Maps};
+use crate::config::Config;
+use glam::DVec3;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::FRAC_PI_4;
+
+/// How the host fills the maps.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum,
+)]
+#[serde(rename_all = "kebab-case")]
+pub enum MapFit {
+    /// The light model at each entry's direction (the paper).
+    #[default]
+    Sample,
+    /// Least squares over a dense grid of directions with peak refinement, then rounded.
+    Lsq,
+    /// Least squares over a dense grid of directions with uniform weights, then rounded.
+    LsqPlain,
+}
+
+impl MapFit {
+    pub fn name(self) -> &'static str {
+        match self {
+            MapFit::Sample => "sample",
+            MapFit::Lsq => "lsq",
+            MapFit::LsqPlain => "lsq-plain",
+        }
+    }
+}
+
+/// Dense samples per entry spacing along each component.
+pub const SAMPLES_PER_ENTRY: u32 = 4;
+/// Largest magnitudes at which the basis weights are measured through the pipeline.
+pub const PIPELINE_MAXES: u32 = 16;
+/// Residual (output LSBs) above which a quadrant is refined.
+pub const REFINE_TAU: f64 = 4.0;
+/// Exponent of the refinement's reweighting.
+pub const REFINE_POWER: i32 = 2;
+/// Largest growth of a quadrant's RMS residual that a refinement may cost.
+pub const REFINE_RMS_GROWTH: f64 = 1.5;
+/// Reweighted solves of a refined quadrant.
+pub const REFINE_ITERATIONS: u32 = 4;
+
+/// The maps for a light model given as a function of the unit normal, filled as `fit` says:
+/// used by the model, the hex writer and every command.
+pub fn contents(cfg: &Config, fit: MapFit, shade: impl Fn(DVec3) -> f64 + Sync) -> Maps {
+    match fit {
+        MapFit::Sample => reflectance_map::contents(cfg, shade),
+        MapFit::Lsq => LsqFit::new(cfg).fit(shade),
+        MapFit::LsqPlain => LsqFit::plain(cfg).fit(shade),
+    }
+}
+
+/// The per-configuration part of the least-squares fit.
+#[derive(Clone, Debug)]
+pub struct LsqFit {
+    cfg: Config,
+    n: usize,
+    /// For each dense sample along one component: its tangent, and its basis weights as
+    /// (entry, weight) pairs.
+    tangent: Vec<f64>,
+    basis: Vec<Vec<(usize, f64)>>,
+    /// A^-1, n x n row-major.
+    a_inv: Vec<f64>,
+    /// Reweighted solves of a quadrant that misses by more than `refine_tau` (0: none).
+    pub refine_iterations: u32,
+    pub refine_tau: f64,
+    pub refine_power: i32,
+    /// Bandwidth of the quadrant's normal matrix in entry order i_u * n + i_v.
+    band: usize,
+}
+
+impl LsqFit {
+    /// Precomputes the dense grid and the inverse normal matrix of a configuration.
+    pub fn new(cfg: &Config) -> LsqFit {
+        LsqFit::with(cfg, SAMPLES_PER_ENTRY, PIPELINE_MAXES)
+    }
+
+    /// [`LsqFit::new`] without the peak refinement ([`MapFit::LsqPlain`]).
+    pub fn plain(cfg: &Config) -> LsqFit {
+        LsqFit {
+            refine_iterations: 0,
+            ..LsqFit::new(cfg)
+        }
+    }
+
+    /// [`LsqFit::new`] with `q` samples per entry spacing, and the basis weights measured
+    /// through the pipeline at `maxes` largest magnitudes (0: ideal positions).
+    pub fn with(cfg: &Config, q: u32, maxes: u32) -> LsqFit {
+        let n = cfg.entries() as usize;
+        let k = (n - 1) * q as usize + 1;
+        let model = super::Model::new(cfg);
+        let blank = Maps::from_data(cfg, vec![0; 3 * cfg.map_entries() as usize]);
+        let full = 1u32 << (cfg.grad_bits - 1);
+        let mut tangent = Vec::with_capacity(k);
+        let mut basis = Vec::with_capacity(k);
+        let weights = |p: f64| -> Vec<(usize, f64)> {
+            if cfg.interpolation {
+                let x = p / cfg.step() as f64;
+                let base = (x.floor() as usize).min(n - 2);
+                let w = x - base as f64;
+                vec![(base, 1.0 - w), (base + 1, w)]
+            } else {
+                vec![((p + 0.5).floor() as usize, 1.0)]
+            }
+        };
+        for j in 0..k {
+            // Position in entry spacings, 0..=n-1.
+            let x = j as f64 / q as f64;
+            let t = tangent_at(cfg, x);
+            tangent.push(t);
+            let mut acc = vec![0.0; n];
+            if maxes == 0 {
+                for (i, w) in weights(x * cfg.step() as f64) {
+                    acc[i] += w;
+                }
+            } else {
+                for s in 0..maxes {
+                    // Largest magnitudes spread over the top class (every other class shades
+                    // as a subset of it), the component rounded to the nearest integer.
+                    let max = full / 2 + ((2 * s + 1) * (full / 2)) / (2 * maxes);
+                    let c = (t * max as f64).round() as i32;
+                    let p = model.trace(&blank, [max as i32, c, 0], [0; 3]).p_u;
+                    for (i, w) in weights(p as f64) {
+                        acc[i] += w / maxes as f64;
+                    }
+                }
+            }
+            let nz: Vec<(usize, f64)> = acc
+                .iter()
+                .copied()
+                .enumerate()
+                .filter(|&(_, w)| w != 0.0)
+                .collect();
+            basis.push(nz);
+        }
+        let mut a = vec![0.0; n * n];
+        for b in &basis {
+            for &(i, wi) in b {
+                for &(j, wj) in b {
+                    a[i * n + j] += wi * wj;
+                }
+            }
+        }
+        // Entries a sample couples lie within `spread` of each other along a component.
+        let spread = basis
+            .iter()
+            .map(|b| b.iter().map(|e| e.0).max().unwrap() - b.iter().map(|e| e.0).min().unwrap())
+            .max()
+            .unwrap_or(0);
+        LsqFit {
+            cfg: cfg.clone(),
+            n,
+            tangent,
+            basis,
+            a_inv: invert_spd(&a, n),
+            band: spread * n + spread,
+            refine_iterations: if cfg.interpolation {
+                REFINE_ITERATIONS
+            } else {
+                0
+            },
+            refine_tau: REFINE_TAU,
+            refine_power: REFINE_POWER,
+        }
+    }
+
+    /// Dense samples per component.
+    pub fn samples_per_component(&self) -> usize {
+        self.tangent.len()
+    }
+
+    /// The fitted maps of one frame (the 24 quadrants in parallel).
+    pub fn fit(&self, shade: impl Fn(DVec3) -> f64 + Sync) -> Maps {
+        let cfg = &self.cfg;
+        let n = self.n;
+        let quadrants: Vec<Vec<f64>> = (0..24u32)
+            .into_par_iter()
+            .map(|q| self.fit_quadrant(q, &shade))
+            .collect();
+        let top = cfg.map_max() as f64;
+        let mut data = vec![0u32; 3 * cfg.map_entries() as usize];
+        for (q, e) in quadrants.iter().enumerate() {
+            let q = q as u32;
+            let (axis, s_max, s_u, s_v) = (q >> 3, (q >> 2) & 1, (q >> 1) & 1, q & 1);
+            for i_u in 0..n {
+                for i_v in 0..n {
+                    let a = map_lookup::addr(cfg, s_max, s_u, i_u as u32, s_v, i_v as u32);
+                    let v = e[i_u * n + i_v];
+                    data[(axis * cfg.map_entries() + a) as usize] = if v.is_nan() {
+                        0
+                    } else {
+                        (v + 0.5).floor().clamp(0.0, top) as u32
+                    };
+                }
+            }
+        }
+        Maps::from_data(cfg, data)
+    }
+
+    /// The unrounded entries of quadrant q = axis << 3 | s_max << 2 | s_u << 1 | s_v.
+    fn fit_quadrant(&self, q: u32, shade: &impl Fn(DVec3) -> f64) -> Vec<f64> {
+        let (n, k) = (self.n, self.tangent.len());
+        let top = self.cfg.map_max() as f64;
+        let (axis, s_max, s_u, s_v) = (q >> 3, (q >> 2) & 1, (q >> 1) & 1, q & 1);
+        let sg = |s: u32, t: f64| if s == 1 { -t } else { t };
+        // Light-model values on the dense grid, in output LSBs, clamped as the reference
+        // clamps them.
+        let mut f = vec![0.0; k * k];
+        for (ju, &tu) in self.tangent.iter().enumerate() {
+            for (jv, &tv) in self.tangent.iter().enumerate() {
+                let [x, y, z] = place(axis, sg(s_max, 1.0), sg(s_u, tu), sg(s_v, tv));
+                let i = shade(crate::scene::sym_normalize(DVec3::new(x, y, z)));
+                f[ju * k + jv] = if i.is_nan() {
+                    0.0
+                } else {
+                    i.clamp(0.0, 1.0) * top
+                };
+            }
+        }
+        let mut e = vec![0.0; n * n];
+        self.solve_uniform(&f, &mut e);
+        let (max, rms) = self.residuals(&f, &e);
+        if self.refine_iterations > 0 && max > self.refine_tau {
+            let mut r = e.clone();
+            self.refine(&f, &mut r);
+            // Keep the refinement only where it lowers the worst residual without giving up
+            // much RMS (it can trade badly when entries are few for the feature).
+            let (max_r, rms_r) = self.residuals(&f, &r);
+            if max_r < max && rms_r <= REFINE_RMS_GROWTH * rms {
+                e = r;
+            }
+        }
+        e
+    }
+
+    /// E = A^-1 P^T F P A^-1.
+    fn solve_uniform(&self, f: &[f64], e: &mut [f64]) {
+        let (n, k) = (self.n, self.tangent.len());
+        // pf = P^T F (n x k), then b = pf P (n x n).
+        let mut pf = vec![0.0; n * k];
+        for (ju, bu) in self.basis.iter().enumerate() {
+            for &(i, w) in bu {
+                for (acc, &v) in pf[i * k..(i + 1) * k]
+                    .iter_mut()
+                    .zip(&f[ju * k..(ju + 1) * k])
+                {
+                    *acc += w * v;
+                }
+            }
+        }
+        let mut b = vec![0.0; n * n];
+        for i in 0..n {
+            for (jv, bv) in self.basis.iter().enumerate() {
+                let v = pf[i * k + jv];
+                for &(j, w) in bv {
+                    b[i * n + j] += w * v;
+                }
+            }
+        }
+        let mut tmp = vec![0.0; n * n];
+        matmul(&self.a_inv, &b, &mut tmp, n);
+        matmul(&tmp, &self.a_inv, e, n);
+    }
+
+    /// The fitted value at dense sample (ju, jv).
+    fn predict(&self, e: &[f64], ju: usize, jv: usize) -> f64 {
+        let n = self.n;
+        let mut s = 0.0;
+        for &(i, wi) in &self.basis[ju] {
+            for &(j, wj) in &self.basis[jv] {
+                s += wi * wj * e[i * n + j];
+            }
+        }
+        s
+    }
+
+    /// The largest and the RMS residual over the dense grid.
+    fn residuals(&self, f: &[f64], e: &[f64]) -> (f64, f64) {
+        let k = self.tangent.len();
+        let (mut m, mut sq): (f64, f64) = (0.0, 0.0);
+        for ju in 0..k {
+            for jv in 0..k {
+                let r = self.predict(e, ju, jv) - f[ju * k + jv];
+                m = m.max(r.abs());
+                sq += r * r;
+            }
+        }
+        (m, (sq / (k * k) as f64).sqrt())
+    }
+
+    /// Reweighted least squares over the whole quadrant (n^2 unknowns), from the fit in `e`.
+    fn refine(&self, f: &[f64], e: &mut [f64]) {
+        let (n, k) = (self.n, self.tangent.len());
+        let nn = n * n;
+        let mut w = vec![1.0; k * k];
+        let mut a = vec![0.0; nn * nn];
+        let mut b = vec![0.0; nn];
+        let mut phi: Vec<(usize, f64)> = Vec::new();
+        for _ in 0..self.refine_iterations {
+            for ju in 0..k {
+                for jv in 0..k {
+                    let r = (self.predict(e, ju, jv) - f[ju * k + jv]).abs();
+                    w[ju * k + jv] *= 1.0 + (r / self.refine_tau).powi(self.refine_power);
+                }
+            }
+            a.iter_mut().for_each(|x| *x = 0.0);
+            b.iter_mut().for_each(|x| *x = 0.0);
+            for ju in 0..k {
+                for jv in 0..k {
+                    let wk = w[ju * k + jv];
+                    phi.clear();
+                    for &(i, wi) in &self.basis[ju] {
+                        for &(j, wj) in &self.basis[jv] {
+                            phi.push((i * n + j, wi * wj));
+                        }
+                    }
+                    for &(p, x) in &phi {
+                        b[p] += wk * x * f[ju * k + jv];
+                        // The lower triangle is all the factorisation reads.
+                        for &(q, y) in &phi {
+                            if q <= p {
+                                a[p * nn + q] += wk * x * y;
+                            }
+                        }
+                    }
+                }
+            }
+            cholesky_solve(&mut a, &mut b, nn, self.band);
+            e.copy_from_slice(&b);
+        }
+    }
+}
+
+/// The tangent at a position of x entry spacings (0..=entries-1): the tangent the pipeline's
+/// positions stand for, exactly 1 on the border.
+fn tangent_at(cfg: &Config, x: f64) -> f64 {
+    let r = x / (cfg.entries() - 1) as f64;
+    if r >= 1.0 {
+        1.0
+    } else if cfg.compensation {
+        (r * FRAC_PI_4).tan()
+    } else {
+        r
+    }
+}
+
+fn place(axis: u32, m: f64, u: f64, v: f64) -> [f64; 3] {
+    match axis {
+        0 => [m, u, v],
+        1 => [u, m, v],
+        _ => [u, v, m],
+    }
+}
+
+/// c = a b for n x n row-major matrices.
+fn matmul(a: &[f64], b: &[f64], c: &mut [f64], n: usize) {
+    for i in 0..n {
+        for j in 0..n {
+            c[i * n + j] = (0..n).map(|k| a[i * n + k] * b[k * n + j]).sum();
+        }
+    }
+}
+
+/// Solves a x = b in place (x in b) for a symmetric positive definite n x n matrix a whose
+/// entries vanish more than `band` off the diagonal; only its lower triangle is read, and it is
+/// overwritten by its Cholesky factor (which has the same band).
+fn cholesky_solve(a: &mut [f64], b: &mut [f64], n: usize, band: usize) {
+    for j in 0..n {
+        let lo = j.saturating_sub(band);
+        let mut d = a[j * n + j];
+        for k in lo..j {
+            d -= a[j * n + k] * a[j * n + k];
+        }
+        assert!(d > 0.0, "weighted normal matrix not positive definite");
+        let d = d.sqrt();
+        a[j * n + j] = d;
+        for i in j + 1..(j + band + 1).min(n) {
+            let mut s = a[i * n + j];
+            for k in i.saturating_sub(band)..j {
+                s -= a[i * n + k] * a[j * n + k];
+            }
+            a[i * n + j] = s / d;
+        }
+    }
+    for i in 0..n {
+        let mut s = b[i];
+        for k in i.saturating_sub(band)..i {
+            s -= a[i * n + k] * b[k];
+        }
+        b[i] = s / a[i * n + i];
+    }
+    for i in (0..n).rev() {
+        let mut s = b[i];
+        for k in i + 1..(i + band + 1).min(n) {
+            s -= a[k * n + i] * b[k];
+        }
+        b[i] = s / a[i * n + i];
+    }
+}
+
+/// The inverse of a symmetric positive definite n x n matrix, by Cholesky factorisation.
+fn invert_spd(a: &[f64], n: usize) -> Vec<f64> {
+    // a = L L^T.
+    let mut l = vec![0.0; n * n];
+    for i in 0..n {
+        for j in 0..=i {
+            let s: f64 = a[i * n + j] - (0..j).map(|k| l[i * n + k] * l[j * n + k]).sum::<f64>();
+            if i == j {
+                assert!(s > 0.0, "normal matrix not positive definite");
+                l[i * n + i] = s.sqrt();
+            } else {
+                l[i * n + j] = s / l[j * n + j];
+            }
+        }
+    }
+    // Solve L L^T x = e_c for every column c.
+    let mut inv = vec![0.0; n * n];
+    for c in 0..n {
+        let mut y = vec![0.0; n];
+        for i in 0..n {
+            let e = if i == c { 1.0 } else { 0.0 };
+            y[i] = (e - (0..i).map(|k| l[i * n + k] * y[k]).sum::<f64>()) / l[i * n + i];
+        }
+        for i in (0..n).rev() {
+            let s = y[i]
+                - (i + 1..n)
+                    .map(|k| l[k * n + i] * inv[k * n + c])
+                    .sum::<f64>();
+            inv[i * n + c] = s / l[i * n + i];
+        }
+    }
+    inv
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inverse_is_an_inverse() {
+        let cfg = Config::default();
+        let fit = LsqFit::new(&cfg);
+        let n = fit.n;
+        let mut a = vec![0.0; n * n];
+        for b in &fit.basis {
+            for &(i, wi) in b {
+                for &(j, wj) in b {
+                    a[i * n + j] += wi * wj;
+                }
+            }
+        }
+        let mut id = vec![0.0; n * n];
+        matmul(&a, &fit.a_inv, &mut id, n);
+        for i in 0..n {
+            for j in 0..n {
+                assert!(
+                    (id[i * n + j] - (i == j) as u8 as f64).abs() < 1e-12,
+                    "{i} {j}"
+                );
+            }
+        }
+    }
+
+    /// A light model that is itself bilinear in the positions is reproduced exactly, entry for
+    /// entry, by both fits.
+    #[test]
+    fn reproduces_a_bilinear_light_model() {
+        for cfg in [
+            Config::default(),
+            Config {
+                index_bits: 4,
+                interp_bits: 2,
+                ..Config::default()
+            },
+        ] {
+            // Ideal positions, so that the fitted model is exactly bilinear in them.
+            let fit = LsqFit::with(&cfg, SAMPLES_PER_ENTRY, 0);
+            // The light model as a function of the direction: 0.2 + 0.5 * (x_u) * (x_v) / (n-1)^2
+            // in entry spacings of the two tangents, on every face.
+            let n1 = (cfg.entries() - 1) as f64;
+            let pos = |t: f64| t.abs().atan() / FRAC_PI_4 * n1;
+            let shade = |d: DVec3| {
+                let a = d.abs();
+                let (m, u, v) = if a.x >= a.y && a.x >= a.z {
+                    (a.x, a.y, a.z)
+                } else if a.y >= a.z {
+                    (a.y, a.x, a.z)
+                } else {
+                    (a.z, a.x, a.y)
+                };
+                0.2 + 0.5 * pos(u / m) * pos(v / m) / (n1 * n1)
+            };
+            let fitted = fit.fit(shade);
+            let sampled = reflectance_map::contents(&cfg, shade);
+            let diff = fitted
+                .data
+                .iter()
+                .zip(&sampled.data)
+                .filter(|(a, b)| a.abs_diff(**b) > 1)
+                .count();
+            assert_eq!(diff, 0, "{}", cfg.summary());
+        }
+    }
+
+    /// Basis weights measured through the pipeline sum to 1, so a constant light model gives
+    /// that constant everywhere, in every configuration shape.
+    #[test]
+    fn constant_light_model_gives_constant_maps() {
+        for cfg in [
+            Config::default(),
+            Config {
+                compensation: false,
+                ..Config::default()
+            },
+            Config {
+                interpolation: false,
+                interp_bits: 0,
+                ..Config::default()
+            },
+            Config {
+                index_bits: 2,
+                interp_bits: 1,
+                map_bits: 10,
+                ..Config::default()
+            },
+        ] {
+            let maps = contents(&cfg, MapFit::Lsq, |_| 0.4);
+            let want = reflectance_map::quantise(&cfg, 0.4);
+            assert!(maps.data.iter().all(|&e| e == want), "{}", cfg.summary());
+        }
+    }
+}

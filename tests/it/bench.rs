@@ -1,0 +1,109 @@
+//! `rmapgen bench`: the quick run writes its table, CSV and plots, and the Pareto marking
+//! follows its definition.
+
+use super::helpers;
+use rmapgen::bench::{self, Row};
+
+fn row(scene: &str, bits: u64, speed: f64, rmse: f64) -> Row {
+    Row {
+        scene: scene.into(),
+        design: format!("{bits}/{speed}"),
+        config: String::new(),
+        map_fit: "sample".into(),
+        entries: 0,
+        max_abs_error: 0,
+        rmse,
+        psnr_db: 0.0,
+        msamples_1_thread: speed,
+        msamples_all_cores: speed,
+        float_ratio: 1.0,
+        map_build_us: 0.0,
+        rom_bits: 0,
+        map_bits: bits,
+        yosys_cells: None,
+        pareto_cost: false,
+        pareto_speed: false,
+    }
+}
+
+#[test]
+fn pareto_fronts_per_scene() {
+    let mut rows = vec![
+        row("a", 100, 10.0, 2.0),
+        row("a", 200, 20.0, 1.0),
+        row("a", 300, 5.0, 1.5), // dominated in cost by the second, in speed too
+        row("a", 100, 10.0, 2.5), // dominated by the first
+        row("b", 900, 1.0, 9.0), // alone in its scene: on both fronts
+    ];
+    bench::mark_pareto(&mut rows);
+    let fronts: Vec<(bool, bool)> = rows
+        .iter()
+        .map(|r| (r.pareto_cost, r.pareto_speed))
+        .collect();
+    assert_eq!(
+        fronts,
+        [
+            (true, false),
+            (true, true),
+            (false, false),
+            (false, false),
+            (true, true)
+        ]
+    );
+    let md = bench::markdown(&rows);
+    assert_eq!(md.lines().count(), 2 + rows.len());
+    assert!(md.lines().nth(2).unwrap().ends_with("| cost |"), "{md}");
+    let csv = bench::csv(&rows);
+    assert_eq!(csv.lines().count(), 1 + rows.len());
+    assert!(csv.lines().all(|l| l.split(',').count() == 17), "{csv}");
+}
+
+#[test]
+fn quick_run_writes_table_csv_and_plots() {
+    let dir = helpers::tempdir();
+    let out = dir.path().join("bench");
+    let run = helpers::run(&[
+        "bench",
+        "--quick",
+        "--no-yosys",
+        "--size",
+        "48",
+        "--seconds",
+        "0.01",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    for f in [
+        "bench.md",
+        "bench.csv",
+        "bench.json",
+        "error_vs_cost.png",
+        "error_vs_cost.svg",
+        "error_vs_speed.png",
+        "error_vs_speed.svg",
+    ] {
+        assert!(
+            out.join(f)
+                .metadata()
+                .map(|m| m.len() > 100)
+                .unwrap_or(false),
+            "{f}"
+        );
+    }
+    let md = std::fs::read_to_string(out.join("bench.md")).unwrap();
+    // The paper's configuration with both fits and the octahedral map, on three scenes.
+    assert_eq!(md.lines().count(), 2 + 3 * 3, "{md}");
+    assert!(
+        md.contains("| standard | paper I3 P3 | lsq |") && md.contains("octahedral 39x39"),
+        "{md}"
+    );
+    let png = image::open(out.join("error_vs_cost.png")).unwrap();
+    assert_eq!((png.width(), png.height()), (900, 600));
+    let bad = helpers::run(&["bench", "--size", "3", "--out", out.to_str().unwrap()]);
+    helpers::assert_error(&bad, "size 3 is out of range");
+}
