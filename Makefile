@@ -31,7 +31,10 @@ cargo-test:
 roms: build
 	$(RMAPGEN) roms --out $(OUT)/roms
 
-test: tools cargo-test
+# Everything: cargo tests (model, golden rtl_out/, vectors, CLI errors, sampled stress), Verilator
+# lint, Yosys synthesis, and every testbench in Icarus and Verilator plus the 1M-vector harness.
+test: tools cargo-test lint synth sim-all
+	@echo "make test: all checks passed"
 
 # ---- Simulation (tb/run_sims.sh): every testbench of the design generated with $(GEN_FLAGS)
 # into $(SIM_OUT) (not the committed rtl_out/), under Verilator (sim), Icarus (sim-icarus) or
