@@ -30,7 +30,20 @@ pub struct Config {
     pub interpolation: bool,
     /// Multiply an 8-bit RGB sample colour by the intensity.
     pub color: bool,
+    /// Where the RTL's pipeline registers sit, trading latency for clock rate (the model's
+    /// results do not depend on it): 0 compact (fewest registers, lowest latency), 1 adds
+    /// registers after every memory read and between the adder levels of the multipliers,
+    /// 2 registers every adder level (highest Fmax). Range [`PIPELINE_DEPTHS`];
+    /// `rtl::latency` gives each stage's latency for it.
+    pub pipeline_depth: u32,
+    /// A valid/ready handshake (AXI-Stream style) on the top: `ready_o` tells the source a
+    /// sample is accepted, `ready_i` low stalls the whole pipeline. Off: a plain valid
+    /// stream that accepts a sample every clock `valid_i` is high.
+    pub handshake: bool,
 }
+
+/// Allowed values of [`Config::pipeline_depth`].
+pub const PIPELINE_DEPTHS: (u32, u32) = (0, 2);
 
 /// Width of each channel of the optional sample colour.
 pub const COLOR_BITS: u32 = 8;
@@ -80,6 +93,8 @@ impl Default for Config {
             compensation: true,
             interpolation: true,
             color: false,
+            pipeline_depth: 0,
+            handshake: false,
         }
     }
 }
@@ -110,6 +125,15 @@ impl Config {
                     max,
                 });
             }
+        }
+        let (min, max) = PIPELINE_DEPTHS;
+        if self.pipeline_depth < min || self.pipeline_depth > max {
+            return Err(ConfigError::OutOfRange {
+                field: "pipeline_depth",
+                value: self.pipeline_depth,
+                min,
+                max,
+            });
         }
         let c = |s: String| Err(ConfigError::Conflict(s));
         if self.red_bits > self.grad_bits {
@@ -299,7 +323,7 @@ impl Config {
     /// A short, stable description used in headers and file names.
     pub fn summary(&self) -> String {
         format!(
-            "G{} R{} W{} F{} I{} P{} M{} comp={} interp={} color={}",
+            "G{} R{} W{} F{} I{} P{} M{} comp={} interp={} color={} depth={} handshake={}",
             self.grad_bits,
             self.red_bits,
             self.recip_bits,
@@ -309,7 +333,9 @@ impl Config {
             self.map_bits,
             self.compensation as u8,
             self.interpolation as u8,
-            self.color as u8
+            self.color as u8,
+            self.pipeline_depth,
+            self.handshake as u8
         )
     }
 }

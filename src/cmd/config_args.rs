@@ -41,6 +41,14 @@ pub struct ConfigArgs {
     /// Add the 8-bit RGB colour multiplier.
     #[arg(long)]
     pub color: bool,
+    /// Pipeline registers: 0 compact (lowest latency), 1 and 2 add registers for clock rate
+    /// [0..=2, default 0].
+    #[arg(long, value_name = "N")]
+    pub pipeline_depth: Option<u32>,
+    /// Valid/ready handshake on the top (backpressure stalls the pipeline) instead of a
+    /// plain valid stream.
+    #[arg(long)]
+    pub handshake: bool,
 }
 
 impl ConfigArgs {
@@ -52,7 +60,15 @@ impl ConfigArgs {
         macro_rules! set {
             ($($f:ident),*) => { $( if let Some(v) = self.$f { c.$f = v; } )* };
         }
-        set!(grad_bits, red_bits, recip_bits, frac_bits, index_bits, map_bits);
+        set!(
+            grad_bits,
+            red_bits,
+            recip_bits,
+            frac_bits,
+            index_bits,
+            map_bits,
+            pipeline_depth
+        );
         if self.no_compensation {
             c.compensation = false;
         }
@@ -65,6 +81,9 @@ impl ConfigArgs {
         }
         if self.color {
             c.color = true;
+        }
+        if self.handshake {
+            c.handshake = true;
         }
         c.validate()?;
         Ok(c)

@@ -22,6 +22,10 @@ pub struct RenderArgs {
     /// Scale the gradients down by 2^K, to exercise the leading-zero shift [0..=grad-bits - 1].
     #[arg(long, value_name = "K", default_value_t = 0)]
     pub shrink: u32,
+    /// Also shade every pixel with the generated RTL (Verilated top) and write rtl.png; fails
+    /// unless the RTL image equals the model image pixel for pixel.
+    #[arg(long)]
+    pub rtl: bool,
     /// Output directory for reference.png, model.png, error50.png and metrics.json (replaced
     /// whole on success).
     #[arg(long, value_name = "DIR")]
@@ -40,7 +44,13 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     };
     options.validate(&cfg)?;
     let out = StagedDir::new(&a.out)?;
-    let r = render::render(&cfg, &scene, options, None)?;
+    let rtl = if a.rtl { Some(crate::rtl::verilated::VerilatedTop::build(&cfg, &scene)?) } else { None };
+    let r = render::render(&cfg, &scene, options, rtl.as_ref().map(|t| t as &dyn render::IntensitySource))?;
+    if let Some(n) = r.rtl_mismatches() {
+        if n > 0 {
+            anyhow::bail!("the RTL image differs from the model image in {n} pixels");
+        }
+    }
     r.write(&out)?;
     let p = out.commit()?;
     println!("{} -> {}", r.summary(), p.display());

@@ -76,6 +76,10 @@ pub struct VolumeArgs {
     /// timing.json and print a report.
     #[arg(long)]
     pub timing: bool,
+    /// Also shade every sample with the generated RTL (Verilated top) and write rtl.png; fails
+    /// unless the RTL image equals the model image pixel for pixel.
+    #[arg(long)]
+    pub rtl: bool,
     /// Timed runs per measurement with --timing (the median is reported).
     #[arg(long, value_name = "N", default_value_t = 5)]
     pub repeat: u32,
@@ -303,7 +307,19 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
     let t = Instant::now();
     let p = Prepared::new(&vol, cfg.grad_bits, opts.brick);
     let prepare_ms = t.elapsed().as_secs_f64() * 1e3;
-    let r: VolumeRender = report::render(&p, &cfg, &scene, opts, None)?;
+    let rtl = if a.rtl { Some(crate::rtl::verilated::VerilatedTop::build(&cfg, &scene)?) } else { None };
+    let r: VolumeRender = report::render(
+        &p,
+        &cfg,
+        &scene,
+        opts,
+        rtl.as_ref().map(|t| t as &dyn crate::render::IntensitySource),
+    )?;
+    if let Some(n) = r.rtl_mismatches() {
+        if n > 0 {
+            bail!("the RTL image differs from the model image in {n} pixels");
+        }
+    }
     r.write(&out)?;
     let timing = if a.timing {
         let (mut t, text) = timing(&p, &cfg, &scene, opts, a.repeat)?;

@@ -7,6 +7,7 @@ pub mod banks;
 pub mod manifest;
 pub mod ports;
 pub mod templates;
+pub mod verilated;
 
 use crate::config::Config;
 use crate::hexfile;

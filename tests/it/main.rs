@@ -15,3 +15,4 @@ mod stress;
 mod symmetry;
 mod vectors;
 mod volume;
+mod rtl_in_loop;

@@ -33,6 +33,7 @@ pub fn any_config() -> impl Strategy<Value = Config> {
                 compensation: comp,
                 interpolation: p > 0,
                 color,
+                ..Config::default()
             };
             c.validate().ok().map(|_| c)
         })
