@@ -28,8 +28,10 @@ tools:
 cargo-test:
 	$(CARGO) test
 
+# Only the $$readmemh files of the default design, refreshed in place in $(OUT).
 roms: build
-	$(RMAPGEN) roms --out $(OUT)/roms
+	$(RMAPGEN) roms --out build/roms
+	cp build/roms/*.hex $(OUT)/
 
 # Everything: cargo tests (model, golden rtl_out/, vectors, CLI errors, sampled stress), Verilator
 # lint, Yosys synthesis, and every testbench in Icarus and Verilator plus the 1M-vector harness.

@@ -1,7 +1,6 @@
 //! `rmapgen roms`: the ROM and map contents as `$readmemh` files, nothing else.
 
 use super::config_args::ConfigArgs;
-use crate::hexfile;
 use crate::output::StagedDir;
 use crate::scene::Scene;
 use anyhow::Result;
@@ -33,7 +32,7 @@ pub fn run(a: &RomsArgs) -> Result<()> {
         scene.map_fit = f;
     }
     let out = StagedDir::new(&a.out)?;
-    for (name, text) in hexfile::all(&cfg, &scene) {
+    for (name, text) in crate::rtl::hex_files(&cfg, &scene) {
         out.write_text(&name, &text)?;
     }
     let p = out.commit()?;

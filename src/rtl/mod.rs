@@ -215,6 +215,23 @@ pub fn modules(cfg: &Config) -> Vec<Module> {
     v
 }
 
+/// Every `$readmemh` file of a design: recip_rom.hex, atan_rom.hex (with compensation), the
+/// scene's logical maps map_<axis>.hex, the second map map2_<axis>.hex ([`Scene::alternate`],
+/// which testbenches load through the host port) and the map banks' init files. `generate`
+/// and `roms` both write exactly these.
+pub fn hex_files(cfg: &Config, scene: &Scene) -> Vec<(String, String)> {
+    let mut v = hexfile::all(cfg, scene);
+    let alt = hexfile::scene_maps(cfg, &Scene::alternate());
+    for (axis, name) in ["x", "y", "z"].iter().enumerate() {
+        let what = format!(
+            "second reflectance map (scene two_lights), max axis {name}, address {{s_max, s_u, i_u, s_v, i_v}}"
+        );
+        v.push((format!("map2_{name}.hex"), hexfile::format(cfg, &what, cfg.map_bits, alt.axis(axis as u32))));
+    }
+    v.extend(banks::bank_files(cfg, &hexfile::scene_maps(cfg, scene)));
+    v
+}
+
 /// Writes every module's `.v`, the ROM and map init files, the logical maps of the scene
 /// (`map_<axis>.hex`) and of [`Scene::alternate`] (`map2_<axis>.hex`, which testbenches load
 /// through the host port), and `manifest.json`. Returns the manifest.
@@ -229,21 +246,7 @@ pub fn write_design(cfg: &Config, scene: &Scene, out: &StagedDir) -> Result<Mani
     for m in modules(cfg) {
         write(m.file(), &templates::render(cfg, m)?)?;
     }
-    // recip_rom.hex, atan_rom.hex (with compensation), map_<axis>.hex.
-    for (name, text) in hexfile::all(cfg, scene) {
-        write(name, &text)?;
-    }
-    let alt = hexfile::scene_maps(cfg, &Scene::alternate());
-    for (axis, name) in ["x", "y", "z"].iter().enumerate() {
-        let what = format!(
-            "second reflectance map (scene two_lights), max axis {name}, address {{s_max, s_u, i_u, s_v, i_v}}"
-        );
-        write(
-            format!("map2_{name}.hex"),
-            &hexfile::format(cfg, &what, cfg.map_bits, alt.axis(axis as u32)),
-        )?;
-    }
-    for (name, text) in banks::bank_files(cfg, &hexfile::scene_maps(cfg, scene)) {
+    for (name, text) in hex_files(cfg, scene) {
         write(name, &text)?;
     }
     files.push(manifest::FILE.to_string());
