@@ -21,9 +21,10 @@ run: build
 	$(RMAPGEN) generate --out $(OUT)
 	$(RMAPGEN) render --scene $(SCENE) --out out/sphere
 
-# Installs iverilog, verilator and yosys with apt-get when missing (a fresh machine has none).
+# Installs iverilog, verilator, yosys, nextpnr-ice40 and icestorm with apt-get when missing
+# (a fresh machine has none).
 tools:
-	@scripts/install-tools.sh
+	@WITH_FPGA=1 scripts/install-tools.sh
 
 cargo-test:
 	$(CARGO) test
@@ -35,7 +36,9 @@ roms: build
 
 # Everything: cargo tests (model, golden rtl_out/, vectors, CLI errors, sampled stress), Verilator
 # lint, Yosys synthesis, and every testbench in Icarus and Verilator plus the 1M-vector harness.
-test: tools cargo-test lint synth sim-all
+# Also the handshake design's top testbench under random backpressure (sim-handshake) and
+# the default design placed and routed (fpga-check: block RAMs and the Fmax target, ~20 s).
+test: tools cargo-test lint synth sim-all sim-handshake fpga-check
 	@echo "make test: all checks passed"
 
 # ---- Simulation (tb/run_sims.sh): every testbench of the design generated with $(GEN_FLAGS)
@@ -84,3 +87,47 @@ lint:
 
 synth:
 	YOSYS=$(YOSYS) scripts/synth.sh $(OUT) $(SYNTH_DIR)
+
+# ---- Flow control: the default configuration with the valid/ready handshake (--handshake)
+# into $(HS_OUT); its top testbench on $(SIM_TB_STREAM) vectors under random backpressure in
+# Icarus and Verilator, and the C++ harness on $(SIM_STREAM) vectors with backpressure.
+HS_OUT ?= build/rtl_handshake
+
+.PHONY: sim-handshake
+
+sim-handshake: build
+	$(RMAPGEN) generate --out $(HS_OUT) --handshake $(GEN_FLAGS)
+	$(SIM_ENV) tb/run_sims.sh --icarus --verilator --only rmap_top --stream $(SIM_STREAM) --tb-stream $(SIM_TB_STREAM) $(HS_OUT)
+
+# ---- FPGA (src/rtl/fpga.rs): Yosys synth_ice40 and nextpnr-ice40 on $(OUT): post-route Fmax,
+# logic cells, block RAMs, critical path; fails if a ROM or map bank is not in block RAM (a
+# missed timing target is only reported). fpga-check also fails below $(FPGA_FREQ) MHz.
+# Installs yosys, nextpnr-ice40 and fpga-icestorm when missing. Logs in $(FPGA_DIR).
+FPGA_DEVICE  ?= hx8k
+FPGA_PACKAGE ?= ct256
+FPGA_FREQ    ?= 125
+FPGA_SEED    ?= 1
+FPGA_DIR     ?= build/fpga
+FPGA_ARGS     = --dir $(OUT) --device $(FPGA_DEVICE) --package $(FPGA_PACKAGE) --freq $(FPGA_FREQ) --seed $(FPGA_SEED) --logs $(FPGA_DIR)
+
+.PHONY: fpga fpga-check
+
+fpga: build
+	@WITH_FPGA=1 scripts/install-tools.sh
+	YOSYS=$(YOSYS) $(RMAPGEN) fpga $(FPGA_ARGS)
+
+fpga-check: build
+	@WITH_FPGA=1 scripts/install-tools.sh
+	YOSYS=$(YOSYS) $(RMAPGEN) fpga $(FPGA_ARGS) --require-timing
+
+# ---- Waves: the top testbench of $(SIM_OUT) under Icarus with +vcd=, for GTKWave.
+WAVE ?= build/wave/rmap_top.vcd
+
+.PHONY: wave
+
+wave: sim-gen
+	@mkdir -p $(dir $(WAVE)) build/wave
+	$(IVERILOG) -g2005 -Wall -Wno-timescale -s rmap_top_tb -o build/wave/rmap_top_tb.vvp $(SIM_OUT)/tb/rmap_top_tb.v $(filter-out $(SIM_OUT)/tb/%,$(wildcard $(SIM_OUT)/*.v))
+	cd $(SIM_OUT) && $(VVP) -N $(abspath build/wave/rmap_top_tb.vvp) +vcd=$(abspath $(WAVE)) > $(abspath build/wave/run.log)
+	@tail -n 1 build/wave/run.log
+	@echo "wave: $(WAVE) (gtkwave $(WAVE))"

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs the simulators and synthesis tools from Debian's packages when any is missing.
+# Installs the simulators and synthesis tools from Debian's packages when any is missing;
+# WITH_FPGA=1 also nextpnr-ice40 and fpga-icestorm (place and route, make fpga).
 # Fails loudly (exit 1) when it cannot: the tests must never skip a simulator silently.
 set -euo pipefail
 need=()
@@ -24,7 +25,12 @@ fi
 $SUDO apt-get update -qq || { echo "install-tools: apt-get update failed" >&2; exit 1; }
 DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${need[@]}" >/dev/null \
   || { echo "install-tools: apt-get install ${need[*]} failed" >&2; exit 1; }
-for t in iverilog vvp verilator yosys; do
+check=(iverilog vvp verilator yosys)
+[ "${WITH_FPGA:-0}" = 1 ] && check+=(nextpnr-ice40 icepack)
+for t in "${check[@]}"; do
   command -v "$t" >/dev/null 2>&1 || { echo "install-tools: $t still missing after install" >&2; exit 1; }
 done
 echo "install-tools: $(iverilog -V 2>&1 | head -1); $(verilator --version); $(yosys -V)"
+if [ "${WITH_FPGA:-0}" = 1 ]; then
+  echo "install-tools: $(nextpnr-ice40 --version 2>&1 | head -1)"
+fi

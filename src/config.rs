@@ -31,10 +31,10 @@ pub struct Config {
     /// Multiply an 8-bit RGB sample colour by the intensity.
     pub color: bool,
     /// Where the RTL's pipeline registers sit, trading latency for clock rate (the model's
-    /// results do not depend on it): 0 compact (fewest registers, lowest latency), 1 adds
-    /// registers after every memory read and between the adder levels of the multipliers,
-    /// 2 registers every adder level (highest Fmax). Range [`PIPELINE_DEPTHS`];
-    /// `rtl::latency` gives each stage's latency for it.
+    /// results do not depend on it): 0 compact (fewest registers, lowest latency), 1 adds a
+    /// register after every memory read and after every second adder level of the
+    /// multipliers, 2 (the default) registers every adder level. Range [`PIPELINE_DEPTHS`];
+    /// `rtl::pipe` places the registers and `rtl::latency` counts them.
     pub pipeline_depth: u32,
     /// A valid/ready handshake (AXI-Stream style) on the top: `ready_o` tells the source a
     /// sample is accepted, `ready_i` low stalls the whole pipeline. Off: a plain valid
@@ -93,7 +93,8 @@ impl Default for Config {
             compensation: true,
             interpolation: true,
             color: false,
-            pipeline_depth: 0,
+            // Not the paper's: the depth that meets 125 MHz on an iCE40 HX8K.
+            pipeline_depth: 2,
             handshake: false,
         }
     }
@@ -243,25 +244,13 @@ impl Config {
     pub fn recip_addr_bits(&self) -> u32 {
         self.red_bits - 1
     }
-    /// Width of a * recip plus the rounding constant in normalise (never overflows).
-    pub fn norm_sum_bits(&self) -> u32 {
-        self.red_bits + self.recip_bits + 1
-    }
     /// Normalise's rounding constant, half an LSB of the fraction: 2^(norm_shift - 1).
     pub fn norm_half(&self) -> u64 {
         1 << (self.norm_shift() - 1)
     }
-    /// Normalise multiplies a * recip as two registered halves of a: the low half's width.
-    pub fn norm_split_bits(&self) -> u32 {
-        self.red_bits / 2
-    }
     /// Entries of the compensation (atan) ROM: one per fraction code.
     pub fn atan_entries(&self) -> u32 {
         1 << self.frac_bits
-    }
-    /// Width of u * pos_max plus the rounding constant in the linear index.
-    pub fn linear_sum_bits(&self) -> u32 {
-        self.frac_bits + self.pos_bits()
     }
     /// The linear index's rounding constant, half a fraction LSB scaled: 2^(frac_bits - 1).
     pub fn frac_half(&self) -> u64 {
@@ -271,17 +260,9 @@ impl Config {
     pub fn base_max(&self) -> u32 {
         self.entries() - 2
     }
-    /// Width of the interpolator's first pass a = e * step + (e' - e) * w, 0..=map_max * step.
-    pub fn interp_a_bits(&self) -> u32 {
-        self.map_bits + self.interp_bits
-    }
     /// Width of the second pass r (before rounding), 0..=map_max * step^2, plus half.
     pub fn interp_r_bits(&self) -> u32 {
         self.map_bits + 2 * self.interp_bits
-    }
-    /// The interpolator's rounding constant, step^2 / 2 (needs interp_bits >= 1).
-    pub fn interp_half(&self) -> u64 {
-        1 << (2 * self.interp_bits - 1)
     }
     /// Map RAM banks: four (by the parities of i_u and i_v) with interpolation, else one.
     pub fn bank_count(&self) -> u32 {

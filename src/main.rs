@@ -34,6 +34,20 @@ enum Command {
     /// Measure error against run time and hardware cost over configurations, scenes and map
     /// fits; write a Markdown table, a CSV and plots.
     Bench(cmd::bench::BenchArgs),
+    /// Place and route the design for an iCE40 (Yosys synth_ice40, nextpnr-ice40): post-route
+    /// Fmax, logic cells, block RAMs, the critical path; fails if a ROM or map bank is not in
+    /// block RAM.
+    Fpga(cmd::fpga::FpgaArgs),
+    /// Choose the cheapest configuration whose error on the scene's sphere test image meets a
+    /// target, and write its design as `generate` does.
+    ///
+    /// Searched: red-bits, frac-bits, recip-bits, index-bits, interp-bits (0 = no
+    /// interpolation) and compensation on/off, over every valid combination of their ranges;
+    /// fixed: grad-bits and map-bits (the interface; the target is in LSBs of the map-bits
+    /// output), colour multiply (on exactly when the scene has a `color`). Candidates are
+    /// measured in order of cost until the first meets the target, so every cheaper one is
+    /// measured and rejected. Exit 2 with the lowest error reachable when none does.
+    Fit(cmd::fit::FitArgs),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -44,6 +58,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Vectors(a) => cmd::vectors::run(&a),
         Command::Stress(a) => cmd::stress::run(&a),
         Command::Bench(a) => cmd::bench::run(&a),
+        Command::Fpga(a) => cmd::fpga::run(&a),
+        Command::Fit(a) => cmd::fit::run(&a),
         Command::Volume(a) => cmd::volume::run(&a),
     }
 }

@@ -25,6 +25,12 @@ pub struct Scene {
     /// directions, `model::map_fit`). A top-level key; commands' `--map-fit` overrides it.
     #[serde(default)]
     pub map_fit: crate::model::map_fit::MapFit,
+    /// The surface colour every sample carries, `[r, g, b]` in 0..=1 (a top-level key, sent to
+    /// the design as 8-bit RGB, [`Scene::color8`]). A scene with a colour needs the colour
+    /// multiplier (`rmapgen fit` includes it, and its test image checks the three channels);
+    /// without one the design delivers the intensity only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub color: Option<[f64; 3]>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -158,19 +164,40 @@ impl Scene {
         if let Some(t) = &self.transfer {
             t.validate()?;
         }
+        if let Some(c) = self.color {
+            if c.iter().any(|x| !(0.0..=1.0).contains(x)) {
+                anyhow::bail!("color {c:?} must have three components in 0..=1");
+            }
+        }
         Ok(())
     }
 
+    /// The scene's colour as the 8-bit RGB the colour multiplier takes (round half up), or
+    /// `None` for a scene without colour.
+    pub fn color8(&self) -> Option<[u32; 3]> {
+        let max = ((1u32 << crate::config::COLOR_BITS) - 1) as f64;
+        self.color
+            .map(|c| c.map(|x| (x * max + 0.5).floor() as u32))
+    }
+
     /// A scene prepared for fast evaluation: unit vectors, and the lights and terms that
-    /// contribute nothing dropped.
+    /// contribute nothing dropped: lights of intensity 0, every light when the material has
+    /// neither diffuse nor specular, the specular term when its coefficient is 0 (see
+    /// [`PreparedScene::shade`]); lights with the same direction become one light of their
+    /// summed intensity (the light model is linear in a light's intensity).
     pub fn prepared(&self) -> PreparedScene {
         let m = &self.material;
-        let lights = self
-            .lights
-            .iter()
-            .filter(|l| l.intensity > 0.0 && (m.diffuse > 0.0 || m.specular > 0.0))
-            .map(|l| (sym_normalize(DVec3::from_array(l.direction)), l.intensity))
-            .collect();
+        let mut lights: Vec<(DVec3, f64)> = Vec::new();
+        for l in &self.lights {
+            if l.intensity <= 0.0 || (m.diffuse <= 0.0 && m.specular <= 0.0) {
+                continue;
+            }
+            let d = sym_normalize(DVec3::from_array(l.direction));
+            match lights.iter_mut().find(|(e, _)| *e == d) {
+                Some((_, i)) => *i += l.intensity,
+                None => lights.push((d, l.intensity)),
+            }
+        }
         PreparedScene {
             view: sym_normalize(DVec3::from_array(self.view.direction)),
             two_sided: self.view.two_sided,
@@ -180,6 +207,44 @@ impl Scene {
             shininess: m.shininess,
             lights,
         }
+    }
+
+    /// What building the maps evaluates, and what it leaves out, in one line: for `fit` and
+    /// the tests.
+    pub fn terms(&self) -> String {
+        let p = self.prepared();
+        let mut used = Vec::new();
+        if p.ambient > 0.0 {
+            used.push("ambient".to_string());
+        }
+        if !p.lights.is_empty() {
+            if p.diffuse > 0.0 {
+                used.push("diffuse".to_string());
+            }
+            if p.specular > 0.0 {
+                used.push(format!("specular (shininess {})", p.shininess));
+            }
+        }
+        let skipped = self.lights.len() - p.lights.len();
+        let mut s = format!(
+            "{} of {} light(s), terms: {}",
+            p.lights.len(),
+            self.lights.len(),
+            if used.is_empty() {
+                "none".to_string()
+            } else {
+                used.join(" + ")
+            }
+        );
+        if skipped > 0 {
+            s.push_str(&format!(
+                "; {skipped} light(s) skipped (intensity 0, no diffuse or specular, or merged with a light of the same direction)"
+            ));
+        }
+        if p.specular <= 0.0 && self.material.specular <= 0.0 && !p.lights.is_empty() {
+            s.push_str("; no specular term");
+        }
+        s
     }
 
     /// The light model at a unit normal (not clamped; map building and the reference clamp).
@@ -270,5 +335,77 @@ mod tests {
         assert!(
             Scene::from_toml_str(&format!("{mat}[transfer]\npoint=[[10,0],[20,1]]\n")).is_err()
         );
+    }
+    #[test]
+    fn prepared_drops_and_merges_what_contributes_nothing() {
+        let mat = "[material]\nambient=0.1\ndiffuse=0.6\nspecular=0.3\nshininess=20\n";
+        let full = Scene::from_toml_str(&format!(
+            "{mat}[[light]]\ndirection=[1,1,2]\nintensity=0.25\n\
+             [[light]]\ndirection=[-1,0,1]\nintensity=0\n\
+             [[light]]\ndirection=[2,2,4]\nintensity=0.5\n"
+        ))
+        .unwrap();
+        let one = Scene::from_toml_str(&format!(
+            "{mat}[[light]]\ndirection=[1,1,2]\nintensity=0.75\n"
+        ))
+        .unwrap();
+        let p = full.prepared();
+        assert_eq!(p.lights.len(), 1, "{:?}", p.lights);
+        assert_eq!(p.lights[0].1, 0.75);
+        // The same light model as the full sum, and the same one as the one-light scene.
+        let mut rng = crate::vectors::rng::SplitMix64::new(3);
+        for _ in 0..500 {
+            let mut c = || rng.below(2001) as f64 / 1000.0 - 1.0;
+            let n = DVec3::new(c(), c(), c());
+            if n.length() < 1e-3 {
+                continue;
+            }
+            let n = sym_normalize(n);
+            let by_light: f64 = 0.1
+                + full
+                    .lights
+                    .iter()
+                    .map(|l| {
+                        let ls = sym_normalize(DVec3::from_array(l.direction));
+                        let nl = sym_dot(n, ls);
+                        if nl <= 0.0 {
+                            return 0.0;
+                        }
+                        let rv = sym_dot(2.0 * nl * n - ls, DVec3::Z);
+                        l.intensity * (0.6 * nl + 0.3 * rv.max(0.0).powf(20.0))
+                    })
+                    .sum::<f64>();
+            assert!((p.shade(n) - by_light).abs() < 1e-12);
+            assert_eq!(p.shade(n), one.prepared().shade(n));
+        }
+        let t = full.terms();
+        assert!(
+            t.starts_with("1 of 3 light(s), terms: ambient + diffuse + specular")
+                && t.contains("2 light(s) skipped"),
+            "{t}"
+        );
+        let diffuse = Scene::from_toml_str(
+            "[material]\nambient=0.1\ndiffuse=0.9\nspecular=0\nshininess=1\n[[light]]\ndirection=[1,1,2]\n",
+        )
+        .unwrap();
+        assert_eq!(
+            diffuse.terms(),
+            "1 of 1 light(s), terms: ambient + diffuse; no specular term"
+        );
+        let dark = Scene::from_toml_str(
+            "[material]\nambient=0.2\ndiffuse=0\nspecular=0\nshininess=1\n[[light]]\ndirection=[1,1,2]\n",
+        )
+        .unwrap();
+        assert!(dark.prepared().lights.is_empty());
+    }
+
+    #[test]
+    fn colour_is_optional_and_checked() {
+        let mat = "[material]\nambient=0.1\ndiffuse=0.6\nspecular=0.3\nshininess=20\n";
+        assert_eq!(Scene::standard().color8(), None);
+        let s = Scene::from_toml_str(&format!("color = [1.0, 0.5, 0.0]\n{mat}")).unwrap();
+        assert_eq!(s.color8(), Some([255, 128, 0]));
+        let e = Scene::from_toml_str(&format!("color = [1.5, 0.5, 0.0]\n{mat}")).unwrap_err();
+        assert!(e.to_string().contains("0..=1"), "{e}");
     }
 }

@@ -55,6 +55,11 @@ pub struct TbData {
     pub timeout: u32,
     pub seed: u32,
     pub has_en: bool,
+    /// The top with valid/ready flow control: ready_i random, acceptance by ready_o.
+    pub handshake: bool,
+    /// `{zero_o, i_o, ...}`: every checked output, and its width (the hold check).
+    pub outs_concat: String,
+    pub outs_bits: u32,
     pub inputs: Vec<Sig>,
     pub outputs: Vec<Sig>,
     pub ports: Vec<Sig>,
@@ -181,6 +186,10 @@ pub fn data(cfg: &Config, stage: Stage) -> Result<TbData> {
         bail!("{} has no valid_o port", stage.name());
     }
     let has_en = inputs.iter().any(|s| s.name == "en_i");
+    let handshake = inputs.iter().any(|s| s.name == "ready_i");
+    if handshake && !outputs.iter().any(|s| s.name == "ready_o") {
+        bail!("{} has ready_i but no ready_o", stage.name());
+    }
 
     let mut fields = Vec::new();
     for f in stage.fields(cfg) {
@@ -289,6 +298,16 @@ pub fn data(cfg: &Config, stage: Stage) -> Result<TbData> {
         timeout: 1000 + 8 * latency,
         seed: 1,
         has_en,
+        handshake,
+        outs_concat: format!(
+            "{{{}}}",
+            out_fields
+                .iter()
+                .map(|f| f.port.clone())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+        outs_bits: out_fields.iter().map(|f| f.bits).sum(),
         scan_format: join(fields.iter().map(|_| "%h".to_string()).collect(), " "),
         scan_args: join(fields.iter().map(|f| format!("s_{}", f.name)).collect(), ", "),
         in_format: fmt_of(&in_all),
@@ -341,7 +360,8 @@ pub fn harness_header(cfg: &Config) -> String {
          #define RMAP_MAP_ADDR_BITS {}\n\
          #define RMAP_COLOR {}\n\
          #define RMAP_LATENCY {}\n\
-         #define RMAP_NFIELDS {}\n",
+         #define RMAP_NFIELDS {}\n\
+         #define RMAP_HANDSHAKE {}\n",
         env!("CARGO_PKG_VERSION"),
         cfg.summary(),
         fields.iter().map(|f| f.name).collect::<Vec<_>>().join(" "),
@@ -351,6 +371,7 @@ pub fn harness_header(cfg: &Config) -> String {
         cfg.color as u32,
         rtl::top_latency(cfg),
         fields.len(),
+        cfg.handshake as u32,
     )
 }
 

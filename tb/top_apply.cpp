@@ -55,10 +55,8 @@ int main(int argc, char** argv) {
     top->valid_i = 0;
     top->swap_i = 0;
     top->wr_en_i = 0;
-#ifdef RMAP_HANDSHAKE
 #if RMAP_HANDSHAKE
     top->ready_i = 1;
-#endif
 #endif
     top->eval();
     tick();
@@ -79,7 +77,12 @@ int main(int argc, char** argv) {
             ++nout;
         }
         top->valid_i = 0;
-        if (nin < count) {
+#if RMAP_HANDSHAKE
+        const bool can_accept = top->ready_o;  // ready_i stays high: results leave at once
+#else
+        const bool can_accept = true;
+#endif
+        if (nin < count && can_accept) {
             const uint32_t* v = &s[6 * nin];
             top->valid_i = 1;
             top->gx_i = v[0];

@@ -11,8 +11,13 @@
 // one): fields `map gx gy gz [r g b] zero i [r_o g_o b_o]`. While the map-0 vectors stream,
 // the harness writes map2_<axis>.hex through the host port into the back buffer, one word
 // per clock; the first map-1 vector waits for the load and is presented with swap_i high.
-// Every output must appear in order, exactly RMAP_LATENCY clocks after its input. Prints the
-// throughput, then `N passed, M failed` as the last line; exits 1 on any failure.
+// Every output must appear in order, exactly RMAP_LATENCY clocks after its input. With the
+// valid/ready handshake (RMAP_HANDSHAKE) the harness applies random backpressure (ready_i low
+// one clock in four, and one clock in 256 a stall of up to 63 clocks), presents a sample only
+// when ready_o is high, and takes a result with valid_o && ready_i; a result may then come
+// later than RMAP_LATENCY clocks, never earlier, and exactly then when no backpressure came
+// after its input. Prints the throughput, then `N passed, M failed` as the last line; exits 1
+// on any failure.
 #include "Vrmap_top.h"
 #include "rmap_top_config.h"
 #include "verilated.h"
@@ -177,6 +182,18 @@ int main(int argc, char** argv) {
     top->valid_i = 0;
     top->swap_i = 0;
     top->wr_en_i = 0;
+#if RMAP_HANDSHAKE
+    top->ready_i = 1;
+    uint64_t rng = 0x9E3779B97F4A7C15ull;
+    auto rnd = [&] {
+        rng ^= rng << 13;
+        rng ^= rng >> 7;
+        rng ^= rng << 17;
+        return rng;
+    };
+    int stall_left = 0;
+    int64_t last_bp = -1;
+#endif
     top->eval();
     auto tick = [&] {
         top->clk_i = 1;
@@ -202,8 +219,25 @@ int main(int argc, char** argv) {
     uint64_t clock = 0, last_progress = 0;
     const auto t0 = std::chrono::steady_clock::now();
     while (nout < n) {
+#if RMAP_HANDSHAKE
+        // Backpressure for the coming edge; a result leaves with valid_o && ready_i.
+        bool ready = true;
+        const uint64_t r = rnd();
+        if (stall_left > 0) {
+            ready = false;
+            --stall_left;
+        } else if (nin >= 64) {
+            ready = (r & 3) != 0;
+            if (((r >> 8) & 255) == 0) stall_left = static_cast<int>((r >> 16) & 63);
+        }
+        if (!ready) last_bp = static_cast<int64_t>(clock);
+        top->ready_i = ready;
+        const bool leaves = top->valid_o && ready;
+#else
+        const bool leaves = top->valid_o;
+#endif
         // Outputs of the state after the last rising edge.
-        if (top->valid_o) {
+        if (leaves) {
             if (nout == nin) {
                 error("valid_o with no sample in flight");
             } else {
@@ -213,7 +247,12 @@ int main(int argc, char** argv) {
                 ok = ok && top->r_o == e.rgb_o[0] && top->g_o == e.rgb_o[1] && top->b_o == e.rgb_o[2];
 #endif
                 const uint64_t lat = clock - accepted[nout];
+#if RMAP_HANDSHAKE
+                ok = ok && lat >= RMAP_LATENCY &&
+                     (last_bp >= static_cast<int64_t>(accepted[nout]) || lat == RMAP_LATENCY);
+#else
                 ok = ok && lat == RMAP_LATENCY;
+#endif
                 if (ok) {
                     ++passed;
                 } else {
@@ -248,7 +287,12 @@ int main(int argc, char** argv) {
         top->valid_i = 0;
         top->swap_i = 0;
         top->wr_en_i = 0;
-        if (nin < n) {
+#if RMAP_HANDSHAKE
+        const bool can_accept = top->ready_o;
+#else
+        const bool can_accept = true;
+#endif
+        if (nin < n && can_accept) {
             const Vector& v = vecs[nin];
             if (!(v.map == 1 && !swapped && nwr < kWrites)) {
                 if (v.map == 1 && !swapped) {
@@ -290,6 +334,9 @@ int main(int argc, char** argv) {
     top->valid_i = 0;
     top->wr_en_i = 0;
     top->swap_i = 0;
+#if RMAP_HANDSHAKE
+    top->ready_i = 1;
+#endif
     for (int k = 0; k < RMAP_LATENCY + 4; ++k) {
         tick();
         if (top->valid_o) error("valid_o after the last sample");

@@ -5,7 +5,8 @@
 // position, so that equal position steps are equal steps in angle: entry u holds
 // round(atan(u / 2^F) / (pi/4) * POS_MAX), the all-ones code standing for tan = 1
 // (contents: rmapgen's model, atan_rom::contents). u and v each read their own copy of the
-// table, so each is a single-port synchronous ROM that maps to its own block RAM. Latency 1.
+// table, so each is a single-port synchronous ROM that maps to its own block RAM.{% if out_reg %} A fabric
+// register follows the block RAM's output register (pipeline_depth >= 1).{% endif %} Latency {= latency =}.
 module atan_rom #(
   parameter INIT_FILE = "{= init_file =}"  // $readmemh file, one POS-bit entry per line
 ) (
@@ -14,24 +15,19 @@ module atan_rom #(
 
   localparam POS     = {= pos =};  // position width, index and interpolation bits
   localparam ENTRIES = {= entries =};  // 2^F, one per fraction code
+  localparam LATENCY = {= latency =};
 
+  // ram_style: block RAM even where Yosys would build a small table from LUTs.
+  (* ram_style = "block" *)
   reg [POS-1:0] rom_u [0:ENTRIES-1];
+  (* ram_style = "block" *)
   reg [POS-1:0] rom_v [0:ENTRIES-1];
   initial begin
     $readmemh(INIT_FILE, rom_u);
     $readmemh(INIT_FILE, rom_v);
   end
 
-  reg           valid_q;
   reg [POS-1:0] pu_q, pv_q;
-
-  always @(posedge clk_i or negedge rst_ni) begin
-    if (!rst_ni) begin
-      valid_q <= 1'b0;
-    end else if (en_i) begin
-      valid_q <= valid_i;
-    end
-  end
 
   always @(posedge clk_i) begin
     if (en_i) begin
@@ -45,9 +41,25 @@ module atan_rom #(
     end
   end
 
-  assign valid_o = valid_q;
+{%- if out_reg %}
+
+  reg [POS-1:0] pu_q2, pv_q2;
+
+  always @(posedge clk_i) begin
+    if (en_i) begin
+      pu_q2 <= pu_q;
+      pv_q2 <= pv_q;
+    end
+  end
+{%- endif %}
+{%- include "valid_line.v" %}
+{%- if out_reg %}
+  assign pu_o    = pu_q2;
+  assign pv_o    = pv_q2;
+{%- else %}
   assign pu_o    = pu_q;
   assign pv_o    = pv_q;
+{%- endif %}
 
 endmodule
 

@@ -3,50 +3,46 @@
 
 // Linear index, in place of the atan ROM when distortion compensation is off: the position
 // is the fraction scaled to 0..POS_MAX, p = (u * POS_MAX + 2^(F-1)) >> F (half up), and the
-// all-ones code (tan = 1) goes to the border exactly: p = POS_MAX. Latency 1.
+// all-ones code (tan = 1) goes to the border exactly: it is read as u' = 2^F, which gives
+// p = POS_MAX. The constant POS_MAX = (2^I - 1) * 2^P makes u' * POS_MAX a sum of I shifted
+// copies of u', an adder tree registered as pipeline_depth = {= depth =} places it
+// (rmapgen::rtl::pipe). Latency {= latency =}.
 module linear_index (
 {= h.ports =}
 );
 
   localparam F   = {= f =};  // fraction width
   localparam POS = {= pos =};  // position width
-  localparam LW  = {= lw =};  // u * POS_MAX + HALF
-  localparam [POS-1:0] POS_MAX = {= pos =}'d{= pos_max =};  // (2^I - 1) * 2^P, the border
-  localparam [LW-1:0]  HALF    = {= lw =}'d{= half =};  // 2^(F-1)
+  localparam LW  = {= lw =};  // u' * POS_MAX + HALF, 0..2^F * POS_MAX + HALF
+  localparam LATENCY = {= latency =};
 
-  wire [LW-1:0] u_x, v_x, scale;
-  assign u_x   = {{POS{1'b0}}, u_i};
-  assign v_x   = {{POS{1'b0}}, v_i};
-  assign scale = {{F{1'b0}}, POS_MAX};
+  // ---------------------------------------------------------------- u' and v'
+  wire [F:0] ux_d, vx_d;
+  assign ux_d = (u_i == {F{1'b1}}) ? {1'b1, {F{1'b0}}} : {1'b0, u_i};
+  assign vx_d = (v_i == {F{1'b1}}) ? {1'b1, {F{1'b0}}} : {1'b0, v_i};
+{%- if pre_reg %}
 
-  wire [LW-1:0] su, sv;
-  assign su = u_x * scale + HALF;
-  assign sv = v_x * scale + HALF;
-
-  wire unused_round;
-  assign unused_round = ^{su[F-1:0], sv[F-1:0]};
-
-  reg           valid_q;
-  reg [POS-1:0] pu_q, pv_q;
-
-  always @(posedge clk_i or negedge rst_ni) begin
-    if (!rst_ni) begin
-      valid_q <= 1'b0;
-    end else if (en_i) begin
-      valid_q <= valid_i;
-    end
-  end
+  reg [F:0] ux_q1, vx_q1;
 
   always @(posedge clk_i) begin
     if (en_i) begin
-      pu_q <= (u_i == {F{1'b1}}) ? POS_MAX : su[LW-1:F];
-      pv_q <= (v_i == {F{1'b1}}) ? POS_MAX : sv[LW-1:F];
+      ux_q1 <= ux_d;
+      vx_q1 <= vx_d;
     end
   end
+{%- endif %}
+{%- include "steps.v" %}
 
-  assign valid_o = valid_q;
-  assign pu_o    = pu_q;
-  assign pv_o    = pv_q;
+  // ---------------------------------------------------------------- positions
+  wire [LW-1:0] su, sv;
+  assign su = {= sum_u =};
+  assign sv = {= sum_v =};
+
+  wire unused_round;
+  assign unused_round = ^{su[F-1:0], sv[F-1:0]};
+{%- include "valid_line.v" %}
+  assign pu_o    = su[F+POS-1:F];
+  assign pv_o    = sv[F+POS-1:F];
 
 endmodule
 

@@ -16,8 +16,8 @@ module map_bank #(
   localparam ENTRIES = {= entries =};  // 2^BA
 
   // no_rw_check: a same-address read and write never happen (see above), so Yosys need not
-  // add logic to define their result.
-  (* no_rw_check *)
+  // add logic to define their result. ram_style: block RAM at every size.
+  (* no_rw_check, ram_style = "block" *)
   reg [M-1:0] mem [0:ENTRIES-1];
   initial begin
     $readmemh(INIT_FILE, mem);

@@ -8,15 +8,16 @@
 // always sit in four different banks. Bank address {buf, axis, s_max, s_u, i_u >> 1, s_v,
 // i_v >> 1}; the sample's rd_buf picks the buffer. The host writes through wr_* (logical map
 // address, any buffer) independently of en_i.
-// Stage 1 splits and forms the bank addresses; stage 2 reads the banks; stage 3 puts the
-// bank outputs back in neighbour order. Latency 3.
+// Stage 1 splits and forms the bank addresses; stage 2 reads the banks;{% if bank_reg %} stage 3 registers
+// the banks' outputs in the fabric (pipeline_depth >= 1);{% endif %} stage {= out =} puts the bank outputs
+// back in neighbour order. Latency {= latency =}.
 {%- else -%}
 // Map look-up without interpolation: the position is the entry index; read that entry from
 // the map of the max axis. One bank, address {buf, axis, s_max, s_u, i_u, s_v, i_v}; the
 // sample's rd_buf picks the buffer. The host writes through wr_* (logical map address, any
 // buffer) independently of en_i.
-// Stage 1 forms the bank address; stage 2 reads the bank; stage 3 registers the entry.
-// Latency 3.
+// Stage 1 forms the bank address; stage 2 reads the bank;{% if bank_reg %} stage 3 registers the bank's
+// output in the fabric (pipeline_depth >= 1);{% endif %} stage {= out =} registers the entry. Latency {= latency =}.
 {%- endif %}
 module map_lookup (
 {= h.ports =}
@@ -29,6 +30,7 @@ module map_lookup (
 {%- endif %}
   localparam BA = {= ba =};  // bank address width
   localparam M  = {= m =};  // entry width
+  localparam LATENCY = {= latency =};
 {%- if interpolation %}
   localparam [I-1:0]  BASE_MAX = {= i =}'d{= base_max =};  // 2^I - 2: the outer entry is never a base
   localparam [IH-1:0] HI_ONE   = {= ih =}'d1;
@@ -57,18 +59,9 @@ module map_lookup (
   assign even_u = base_u[0] ? odd_u + HI_ONE : odd_u;
   assign even_v = base_v[0] ? odd_v + HI_ONE : odd_v;
 
-  reg          valid_q1;
   reg [BA-1:0] addr00_q1, addr10_q1, addr01_q1, addr11_q1;  // bank <u parity><v parity>
   reg          odd_u_q1, odd_v_q1;  // base parities, to put the banks back in order
   reg [P:0]    wu_q1, wv_q1;
-
-  always @(posedge clk_i or negedge rst_ni) begin
-    if (!rst_ni) begin
-      valid_q1 <= 1'b0;
-    end else if (en_i) begin
-      valid_q1 <= valid_i;
-    end
-  end
 
   always @(posedge clk_i) begin
     if (en_i) begin
@@ -106,17 +99,8 @@ module map_lookup (
     .rd_data_o (d{= b.name =}_q2)
   );
 {% endfor %}
-  reg       valid_q2;
   reg       odd_u_q2, odd_v_q2;
   reg [P:0] wu_q2, wv_q2;
-
-  always @(posedge clk_i or negedge rst_ni) begin
-    if (!rst_ni) begin
-      valid_q2 <= 1'b0;
-    end else if (en_i) begin
-      valid_q2 <= valid_q1;
-    end
-  end
 
   always @(posedge clk_i) begin
     if (en_i) begin
@@ -126,71 +110,73 @@ module map_lookup (
       wv_q2    <= wv_q1;
     end
   end
+{%- if bank_reg %}
 
   // ---------------------------------------------------------------- stage 3
+  // The block RAMs' clock-to-output is slow; the neighbour reorder starts from a register.
+  reg [M-1:0] d00_q3, d10_q3, d01_q3, d11_q3;
+  reg         odd_u_q3, odd_v_q3;
+  reg [P:0]   wu_q3, wv_q3;
+
+  always @(posedge clk_i) begin
+    if (en_i) begin
+      d00_q3   <= d00_q2;
+      d10_q3   <= d10_q2;
+      d01_q3   <= d01_q2;
+      d11_q3   <= d11_q2;
+      odd_u_q3 <= odd_u_q2;
+      odd_v_q3 <= odd_v_q2;
+      wu_q3    <= wu_q2;
+      wv_q3    <= wv_q2;
+    end
+  end
+{%- endif %}
+
+  // ---------------------------------------------------------------- stage {= out =}
   // The base entry is in the bank of the base's parities, its u neighbour in the bank of the
   // other u parity, and so on.
   reg [M-1:0] e00_d, e10_d, e01_d, e11_d;
   always @* begin
-    case ({odd_u_q2, odd_v_q2})
+    case ({odd_u_{= rd =}, odd_v_{= rd =}})
       2'b00: begin
-        e00_d = d00_q2;  e10_d = d10_q2;  e01_d = d01_q2;  e11_d = d11_q2;
+        e00_d = d00_{= rd =};  e10_d = d10_{= rd =};  e01_d = d01_{= rd =};  e11_d = d11_{= rd =};
       end
       2'b10: begin
-        e00_d = d10_q2;  e10_d = d00_q2;  e01_d = d11_q2;  e11_d = d01_q2;
+        e00_d = d10_{= rd =};  e10_d = d00_{= rd =};  e01_d = d11_{= rd =};  e11_d = d01_{= rd =};
       end
       2'b01: begin
-        e00_d = d01_q2;  e10_d = d11_q2;  e01_d = d00_q2;  e11_d = d10_q2;
+        e00_d = d01_{= rd =};  e10_d = d11_{= rd =};  e01_d = d00_{= rd =};  e11_d = d10_{= rd =};
       end
       default: begin
-        e00_d = d11_q2;  e10_d = d01_q2;  e01_d = d10_q2;  e11_d = d00_q2;
+        e00_d = d11_{= rd =};  e10_d = d01_{= rd =};  e01_d = d10_{= rd =};  e11_d = d00_{= rd =};
       end
     endcase
   end
 
-  reg         valid_q3;
-  reg [M-1:0] e00_q3, e10_q3, e01_q3, e11_q3;
-  reg [P:0]   wu_q3, wv_q3;
-
-  always @(posedge clk_i or negedge rst_ni) begin
-    if (!rst_ni) begin
-      valid_q3 <= 1'b0;
-    end else if (en_i) begin
-      valid_q3 <= valid_q2;
-    end
-  end
+  reg [M-1:0] e00_{= out_q =}, e10_{= out_q =}, e01_{= out_q =}, e11_{= out_q =};
+  reg [P:0]   wu_{= out_q =}, wv_{= out_q =};
 
   always @(posedge clk_i) begin
     if (en_i) begin
-      e00_q3 <= e00_d;
-      e10_q3 <= e10_d;
-      e01_q3 <= e01_d;
-      e11_q3 <= e11_d;
-      wu_q3  <= wu_q2;
-      wv_q3  <= wv_q2;
+      e00_{= out_q =} <= e00_d;
+      e10_{= out_q =} <= e10_d;
+      e01_{= out_q =} <= e01_d;
+      e11_{= out_q =} <= e11_d;
+      wu_{= out_q =}  <= wu_{= rd =};
+      wv_{= out_q =}  <= wv_{= rd =};
     end
   end
-
-  assign valid_o = valid_q3;
-  assign e00_o   = e00_q3;
-  assign e10_o   = e10_q3;
-  assign e01_o   = e01_q3;
-  assign e11_o   = e11_q3;
-  assign wu_o    = wu_q3;
-  assign wv_o    = wv_q3;
+{%- include "valid_line.v" %}
+  assign e00_o   = e00_{= out_q =};
+  assign e10_o   = e10_{= out_q =};
+  assign e01_o   = e01_{= out_q =};
+  assign e11_o   = e11_{= out_q =};
+  assign wu_o    = wu_{= out_q =};
+  assign wv_o    = wv_{= out_q =};
 {%- else %}
 
   // ---------------------------------------------------------------- stage 1
-  reg          valid_q1;
   reg [BA-1:0] addr_q1;
-
-  always @(posedge clk_i or negedge rst_ni) begin
-    if (!rst_ni) begin
-      valid_q1 <= 1'b0;
-    end else if (en_i) begin
-      valid_q1 <= valid_i;
-    end
-  end
 
   always @(posedge clk_i) begin
     if (en_i) begin
@@ -213,36 +199,30 @@ module map_lookup (
     .rd_data_o (d_q2)
   );
 {% endfor %}
-  reg valid_q2;
 
-  always @(posedge clk_i or negedge rst_ni) begin
-    if (!rst_ni) begin
-      valid_q2 <= 1'b0;
-    end else if (en_i) begin
-      valid_q2 <= valid_q1;
-    end
-  end
+{%- if bank_reg %}
 
   // ---------------------------------------------------------------- stage 3
-  reg         valid_q3;
-  reg [M-1:0] e00_q3;
-
-  always @(posedge clk_i or negedge rst_ni) begin
-    if (!rst_ni) begin
-      valid_q3 <= 1'b0;
-    end else if (en_i) begin
-      valid_q3 <= valid_q2;
-    end
-  end
+  // The block RAM's clock-to-output is slow: a fabric register follows it.
+  reg [M-1:0] d_q3;
 
   always @(posedge clk_i) begin
     if (en_i) begin
-      e00_q3 <= d_q2;
+      d_q3 <= d_q2;
     end
   end
+{%- endif %}
 
-  assign valid_o = valid_q3;
-  assign e00_o   = e00_q3;
+  // ---------------------------------------------------------------- stage {= out =}
+  reg [M-1:0] e00_{= out_q =};
+
+  always @(posedge clk_i) begin
+    if (en_i) begin
+      e00_{= out_q =} <= d_{= rd =};
+    end
+  end
+{%- include "valid_line.v" %}
+  assign e00_o   = e00_{= out_q =};
 {%- endif %}
 
 endmodule

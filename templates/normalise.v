@@ -2,11 +2,13 @@
 `default_nettype none
 
 // Normalise: u = a / m and v = b / m as F-bit fractions, computed as a * (1/m) with the
-// reciprocal ROM and two multipliers, rounded half up:
+// reciprocal ROM, rounded half up:
 //   u = min(2^F-1, (a*recip + 2^(SH-1)) >> SH).
 // A component equal to the max saturates to all ones, which the index stages read as exactly
-// 1. Stage 1 reads the ROM and compares; stage 2 multiplies by the two halves of a; stage 3
-// adds the halves, rounds and saturates. Latency 3.
+// 1. The first clock reads the ROM and compares;{% if rom_reg %} the next registers the ROM's output;{% endif %} then
+// a * recip + HALF is an adder tree of the partial products (a[j] ? recip << j : 0), one LUT
+// level and one carry chain per level, registered as pipeline_depth = {= depth =} places them
+// (rmapgen::rtl::pipe); the last clock rounds and saturates. Latency {= latency =}.
 module normalise (
 {= h.ports =}
 );
@@ -16,11 +18,10 @@ module normalise (
   localparam F  = {= f =};  // fraction width
   localparam RA = {= ra =};  // reciprocal ROM address width
   localparam SH = {= sh =};  // a * recip >> SH is an F-bit fraction: R-1+W-F
-  localparam PW = {= pw =};  // a * recip + HALF, never overflows
-  localparam AL = {= al =};  // low part of a in the two-part multiply
-  localparam [PW-1:0] HALF = {= pw =}'d{= half =};  // 2^(SH-1), rounds half up
+  localparam SW = {= sw =};  // a * recip + HALF (the adder tree's result)
+  localparam LATENCY = {= latency =};
 
-  // ---------------------------------------------------------------- stage 1
+  // ---------------------------------------------------------------- ROM read and compare
   wire [W-1:0] recip_q1;  // registered inside the ROM
   recip_rom u_recip_rom (
     .clk_i  (clk_i),
@@ -29,17 +30,8 @@ module normalise (
     .data_o (recip_q1)
   );
 
-  reg         valid_q1;
   reg [R-1:0] a_q1, b_q1;
   reg         a_max_q1, b_max_q1;
-
-  always @(posedge clk_i or negedge rst_ni) begin
-    if (!rst_ni) begin
-      valid_q1 <= 1'b0;
-    end else if (en_i) begin
-      valid_q1 <= valid_i;
-    end
-  end
 
   always @(posedge clk_i) begin
     if (en_i) begin
@@ -49,75 +41,50 @@ module normalise (
       b_max_q1 <= (b_i == m_i);
     end
   end
+{%- if rom_reg %}
 
-  // ---------------------------------------------------------------- stage 2
-  // a * recip in two halves of a, so that each half's adder tree fits in a clock; stage 3
-  // adds them with the rounding constant.
-  wire [PW-1:0] a_lo_x, a_hi_x, recip_x;
-  assign a_lo_x  = {{(PW-AL){1'b0}}, a_q1[AL-1:0]};
-  assign a_hi_x  = {{(PW-R+AL){1'b0}}, a_q1[R-1:AL]};
-  assign recip_x = {{(PW-W){1'b0}}, recip_q1};
-  wire [PW-1:0] b_lo_x, b_hi_x;
-  assign b_lo_x  = {{(PW-AL){1'b0}}, b_q1[AL-1:0]};
-  assign b_hi_x  = {{(PW-R+AL){1'b0}}, b_q1[R-1:AL]};
-
-  reg          valid_q2;
-  reg [PW-1:0] pa_lo_q2, pa_hi_q2, pb_lo_q2, pb_hi_q2;
-  reg          a_max_q2, b_max_q2;
-
-  always @(posedge clk_i or negedge rst_ni) begin
-    if (!rst_ni) begin
-      valid_q2 <= 1'b0;
-    end else if (en_i) begin
-      valid_q2 <= valid_q1;
-    end
-  end
+  // ---------------------------------------------------------------- ROM output register
+  // The block RAM's clock-to-output is slow; the multipliers start from a fabric register.
+  reg [W-1:0] recip_q2;
+  reg [R-1:0] a_q2, b_q2;
+  reg         a_max_q2, b_max_q2;
 
   always @(posedge clk_i) begin
     if (en_i) begin
-      pa_lo_q2 <= a_lo_x * recip_x;
-      pa_hi_q2 <= a_hi_x * recip_x;
-      pb_lo_q2 <= b_lo_x * recip_x;
-      pb_hi_q2 <= b_hi_x * recip_x;
+      recip_q2 <= recip_q1;
+      a_q2     <= a_q1;
+      b_q2     <= b_q1;
       a_max_q2 <= a_max_q1;
       b_max_q2 <= b_max_q1;
     end
   end
+{%- endif %}
+{%- include "steps.v" %}
 
-  // ---------------------------------------------------------------- stage 3
-  wire [PW-1:0] sa, sb;
-  assign sa = pa_lo_q2 + (pa_hi_q2 << AL) + HALF;
-  assign sb = pb_lo_q2 + (pb_hi_q2 << AL) + HALF;
+  // ---------------------------------------------------------------- round and saturate
+  wire [SW-1:0] sa, sb;
+  assign sa = {= sum_a =};
+  assign sb = {= sum_b =};
 
   // Anything at or above 2^F after the shift saturates.
   wire sat_a, sat_b;
-  assign sat_a = a_max_q2 || (|sa[PW-1:SH+F]);
-  assign sat_b = b_max_q2 || (|sb[PW-1:SH+F]);
+  assign sat_a = {= a_max =} || (|sa[SW-1:SH+F]);
+  assign sat_b = {= b_max =} || (|sb[SW-1:SH+F]);
 
   wire unused_round;
   assign unused_round = ^{sa[SH-1:0], sb[SH-1:0]};
 
-  reg         valid_q3;
-  reg [F-1:0] u_q3, v_q3;
-
-  always @(posedge clk_i or negedge rst_ni) begin
-    if (!rst_ni) begin
-      valid_q3 <= 1'b0;
-    end else if (en_i) begin
-      valid_q3 <= valid_q2;
-    end
-  end
+  reg [F-1:0] u_q, v_q;
 
   always @(posedge clk_i) begin
     if (en_i) begin
-      u_q3 <= sat_a ? {F{1'b1}} : sa[SH+F-1:SH];
-      v_q3 <= sat_b ? {F{1'b1}} : sb[SH+F-1:SH];
+      u_q <= sat_a ? {F{1'b1}} : sa[SH+F-1:SH];
+      v_q <= sat_b ? {F{1'b1}} : sb[SH+F-1:SH];
     end
   end
-
-  assign valid_o = valid_q3;
-  assign u_o     = u_q3;
-  assign v_o     = v_q3;
+{%- include "valid_line.v" %}
+  assign u_o     = u_q;
+  assign v_o     = v_q;
 
 endmodule
 

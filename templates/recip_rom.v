@@ -14,6 +14,9 @@ module recip_rom #(
   localparam W       = {= w =};  // entry width
   localparam ENTRIES = {= entries =};  // 2^(R-1)
 
+  // ram_style: block RAM even where Yosys would build a small table from LUTs, so that every
+  // configuration has its ROM where rmapgen fpga checks for it.
+  (* ram_style = "block" *)
   reg [W-1:0] rom [0:ENTRIES-1];
   initial begin
     $readmemh(INIT_FILE, rom);

@@ -6,9 +6,18 @@
 // pipe_delay lines carry the sideband (signs, axis, buffer{% if color %}, colour{% endif %}, zero flag) beside the
 // stages, and one output register applies the zero flag.
 // Stage latencies: {= latency_list =}, output register 1: total {= total =}.
+{%- if handshake %}
+// Flow control (valid/ready, AXI-Stream style): a sample is accepted at a rising edge with
+// valid_i && ready_o, a result leaves with valid_o && ready_i. The results wait in a
+// two-entry queue (the output register and a skid register); the whole pipeline advances
+// (every stage's en_i) while the skid register is free, so ready_i low stalls it without
+// losing or repeating a sample. The enable and ready_o are registers: ready_i reaches no
+// clock enable and no output combinationally. valid_o and the outputs hold while ready_i
+// is low. Latency {= total =} enabled clocks (clocks with ready_o high), plus any wait in the queue.
+{%- endif %}
 // Map buffers: a sample accepted in the cycle of swap_i or later reads the new front buffer;
 // host writes go to the back buffer. After a swap, let the samples accepted before it leave
-// (LATENCY clocks) before writing into the old front buffer.
+// ({% if handshake %}the last of them leaves with valid_o && ready_i{% else %}LATENCY clocks{% endif %}) before writing into the old front buffer.
 module rmap_top (
 {= h.ports =}
 );
@@ -33,9 +42,14 @@ module rmap_top (
   localparam I_DELAY    = {= i_delay =};  // intensity beside color_mul
 {%- endif %}
 
+{%- if handshake %}
+  // Every stage's clock enable: a register (see the flow control below).
+  wire en;
+{%- else %}
   // The plain valid stream never stalls: every stage's clock enable is tied high.
   wire en;
   assign en = 1'b1;
+{%- endif %}
 
   // ---------------------------------------------------------------- map buffers
   reg  front_q;
@@ -276,6 +290,77 @@ module rmap_top (
     .q_o   (out_zero)
   );
 
+{%- if handshake %}
+  // ---------------------------------------------------------------- flow control
+  // A two-entry queue: head (the output registers) and skid. A result enters when the
+  // pipeline delivers one (out_valid at an enabled edge); the head leaves with valid_o &&
+  // ready_i. The pipeline may advance while the skid entry is free after this edge, so en_q
+  // is the next skid state, inverted, registered: the queue can always take what the
+  // pipeline delivers at the next enabled edge.
+  wire         push, pop, take;
+  wire         zero_in;
+  wire [M-1:0] i_in;
+  assign push    = en && out_valid;
+  assign pop     = valid_q && ready_i;
+  assign take    = !valid_q || pop;  // the head is free at this edge
+  assign zero_in = out_zero;
+  assign i_in    = out_zero ? {M{1'b0}} : out_i;
+{%- if color %}
+  wire [C-1:0] r_in, g_in, b_in;
+  assign r_in = out_zero ? {C{1'b0}} : out_r;
+  assign g_in = out_zero ? {C{1'b0}} : out_g;
+  assign b_in = out_zero ? {C{1'b0}} : out_b;
+{%- endif %}
+
+  reg         valid_q, skid_valid_q, en_q;
+  reg         zero_q, skid_zero_q;
+  reg [M-1:0] i_q, skid_i_q;
+{%- if color %}
+  reg [C-1:0] r_q, g_q, b_q, skid_r_q, skid_g_q, skid_b_q;
+{%- endif %}
+  wire        skid_valid_d;
+  assign skid_valid_d = take ? (skid_valid_q && push) : (skid_valid_q || push);
+
+  always @(posedge clk_i or negedge rst_ni) begin
+    if (!rst_ni) begin
+      valid_q      <= 1'b0;
+      skid_valid_q <= 1'b0;
+      en_q         <= 1'b0;  // ready_o low in reset, high from the first clock after it
+    end else begin
+      if (take) begin
+        valid_q <= skid_valid_q || push;
+      end
+      skid_valid_q <= skid_valid_d;
+      en_q         <= !skid_valid_d;
+    end
+  end
+
+  always @(posedge clk_i) begin
+    if (take) begin
+      // The head takes the skid entry if there is one, else the new result.
+      zero_q <= skid_valid_q ? skid_zero_q : zero_in;
+      i_q    <= skid_valid_q ? skid_i_q : i_in;
+{%- if color %}
+      r_q    <= skid_valid_q ? skid_r_q : r_in;
+      g_q    <= skid_valid_q ? skid_g_q : g_in;
+      b_q    <= skid_valid_q ? skid_b_q : b_in;
+{%- endif %}
+    end
+    if (push && (skid_valid_q || !take)) begin
+      // The new result waits behind the head.
+      skid_zero_q <= zero_in;
+      skid_i_q    <= i_in;
+{%- if color %}
+      skid_r_q    <= r_in;
+      skid_g_q    <= g_in;
+      skid_b_q    <= b_in;
+{%- endif %}
+    end
+  end
+
+  assign en      = en_q;
+  assign ready_o = en_q;
+{%- else %}
   reg         valid_q;
   reg         zero_q;
   reg [M-1:0] i_q;
@@ -300,6 +385,7 @@ module rmap_top (
     b_q    <= out_zero ? {C{1'b0}} : out_b;
 {%- endif %}
   end
+{%- endif %}
 
   assign valid_o = valid_q;
   assign zero_o  = zero_q;

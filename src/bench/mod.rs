@@ -4,8 +4,9 @@
 //! Per row: the sphere test image's error against the float reference (max abs, RMSE, PSNR,
 //! via `render`); the fast bit-exact path's throughput on one thread and on all cores over 2^20
 //! uniform random gradients, and the float reference's on the same gradients (all cores, the
-//! ratio); the host's map build per frame (median); the ROM and map bits and, with Yosys
-//! installed, the cell count of generic synthesis (`synth`) of the generated design. A row is
+//! ratio); the host's map build per frame (median); the ROM and map bits and, with Yosys and
+//! nextpnr-ice40 installed, the generated design placed and routed on an iCE40 HX8K
+//! (`rtl::fpga::ice40_report`: logic cells, block RAMs, post-route Fmax). A row is
 //! on a scene's Pareto front when no other row of that scene is at least as good in both error
 //! (RMSE) and cost (bits), or in both error and one-thread speed.
 
@@ -19,6 +20,7 @@ use crate::model::Model;
 use crate::output::StagedDir;
 use crate::reference::Reference;
 use crate::render::{self, metrics, sphere_gradients};
+use crate::rtl::fpga::{self, FpgaReport};
 use crate::scene::Scene;
 use crate::vectors::rng::SplitMix64;
 use anyhow::{Context, Result};
@@ -34,7 +36,7 @@ pub struct Options {
     pub size: u32,
     /// Seconds spent timing each throughput figure.
     pub seconds: f64,
-    /// Synthesise each configuration with Yosys when it is installed.
+    /// Place and route each configuration (Yosys, nextpnr-ice40) when they are installed.
     pub yosys: bool,
     /// Only the paper's configuration (and the octahedral map).
     pub quick: bool,
@@ -70,7 +72,10 @@ pub struct Row {
     pub map_build_us: f64,
     pub rom_bits: u64,
     pub map_bits: u64,
-    pub yosys_cells: Option<u64>,
+    /// iCE40 HX8K after place and route: logic cells, block RAMs, Fmax (with the tools).
+    pub ice40_cells: Option<u32>,
+    pub ice40_brams: Option<u32>,
+    pub fmax_mhz: Option<f64>,
     pub pareto_cost: bool,
     pub pareto_speed: bool,
 }
@@ -193,42 +198,21 @@ fn uniform(n: usize) -> Vec<[i32; 3]> {
         .collect()
 }
 
-/// Cells of generic Yosys synthesis of the configuration's design, when yosys runs.
-pub fn yosys_cells(cfg: &Config, scene: &Scene) -> Result<Option<u64>> {
-    if std::process::Command::new("yosys")
-        .arg("-V")
-        .output()
-        .is_err()
-    {
-        return Ok(None);
+/// The iCE40 figures of each configuration (in parallel, one flow per core), or None for all
+/// when Yosys or nextpnr-ice40 is missing.
+pub fn ice40_figures(configs: &[Config]) -> Result<Vec<Option<FpgaReport>>> {
+    let opts = fpga::Options::default();
+    if !fpga::tools_available(&opts) {
+        return Ok(vec![None; configs.len()]);
     }
-    let dir = std::env::temp_dir().join(format!("rmapgen-bench-{}", std::process::id()));
-    let out = StagedDir::new(&dir)?;
-    crate::rtl::write_design(cfg, scene, &out)?;
-    let run = std::process::Command::new("yosys")
-        .current_dir(out.path())
-        .args([
-            "-q",
-            "-p",
-            "read_verilog *.v; synth -top rmap_top; tee -o cells.txt stat",
-        ])
-        .output()
-        .context("cannot run yosys")?;
-    anyhow::ensure!(
-        run.status.success(),
-        "yosys failed on {}: {}",
-        cfg.summary(),
-        String::from_utf8_lossy(&run.stderr)
-    );
-    let stat = std::fs::read_to_string(out.path().join("cells.txt"))?;
-    let cells = stat
-        .lines()
-        .rev()
-        .filter_map(|l| l.trim().strip_prefix("Number of cells:"))
-        .next()
-        .and_then(|n| n.trim().parse().ok());
-    drop(out);
-    Ok(cells)
+    configs
+        .par_iter()
+        .map(|c| {
+            fpga::ice40_report(c, &opts)
+                .map(Some)
+                .with_context(|| format!("iCE40 flow of {}", c.summary()))
+        })
+        .collect()
 }
 
 /// Measures every row; `progress` is called once per finished step with a description.
@@ -258,7 +242,14 @@ pub fn run(opts: &Options, progress: &dyn Fn(&str)) -> Result<Vec<Row>> {
         reference_values.push(r.intensities(&sphere));
         progress(&format!("reference {name}"));
     }
-    for (design, cfg) in configurations(opts.quick) {
+    let configs = configurations(opts.quick);
+    let figures = if opts.yosys {
+        let cs: Vec<Config> = configs.iter().map(|c| c.1.clone()).collect();
+        ice40_figures(&cs)?
+    } else {
+        vec![None; configs.len()]
+    };
+    for ((design, cfg), fig) in configs.into_iter().zip(figures) {
         let model = Model::new(&cfg);
         let fast = FastShader::new(
             &model,
@@ -267,11 +258,6 @@ pub fn run(opts: &Options, progress: &dyn Fn(&str)) -> Result<Vec<Row>> {
         let one = grads.len() as f64 / time(opts.seconds, || fast.shade_batch(&grads, &mut out16));
         let all =
             grads.len() as f64 / time(opts.seconds, || fast.shade_batch_par(&grads, &mut out16));
-        let cells = if opts.yosys {
-            yosys_cells(&cfg, &Scene::standard())?
-        } else {
-            None
-        };
         progress(&format!("{design}: speed and synthesis"));
         let lsq = LsqFit::new(&cfg);
         for (k, (name, scene)) in scenes.iter().enumerate() {
@@ -311,7 +297,9 @@ pub fn run(opts: &Options, progress: &dyn Fn(&str)) -> Result<Vec<Row>> {
                     map_build_us: build * 1e6,
                     rom_bits: cfg.rom_total_bits(),
                     map_bits: cfg.map_total_bits(),
-                    yosys_cells: cells,
+                    ice40_cells: fig.as_ref().map(|f| f.logic_cells),
+                    ice40_brams: fig.as_ref().map(|f| f.block_rams),
+                    fmax_mhz: fig.as_ref().map(|f| f.fmax_mhz),
                     pareto_cost: false,
                     pareto_speed: false,
                 });
@@ -360,7 +348,9 @@ pub fn run(opts: &Options, progress: &dyn Fn(&str)) -> Result<Vec<Row>> {
             map_build_us: build * 1e6,
             rom_bits: 0,
             map_bits: (side * side) as u64 * d.map_bits as u64,
-            yosys_cells: None,
+            ice40_cells: None,
+            ice40_brams: None,
+            fmax_mhz: None,
             pareto_cost: false,
             pareto_speed: false,
         });
@@ -396,8 +386,8 @@ pub fn mark_pareto(rows: &mut [Row]) {
 /// The rows as a Markdown table.
 pub fn markdown(rows: &[Row]) -> String {
     let mut s = String::from(
-        "| scene | design | map | entries | max abs (LSB) | RMSE (LSB) | PSNR (dB) | 1 thread (M/s) | all cores (M/s) | x float | map build (us) | ROM + map bits | Yosys cells | Pareto |\n\
-         |---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n",
+        "| scene | design | map | entries | max abs (LSB) | RMSE (LSB) | PSNR (dB) | 1 thread (M/s) | all cores (M/s) | x float | map build (us) | ROM + map bits | iCE40 cells | block RAMs | Fmax (MHz) | Pareto |\n\
+         |---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n",
     );
     for r in rows {
         let pareto = match (r.pareto_cost, r.pareto_speed) {
@@ -407,7 +397,7 @@ pub fn markdown(rows: &[Row]) -> String {
             _ => "",
         };
         s += &format!(
-            "| {} | {} | {} | {} | {} | {:.3} | {:.2} | {:.0} | {:.0} | {:.1} | {:.0} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {:.3} | {:.2} | {:.0} | {:.0} | {:.1} | {:.0} | {} | {} | {} | {} | {} |\n",
             r.scene,
             r.design,
             r.map_fit,
@@ -420,7 +410,9 @@ pub fn markdown(rows: &[Row]) -> String {
             r.float_ratio,
             r.map_build_us,
             r.bits(),
-            r.yosys_cells.map_or("-".into(), |c| c.to_string()),
+            r.ice40_cells.map_or("-".into(), |c| c.to_string()),
+            r.ice40_brams.map_or("-".into(), |c| c.to_string()),
+            r.fmax_mhz.map_or("-".into(), |f| format!("{f:.1}")),
             pareto
         );
     }
@@ -429,10 +421,10 @@ pub fn markdown(rows: &[Row]) -> String {
 
 /// The rows as CSV with a header line.
 pub fn csv(rows: &[Row]) -> String {
-    let mut s = String::from("scene,design,config,map_fit,entries,max_abs_error,rmse,psnr_db,msamples_1_thread,msamples_all_cores,float_ratio,map_build_us,rom_bits,map_bits,yosys_cells,pareto_cost,pareto_speed\n");
+    let mut s = String::from("scene,design,config,map_fit,entries,max_abs_error,rmse,psnr_db,msamples_1_thread,msamples_all_cores,float_ratio,map_build_us,rom_bits,map_bits,ice40_cells,ice40_brams,fmax_mhz,pareto_cost,pareto_speed\n");
     for r in rows {
         s += &format!(
-            "{},{},\"{}\",{},{},{},{:.4},{:.3},{:.2},{:.2},{:.2},{:.1},{},{},{},{},{}\n",
+            "{},{},\"{}\",{},{},{},{:.4},{:.3},{:.2},{:.2},{:.2},{:.1},{},{},{},{},{},{},{}\n",
             r.scene,
             r.design,
             r.config,
@@ -447,7 +439,9 @@ pub fn csv(rows: &[Row]) -> String {
             r.map_build_us,
             r.rom_bits,
             r.map_bits,
-            r.yosys_cells.map_or(String::new(), |c| c.to_string()),
+            r.ice40_cells.map_or(String::new(), |c| c.to_string()),
+            r.ice40_brams.map_or(String::new(), |c| c.to_string()),
+            r.fmax_mhz.map_or(String::new(), |f| format!("{f:.2}")),
             r.pareto_cost,
             r.pareto_speed
         );

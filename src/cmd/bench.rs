@@ -19,7 +19,7 @@ pub struct BenchArgs {
     /// Seconds spent timing each throughput figure.
     #[arg(long, value_name = "S", default_value_t = 0.3)]
     pub seconds: f64,
-    /// Skip Yosys synthesis even when yosys is installed.
+    /// Skip the iCE40 place and route (Yosys, nextpnr-ice40) even when they are installed.
     #[arg(long)]
     pub no_yosys: bool,
     /// Only the paper's configuration (and the octahedral map).

@@ -42,7 +42,7 @@ pub struct ConfigArgs {
     #[arg(long)]
     pub color: bool,
     /// Pipeline registers: 0 compact (lowest latency), 1 and 2 add registers for clock rate
-    /// [0..=2, default 0].
+    /// [0..=2, default 2].
     #[arg(long, value_name = "N")]
     pub pipeline_depth: Option<u32>,
     /// Valid/ready handshake on the top (backpressure stalls the pipeline) instead of a

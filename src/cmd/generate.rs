@@ -3,13 +3,15 @@
 //! whole or not at all.
 
 use super::config_args::ConfigArgs;
+use crate::config::Config;
 use crate::output::StagedDir;
+use crate::rtl::Manifest;
 use crate::scene::Scene;
 use crate::vectors::MapSet;
 use crate::{rtl, tb, vectors};
 use anyhow::Result;
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
 pub struct GenerateArgs {
@@ -35,14 +37,7 @@ pub fn run(a: &GenerateArgs) -> Result<()> {
         Some(p) => Scene::from_toml_file(p)?,
         None => Scene::standard(),
     };
-    let out = StagedDir::new(&a.out)?;
-    let manifest = rtl::write_design(&cfg, &scene, &out)?;
-    // The vectors see the same maps as the design: this scene's, and the alternate scene's
-    // that testbenches load through the host port.
-    let maps = MapSet::from_scenes(&cfg, &scene, &Scene::alternate());
-    vectors::write_all_with_maps(&cfg, &out, a.vectors, a.seed, &maps)?;
-    tb::write_all(&cfg, &out)?;
-    let p = out.commit()?;
+    let (p, manifest) = write_dir(&cfg, &scene, &a.out, a.vectors, a.seed, &[])?;
     eprintln!(
         "rmapgen: wrote {} ({} modules, latency {}, {} memory bits) to {}",
         cfg.summary(),
@@ -52,4 +47,29 @@ pub fn run(a: &GenerateArgs) -> Result<()> {
         p.display()
     );
     Ok(())
+}
+
+/// Everything `generate` writes for one validated configuration and scene, into `out`
+/// (replaced whole on success, untouched on failure), plus `extra` files (relative name,
+/// text) beside them. `rmapgen fit` writes its chosen design through this too. Returns the
+/// directory and the manifest.
+pub fn write_dir(
+    cfg: &Config,
+    scene: &Scene,
+    out: &Path,
+    vectors: usize,
+    seed: u64,
+    extra: &[(String, String)],
+) -> Result<(PathBuf, Manifest)> {
+    let out = StagedDir::new(out)?;
+    let manifest = rtl::write_design(cfg, scene, &out)?;
+    // The vectors see the same maps as the design: this scene's, and the alternate scene's
+    // that testbenches load through the host port.
+    let maps = MapSet::from_scenes(cfg, scene, &Scene::alternate());
+    vectors::write_all_with_maps(cfg, &out, vectors, seed, &maps)?;
+    tb::write_all(cfg, &out)?;
+    for (name, text) in extra {
+        out.write_text(name, text)?;
+    }
+    Ok((out.commit()?, manifest))
 }

@@ -2,6 +2,8 @@
 
 pub mod bench;
 pub mod config_args;
+pub mod fit;
+pub mod fpga;
 pub mod generate;
 pub mod render;
 pub mod roms;

@@ -44,8 +44,17 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     };
     options.validate(&cfg)?;
     let out = StagedDir::new(&a.out)?;
-    let rtl = if a.rtl { Some(crate::rtl::verilated::VerilatedTop::build(&cfg, &scene)?) } else { None };
-    let r = render::render(&cfg, &scene, options, rtl.as_ref().map(|t| t as &dyn render::IntensitySource))?;
+    let rtl = if a.rtl {
+        Some(crate::rtl::verilated::VerilatedTop::build(&cfg, &scene)?)
+    } else {
+        None
+    };
+    let r = render::render(
+        &cfg,
+        &scene,
+        options,
+        rtl.as_ref().map(|t| t as &dyn render::IntensitySource),
+    )?;
     if let Some(n) = r.rtl_mismatches() {
         if n > 0 {
             anyhow::bail!("the RTL image differs from the model image in {n} pixels");

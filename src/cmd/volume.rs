@@ -307,13 +307,18 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
     let t = Instant::now();
     let p = Prepared::new(&vol, cfg.grad_bits, opts.brick);
     let prepare_ms = t.elapsed().as_secs_f64() * 1e3;
-    let rtl = if a.rtl { Some(crate::rtl::verilated::VerilatedTop::build(&cfg, &scene)?) } else { None };
+    let rtl = if a.rtl {
+        Some(crate::rtl::verilated::VerilatedTop::build(&cfg, &scene)?)
+    } else {
+        None
+    };
     let r: VolumeRender = report::render(
         &p,
         &cfg,
         &scene,
         opts,
-        rtl.as_ref().map(|t| t as &dyn crate::render::IntensitySource),
+        rtl.as_ref()
+            .map(|t| t as &dyn crate::render::IntensitySource),
     )?;
     if let Some(n) = r.rtl_mismatches() {
         if n > 0 {

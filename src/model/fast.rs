@@ -123,14 +123,14 @@ pub fn intensity_at(
 }
 
 impl Positions {
-    fn new(model: &Model) -> Positions {
+    fn new(model: &Model, limit: usize) -> Positions {
         let cfg = &model.cfg;
         let lane = |m: u32, a: u32| {
             let recip = model.recip[recip_rom::addr(cfg, m) as usize];
             model.position(normalise::lane(cfg, a, m, recip))
         };
         let r = cfg.red_bits;
-        if 1usize << (2 * r - 1) <= FUSED_POSITIONS_MAX {
+        if 1usize << (2 * r - 1) <= limit.min(FUSED_POSITIONS_MAX) {
             let half = 1u32 << (r - 1);
             // Entry ((m - half) << r) | a; unreachable entries (a > m) are filled too.
             let table = Table::build(1 << (2 * r - 1), cfg.pos_bits(), |k| {
@@ -149,10 +149,10 @@ impl Positions {
 }
 
 impl Intensities {
-    fn new(cfg: &Config, maps: &Maps) -> Intensities {
+    fn new(cfg: &Config, maps: &Maps, limit: usize) -> Intensities {
         let stride = cfg.pos_max() + 1;
         let per_face = (stride * stride) as usize;
-        if 24 * per_face > FUSED_INTENSITIES_MAX {
+        if 24 * per_face > limit.min(FUSED_INTENSITIES_MAX) {
             return Intensities::Direct { maps: maps.clone() };
         }
         // One block per (axis, s_max, s_u, s_v), in that order, each p_u-major.
@@ -187,16 +187,23 @@ impl Intensities {
 impl FastShader {
     /// Fuses the model's ROMs (once per configuration) and the maps (once per frame).
     pub fn new(model: &Model, maps: &Maps) -> FastShader {
+        FastShader::for_samples(model, maps, usize::MAX)
+    }
+
+    /// [`FastShader::new`] for a one-off batch of about `samples` gradients: a stage is fused
+    /// only when its table has at most `samples` entries, so building the tables never costs
+    /// more than the batch (`rmapgen fit` shades one image per configuration).
+    pub fn for_samples(model: &Model, maps: &Maps, samples: usize) -> FastShader {
         FastShader {
             cfg: model.cfg.clone(),
-            positions: Positions::new(model),
-            intensities: Intensities::new(&model.cfg, maps),
+            positions: Positions::new(model, samples),
+            intensities: Intensities::new(&model.cfg, maps, samples),
         }
     }
 
     /// Replaces the maps (a new frame), keeping the configuration's position table.
     pub fn set_maps(&mut self, maps: &Maps) {
-        self.intensities = Intensities::new(&self.cfg, maps);
+        self.intensities = Intensities::new(&self.cfg, maps, usize::MAX);
     }
 
     pub fn config(&self) -> &Config {

@@ -154,6 +154,6 @@ mod tests {
             m.memory_bits,
             cfg.rom_total_bits() + 1536 + cfg.bank_total_bits()
         );
-        assert_eq!(m.latency, 12);
+        assert_eq!(m.latency, 24);
     }
 }

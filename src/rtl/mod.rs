@@ -4,8 +4,12 @@
 //! them (the templates, the manifest, the testbenches) reads them from here.
 
 pub mod banks;
+pub mod fpga;
 pub mod manifest;
+pub mod package;
+pub mod pipe;
 pub mod ports;
+pub mod sum;
 pub mod templates;
 pub mod verilated;
 
@@ -95,19 +99,20 @@ pub const OUTPUT_LATENCY: u32 = 1;
 
 /// Clock cycles from a module's inputs to its registered outputs (valid_i to valid_o for a
 /// stage, address to data for a ROM or bank); `None` for `pipe_delay`, whose latency is its
-/// DEPTH parameter. This is the one place latencies are defined.
+/// DEPTH parameter. This is the one place latencies are defined; they follow
+/// `pipeline_depth` through the register plans of [`pipe`].
 pub fn latency(cfg: &Config, m: Module) -> Option<u32> {
     Some(match m {
         Module::ZeroDetect => 1,
-        Module::SortShift => 2,
+        Module::SortShift => pipe::sort_shift_latency(cfg),
         Module::RecipRom => 1,
-        Module::Normalise => 3,
-        Module::AtanRom => 1,
-        Module::LinearIndex => 1,
-        Module::MapLookup => 3,
+        Module::Normalise => pipe::normalise(cfg).latency,
+        Module::AtanRom => 1 + pipe::atan_out_reg(cfg) as u32,
+        Module::LinearIndex => pipe::linear_index(cfg).latency,
+        Module::MapLookup => 3 + pipe::bank_out_reg(cfg) as u32,
         Module::MapBank => 1,
-        Module::Interpolate => 2,
-        Module::ColorMul => 2,
+        Module::Interpolate => pipe::interpolate(cfg).latency,
+        Module::ColorMul => pipe::color_mul(cfg).latency,
         Module::PipeDelay => return None,
         Module::RmapTop => return Some(top_latency(cfg)),
     })
@@ -226,7 +231,10 @@ pub fn hex_files(cfg: &Config, scene: &Scene) -> Vec<(String, String)> {
         let what = format!(
             "second reflectance map (scene two_lights), max axis {name}, address {{s_max, s_u, i_u, s_v, i_v}}"
         );
-        v.push((format!("map2_{name}.hex"), hexfile::format(cfg, &what, cfg.map_bits, alt.axis(axis as u32))));
+        v.push((
+            format!("map2_{name}.hex"),
+            hexfile::format(cfg, &what, cfg.map_bits, alt.axis(axis as u32)),
+        ));
     }
     v.extend(banks::bank_files(cfg, &hexfile::scene_maps(cfg, scene)));
     v
@@ -234,7 +242,8 @@ pub fn hex_files(cfg: &Config, scene: &Scene) -> Vec<(String, String)> {
 
 /// Writes every module's `.v`, the ROM and map init files, the logical maps of the scene
 /// (`map_<axis>.hex`) and of [`Scene::alternate`] (`map2_<axis>.hex`, which testbenches load
-/// through the host port), and `manifest.json`. Returns the manifest.
+/// through the host port), the FuseSoC core and README of [`package`], and `manifest.json`.
+/// Returns the manifest.
 pub fn write_design(cfg: &Config, scene: &Scene, out: &StagedDir) -> Result<Manifest> {
     cfg.validate()?;
     let mut files = Vec::new();
@@ -246,9 +255,13 @@ pub fn write_design(cfg: &Config, scene: &Scene, out: &StagedDir) -> Result<Mani
     for m in modules(cfg) {
         write(m.file(), &templates::render(cfg, m)?)?;
     }
+    let mut hex = Vec::new();
     for (name, text) in hex_files(cfg, scene) {
+        hex.push(name.clone());
         write(name, &text)?;
     }
+    write(package::CORE_FILE.into(), &package::core(cfg, &hex)?)?;
+    write(package::README_FILE.into(), &package::readme(cfg)?)?;
     files.push(manifest::FILE.to_string());
     let manifest = Manifest::new(cfg, files);
     out.write_text(manifest::FILE, &manifest.to_json())?;
@@ -259,19 +272,45 @@ pub fn write_design(cfg: &Config, scene: &Scene, out: &StagedDir) -> Result<Mani
 mod tests {
     use super::*;
 
+    fn at_depth(depth: u32, cfg: Config) -> Config {
+        Config {
+            pipeline_depth: depth,
+            ..cfg
+        }
+    }
+
     #[test]
-    fn default_latency_is_the_documented_twelve() {
-        assert_eq!(top_latency(&Config::default()), 12);
-        let d = sideband_delays(&Config::default());
+    fn compact_latency_is_the_documented_twelve() {
+        let cfg = at_depth(0, Config::default());
+        assert_eq!(top_latency(&cfg), 12);
+        let d = sideband_delays(&cfg);
         assert_eq!((d.sign, d.buf, d.zero, d.rgb), (4, 6, 10, None));
     }
 
     #[test]
+    fn default_depth_two_registers_every_adder_level() {
+        let cfg = Config::default();
+        assert_eq!(cfg.pipeline_depth, 2);
+        let stages: Vec<u32> = pipeline(&cfg).iter().map(|&m| lat(&cfg, m)).collect();
+        // sort_shift: magnitude, compare, select, shift; normalise: ROM, ROM register, three
+        // adder levels, saturation; atan ROM and its register; map_lookup with the bank
+        // register; interpolate: complements, three levels per pass.
+        assert_eq!(stages, [4, 6, 2, 4, 7]);
+        assert_eq!(top_latency(&cfg), 24);
+        let d = sideband_delays(&cfg);
+        assert_eq!((d.sign, d.buf, d.zero), (8, 12, 22));
+        assert_eq!(top_latency(&at_depth(1, cfg)), 19);
+    }
+
+    #[test]
     fn colour_adds_its_stage_and_lines_up_the_colour() {
-        let cfg = Config {
-            color: true,
-            ..Config::default()
-        };
+        let cfg = at_depth(
+            0,
+            Config {
+                color: true,
+                ..Config::default()
+            },
+        );
         assert_eq!(top_latency(&cfg), 14);
         let d = sideband_delays(&cfg);
         assert_eq!((d.zero, d.rgb, d.intensity), (12, Some(11), Some(2)));
@@ -279,9 +318,16 @@ mod tests {
             interpolation: false,
             interp_bits: 0,
             compensation: false,
-            ..cfg
+            ..cfg.clone()
         };
         assert_eq!(top_latency(&off), 2 + 3 + 1 + 3 + 2 + 1);
+        // Deeper: the colour waits for the deeper stages, the intensity beside color_mul too.
+        let deep = at_depth(2, cfg);
+        let d = sideband_delays(&deep);
+        let cm = lat(&deep, Module::ColorMul);
+        assert!(cm > 2);
+        assert_eq!(d.intensity, Some(cm));
+        assert_eq!(d.rgb, Some(top_latency(&deep) - OUTPUT_LATENCY - cm));
     }
 
     #[test]

@@ -199,7 +199,11 @@ pub fn ports(cfg: &Config, m: Module) -> Vec<Port> {
             v.push(i(
                 "valid_i",
                 1,
-                "a sample is accepted every cycle valid_i is high",
+                if cfg.handshake {
+                    "a sample is accepted at a rising edge with valid_i && ready_o"
+                } else {
+                    "a sample is accepted every cycle valid_i is high"
+                },
             ));
             v.push(i("gx_i", g, "G-bit two's complement"));
             v.push(i("gy_i", g, ""));
@@ -218,7 +222,27 @@ pub fn ports(cfg: &Config, m: Module) -> Vec<Port> {
                 "{s_max, s_u, i_u, s_v, i_v}",
             ));
             v.push(i("wr_data_i", mb, ""));
-            v.push(o("valid_o", 1, ""));
+            if cfg.handshake {
+                v.push(i(
+                    "ready_i",
+                    1,
+                    "the result leaves at a rising edge with valid_o && ready_i",
+                ));
+                v.push(o(
+                    "ready_o",
+                    1,
+                    "the pipeline accepts a sample (a register; low in reset)",
+                ));
+            }
+            v.push(o(
+                "valid_o",
+                1,
+                if cfg.handshake {
+                    "holds, with the outputs, until ready_i"
+                } else {
+                    ""
+                },
+            ));
             v.push(o("zero_o", 1, "the sample's gradient was zero"));
             v.push(o("i_o", mb, "intensity (0 when zero_o)"));
             if cfg.color {

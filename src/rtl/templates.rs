@@ -2,7 +2,8 @@
 //! written `{= expr =}`). Every number a template prints comes from a `Config` method, the
 //! model's constants or [`super::latency`]; templates only name them.
 
-use super::{banks, latency, ports, Module};
+use super::sum::Step;
+use super::{banks, latency, pipe, ports, Module};
 use crate::config::{Config, COLOR_BITS};
 use crate::model::color_mul;
 use anyhow::{Context, Result};
@@ -63,6 +64,9 @@ struct ZeroDetect {
 #[template(path = "sort_shift.v", syntax = "verilog")]
 struct SortShift {
     h: Head,
+    latency: u32,
+    mag_reg: bool,
+    cmp_reg: bool,
     g: u32,
     r: u32,
     shw: u32,
@@ -85,20 +89,28 @@ struct RecipRom {
 #[template(path = "normalise.v", syntax = "verilog")]
 struct Normalise {
     h: Head,
+    depth: u32,
+    latency: u32,
     r: u32,
     w: u32,
     f: u32,
     ra: u32,
     sh: u32,
-    pw: u32,
-    al: u32,
-    half: u64,
+    sw: u32,
+    rom_reg: bool,
+    steps: Vec<Step>,
+    sum_a: String,
+    sum_b: String,
+    a_max: String,
+    b_max: String,
 }
 
 #[derive(Template)]
 #[template(path = "atan_rom.v", syntax = "verilog")]
 struct AtanRom {
     h: Head,
+    latency: u32,
+    out_reg: bool,
     init_file: &'static str,
     pos: u32,
     entries: u32,
@@ -108,11 +120,15 @@ struct AtanRom {
 #[template(path = "linear_index.v", syntax = "verilog")]
 struct LinearIndex {
     h: Head,
+    depth: u32,
+    latency: u32,
     f: u32,
     pos: u32,
     lw: u32,
-    pos_max: u32,
-    half: u64,
+    pre_reg: bool,
+    steps: Vec<Step>,
+    sum_u: String,
+    sum_v: String,
 }
 
 /// One map bank as map_lookup instantiates it.
@@ -127,6 +143,12 @@ struct BankInst {
 #[template(path = "map_lookup.v", syntax = "verilog")]
 struct MapLookup {
     h: Head,
+    latency: u32,
+    bank_reg: bool,
+    /// Stage number of the reorder (output) stage, and the suffixes of its inputs and outputs.
+    out: u32,
+    rd: &'static str,
+    out_q: &'static str,
     interpolation: bool,
     i: u32,
     p: u32,
@@ -150,24 +172,31 @@ struct MapBank {
 #[template(path = "interpolate.v", syntax = "verilog")]
 struct Interpolate {
     h: Head,
+    depth: u32,
+    latency: u32,
     m: u32,
     p: u32,
-    aw: u32,
+    s: u32,
     rw: u32,
-    half: u64,
+    in_reg: bool,
+    steps: Vec<Step>,
+    sum_r: String,
 }
 
 #[derive(Template)]
 #[template(path = "color_mul.v", syntax = "verilog")]
 struct ColorMul {
     h: Head,
-    m: u32,
-    c: u32,
-    nw: u32,
+    depth: u32,
+    latency: u32,
     s: u32,
     pw: u32,
     d: u32,
     k: u64,
+    steps: Vec<Step>,
+    pr: String,
+    pg: String,
+    pb: String,
 }
 
 #[derive(Template)]
@@ -180,6 +209,7 @@ struct PipeDelay {
 #[template(path = "rmap_top.v", syntax = "verilog")]
 struct RmapTop {
     h: Head,
+    handshake: bool,
     compensation: bool,
     interpolation: bool,
     color: bool,
@@ -211,6 +241,9 @@ pub fn render(cfg: &Config, m: Module) -> Result<String> {
             let g = cfg.grad_bits;
             SortShift {
                 h,
+                latency: latency(cfg, m).expect("fixed"),
+                mag_reg: pipe::sort_shift_mag_reg(cfg),
+                cmp_reg: pipe::sort_shift_cmp_reg(cfg),
                 g,
                 r: cfg.red_bits,
                 shw: cfg.shift_bits(),
@@ -227,34 +260,54 @@ pub fn render(cfg: &Config, m: Module) -> Result<String> {
             entries: cfg.recip_entries(),
         }
         .render(),
-        Module::Normalise => Normalise {
-            h,
-            r: cfg.red_bits,
-            w: cfg.recip_bits,
-            f: cfg.frac_bits,
-            ra: cfg.recip_addr_bits(),
-            sh: cfg.norm_shift(),
-            pw: cfg.norm_sum_bits(),
-            al: cfg.norm_split_bits(),
-            half: cfg.norm_half(),
+        Module::Normalise => {
+            let p = pipe::normalise(cfg);
+            let sw = p.sum_a.width();
+            Normalise {
+                h,
+                depth: cfg.pipeline_depth,
+                latency: p.latency,
+                r: cfg.red_bits,
+                w: cfg.recip_bits,
+                f: cfg.frac_bits,
+                ra: cfg.recip_addr_bits(),
+                sh: cfg.norm_shift(),
+                sw,
+                rom_reg: p.rom_reg,
+                sum_a: p.sum_a.expr(sw),
+                sum_b: p.sum_b.expr(sw),
+                a_max: p.a_max.name,
+                b_max: p.b_max.name,
+                steps: p.steps,
+            }
+            .render()
         }
-        .render(),
         Module::AtanRom => AtanRom {
             h,
+            latency: latency(cfg, m).expect("fixed"),
+            out_reg: pipe::atan_out_reg(cfg),
             init_file: "atan_rom.hex",
             pos: cfg.pos_bits(),
             entries: cfg.atan_entries(),
         }
         .render(),
-        Module::LinearIndex => LinearIndex {
-            h,
-            f: cfg.frac_bits,
-            pos: cfg.pos_bits(),
-            lw: cfg.linear_sum_bits(),
-            pos_max: cfg.pos_max(),
-            half: cfg.frac_half(),
+        Module::LinearIndex => {
+            let p = pipe::linear_index(cfg);
+            let lw = p.sum_u.width();
+            LinearIndex {
+                h,
+                depth: cfg.pipeline_depth,
+                latency: p.latency,
+                f: cfg.frac_bits,
+                pos: cfg.pos_bits(),
+                lw,
+                pre_reg: p.pre_reg,
+                sum_u: p.sum_u.expr(lw),
+                sum_v: p.sum_v.expr(lw),
+                steps: p.steps,
+            }
+            .render()
         }
-        .render(),
         Module::MapLookup => {
             let banks = (0..cfg.bank_count() as usize)
                 .map(|k| BankInst {
@@ -264,8 +317,14 @@ pub fn render(cfg: &Config, m: Module) -> Result<String> {
                     pv: k >> 1,
                 })
                 .collect();
+            let bank_reg = pipe::bank_out_reg(cfg);
             MapLookup {
                 h,
+                latency: latency(cfg, m).expect("fixed"),
+                bank_reg,
+                out: if bank_reg { 4 } else { 3 },
+                rd: if bank_reg { "q3" } else { "q2" },
+                out_q: if bank_reg { "q4" } else { "q3" },
                 interpolation: cfg.interpolation,
                 i: cfg.index_bits,
                 p: cfg.interp_bits,
@@ -284,26 +343,38 @@ pub fn render(cfg: &Config, m: Module) -> Result<String> {
             entries: cfg.bank_entries(),
         }
         .render(),
-        Module::Interpolate => Interpolate {
-            h,
-            m: cfg.map_bits,
-            p: cfg.interp_bits,
-            aw: cfg.interp_a_bits(),
-            rw: cfg.interp_r_bits(),
-            half: cfg.interp_half(),
+        Module::Interpolate => {
+            let p = pipe::interpolate(cfg);
+            Interpolate {
+                h,
+                depth: cfg.pipeline_depth,
+                latency: p.latency,
+                m: cfg.map_bits,
+                p: cfg.interp_bits,
+                s: cfg.step(),
+                rw: cfg.interp_r_bits(),
+                in_reg: p.in_reg,
+                sum_r: p.sum_r.expr(cfg.interp_r_bits()),
+                steps: p.steps,
+            }
+            .render()
         }
-        .render(),
         Module::ColorMul => {
             let (k, s) = color_mul::constants(cfg);
+            let p = pipe::color_mul(cfg);
+            let pw = cfg.color_product_bits();
             ColorMul {
                 h,
-                m: cfg.map_bits,
-                c: COLOR_BITS,
-                nw: color_mul::numerator_bits(cfg),
+                depth: cfg.pipeline_depth,
+                latency: p.latency,
                 s,
-                pw: cfg.color_product_bits(),
+                pw,
                 d: cfg.map_max(),
                 k,
+                pr: p.products[0].expr(pw),
+                pg: p.products[1].expr(pw),
+                pb: p.products[2].expr(pw),
+                steps: p.steps,
             }
             .render()
         }
@@ -323,6 +394,7 @@ pub fn render(cfg: &Config, m: Module) -> Result<String> {
                 .join(", ");
             RmapTop {
                 h,
+                handshake: cfg.handshake,
                 compensation: cfg.compensation,
                 interpolation: cfg.interpolation,
                 color: cfg.color,

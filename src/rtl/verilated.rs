@@ -23,10 +23,23 @@ pub struct VerilatedTop {
 
 /// Runs a tool, turning a failure into an error that names the command and shows its output.
 fn run_tool(cmd: &mut Command, what: &str) -> Result<()> {
-    let out = cmd.output().with_context(|| format!("cannot run {what} ({cmd:?}); is it installed? (make tools)"))?;
+    let out = cmd
+        .output()
+        .with_context(|| format!("cannot run {what} ({cmd:?}); is it installed? (make tools)"))?;
     if !out.status.success() {
-        let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
-        let tail: Vec<&str> = text.lines().rev().take(12).collect::<Vec<_>>().into_iter().rev().collect();
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let tail: Vec<&str> = text
+            .lines()
+            .rev()
+            .take(12)
+            .collect::<Vec<_>>()
+            .into_iter()
+            .rev()
+            .collect();
         bail!("{what} failed ({cmd:?}): {}", tail.join(" | "));
     }
     Ok(())
@@ -49,17 +62,33 @@ impl VerilatedTop {
             .collect();
         sources.sort();
         let mdir = dir.path().join("obj");
-        let mut cmd = Command::new(std::env::var("VERILATOR").unwrap_or_else(|_| "verilator".into()));
-        cmd.args(["--cc", "--exe", "--build", "-O3", "--x-assign", "fast", "--x-initial", "fast", "--noassert"])
-            .args(["-Wno-fatal", "--top-module", "rmap_top", "--Mdir"])
-            .arg(&mdir)
-            .args(["-o", "top_apply"])
-            .args(&sources)
-            .arg(&harness)
-            .arg("-CFLAGS")
-            .arg(format!("-O2 -I{}", design.join("tb").display()));
+        let mut cmd =
+            Command::new(std::env::var("VERILATOR").unwrap_or_else(|_| "verilator".into()));
+        cmd.args([
+            "--cc",
+            "--exe",
+            "--build",
+            "-O3",
+            "--x-assign",
+            "fast",
+            "--x-initial",
+            "fast",
+            "--noassert",
+        ])
+        .args(["-Wno-fatal", "--top-module", "rmap_top", "--Mdir"])
+        .arg(&mdir)
+        .args(["-o", "top_apply"])
+        .args(&sources)
+        .arg(&harness)
+        .arg("-CFLAGS")
+        .arg(format!("-O2 -I{}", design.join("tb").display()));
         run_tool(&mut cmd, "verilator")?;
-        Ok(VerilatedTop { cfg: cfg.clone(), design, exe: mdir.join("top_apply"), _dir: dir })
+        Ok(VerilatedTop {
+            cfg: cfg.clone(),
+            design,
+            exe: mdir.join("top_apply"),
+            _dir: dir,
+        })
     }
 
     /// The directory the design was generated into.
@@ -68,7 +97,11 @@ impl VerilatedTop {
     }
 
     /// Intensity, zero flag and colour of every sample, as the hardware computes them.
-    pub fn shade(&self, gradients: &[[i32; 3]], rgb: Option<&[[u32; 3]]>) -> Result<Vec<(bool, u32, [u32; 3])>> {
+    pub fn shade(
+        &self,
+        gradients: &[[i32; 3]],
+        rgb: Option<&[[u32; 3]]>,
+    ) -> Result<Vec<(bool, u32, [u32; 3])>> {
         use std::fmt::Write as _;
         let mut text = String::with_capacity(gradients.len() * 16);
         for (k, g) in gradients.iter().enumerate() {
@@ -83,18 +116,35 @@ impl VerilatedTop {
         let input = self._dir.path().join("input.hex");
         let output = self._dir.path().join("output.hex");
         std::fs::write(&input, text)?;
-        run_tool(Command::new(&self.exe).arg(&input).arg(&output).current_dir(&self.design), "the Verilated top")?;
+        run_tool(
+            Command::new(&self.exe)
+                .arg(&input)
+                .arg(&output)
+                .current_dir(&self.design),
+            "the Verilated top",
+        )?;
         let out = std::fs::read_to_string(&output)?;
         let rows: Vec<(bool, u32, [u32; 3])> = out
             .lines()
             .map(|l| {
-                let f: Vec<u32> = l.split(' ').map(|x| u32::from_str_radix(x, 16).unwrap_or(u32::MAX)).collect();
-                let c = if f.len() == 5 { [f[2], f[3], f[4]] } else { [0; 3] };
+                let f: Vec<u32> = l
+                    .split(' ')
+                    .map(|x| u32::from_str_radix(x, 16).unwrap_or(u32::MAX))
+                    .collect();
+                let c = if f.len() == 5 {
+                    [f[2], f[3], f[4]]
+                } else {
+                    [0; 3]
+                };
                 (f[0] == 1, f[1], c)
             })
             .collect();
         if rows.len() != gradients.len() {
-            bail!("the Verilated top returned {} samples for {}", rows.len(), gradients.len());
+            bail!(
+                "the Verilated top returned {} samples for {}",
+                rows.len(),
+                gradients.len()
+            );
         }
         Ok(rows)
     }
@@ -102,6 +152,10 @@ impl VerilatedTop {
 
 impl IntensitySource for VerilatedTop {
     fn intensities(&self, gradients: &[[i32; 3]]) -> Result<Vec<u32>> {
-        Ok(self.shade(gradients, None)?.into_iter().map(|(_, i, _)| i).collect())
+        Ok(self
+            .shade(gradients, None)?
+            .into_iter()
+            .map(|(_, i, _)| i)
+            .collect())
     }
 }

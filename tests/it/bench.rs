@@ -20,7 +20,9 @@ fn row(scene: &str, bits: u64, speed: f64, rmse: f64) -> Row {
         map_build_us: 0.0,
         rom_bits: 0,
         map_bits: bits,
-        yosys_cells: None,
+        ice40_cells: None,
+        ice40_brams: None,
+        fmax_mhz: None,
         pareto_cost: false,
         pareto_speed: false,
     }
@@ -55,7 +57,7 @@ fn pareto_fronts_per_scene() {
     assert!(md.lines().nth(2).unwrap().ends_with("| cost |"), "{md}");
     let csv = bench::csv(&rows);
     assert_eq!(csv.lines().count(), 1 + rows.len());
-    assert!(csv.lines().all(|l| l.split(',').count() == 17), "{csv}");
+    assert!(csv.lines().all(|l| l.split(',').count() == 19), "{csv}");
 }
 
 #[test]

@@ -7,6 +7,7 @@
 //! The tools are required when CI=true (a missing tool fails the test there); elsewhere a
 //! missing tool skips with a message on stderr.
 
+use crate::hdl::{generate, require};
 use crate::helpers;
 use rmapgen::config::Config;
 use rmapgen::rtl::{self, Module};
@@ -76,25 +77,16 @@ const CHECKED: &[(&str, &[&str])] = &[
     ),
 ];
 
-/// Generates into `dir` with `flags` and `vectors` random vectors per stage.
-fn generate(dir: &Path, flags: &[&str], vectors: &str) {
-    let mut args = vec![
-        "generate",
-        "--out",
-        dir.to_str().expect("utf-8 path"),
-        "--vectors",
-        vectors,
-    ];
-    args.extend_from_slice(flags);
-    let o = helpers::run(&args);
-    assert!(
-        o.status.success(),
-        "generate {flags:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+/// The configuration `generate` resolves from `flags`, read back from the manifest.
+/// The names of the design's .v files, sorted.
+fn design_files(dir: &Path) -> Vec<String> {
+    crate::hdl::design_files(dir)
+        .iter()
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect()
 }
 
-/// The configuration `generate` resolves from `flags`, read back from the manifest.
+/// The manifest of a generated directory.
 fn manifest(dir: &Path) -> serde_json::Value {
     let text = std::fs::read_to_string(dir.join("manifest.json")).expect("manifest.json");
     serde_json::from_str(&text).expect("manifest.json is JSON")
@@ -102,31 +94,6 @@ fn manifest(dir: &Path) -> serde_json::Value {
 
 fn config_of(m: &serde_json::Value) -> Config {
     serde_json::from_value(m["config"].clone()).expect("the manifest's config is a Config")
-}
-
-/// The design's .v files (testbenches live in tb/, not here), sorted.
-fn design_files(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .expect("output dir")
-        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
-        .filter(|n| n.ends_with(".v"))
-        .collect();
-    v.sort();
-    v
-}
-
-/// Whether `tool` is on PATH; panics when it is not and CI=true.
-fn require(tool: &str) -> bool {
-    let found = std::env::var_os("PATH")
-        .map(|p| std::env::split_paths(&p).any(|d| d.join(tool).is_file()))
-        .unwrap_or(false);
-    if !found {
-        if std::env::var("CI").map(|v| v == "true").unwrap_or(false) {
-            panic!("{tool} is not installed and CI=true: run `make tools`");
-        }
-        eprintln!("skipping: {tool} is not installed (make tools)");
-    }
-    found
 }
 
 #[test]
@@ -138,7 +105,7 @@ fn committed_rtl_out_is_what_the_default_generates() {
     );
     let t = helpers::tempdir();
     let fresh = t.path().join("rtl_out");
-    generate(&fresh, &[], "2000");
+    generate(&fresh, &[], 2000);
     if let Some(d) = helpers::first_difference(&committed, &fresh) {
         panic!("rtl_out/ is not what `rmapgen generate` writes now: {d}; run `make generate`");
     }
@@ -152,9 +119,9 @@ fn switched_off_stages_are_absent() {
         t.path().join("nointerp"),
         t.path().join("color"),
     );
-    generate(&nocomp, &["--no-compensation"], "10");
-    generate(&nointerp, &["--no-interpolation"], "10");
-    generate(&color, &["--color"], "10");
+    generate(&nocomp, &["--no-compensation"], 10);
+    generate(&nointerp, &["--no-interpolation"], 10);
+    generate(&color, &["--color"], 10);
 
     let files = design_files(&nocomp);
     assert!(!files.contains(&"atan_rom.v".to_string()), "{files:?}");
@@ -178,7 +145,7 @@ fn switched_off_stages_are_absent() {
 
     // The default has colour off; --color adds exactly color_mul.v.
     let default = t.path().join("default");
-    generate(&default, &[], "10");
+    generate(&default, &[], 10);
     let (plain, colored) = (design_files(&default), design_files(&color));
     assert!(!plain.contains(&"color_mul.v".to_string()), "{plain:?}");
     assert!(!std::fs::read_to_string(default.join("rmap_top.v"))
@@ -203,14 +170,14 @@ fn generating_twice_gives_the_same_bytes() {
         "--interp-bits",
         "2",
     ];
-    generate(&t.path().join("a"), &flags, "50");
-    generate(&t.path().join("b"), &flags, "50");
+    generate(&t.path().join("a"), &flags, 50);
+    generate(&t.path().join("b"), &flags, 50);
     assert_eq!(
         helpers::first_difference(&t.path().join("a"), &t.path().join("b")),
         None
     );
     // And regenerating over an existing directory replaces it whole.
-    generate(&t.path().join("a"), &[], "50");
+    generate(&t.path().join("a"), &[], 50);
     assert!(!t.path().join("a").join("color_mul.v").exists());
 }
 
@@ -255,7 +222,7 @@ fn unwritable_out_exits_2() {
 fn failed_generate_keeps_the_existing_output() {
     let t = helpers::tempdir();
     let out = t.path().join("rtl");
-    generate(&out, &[], "5");
+    generate(&out, &[], 5);
     let before = helpers::tree(&out);
     let o = helpers::run(&[
         "generate",
@@ -298,7 +265,7 @@ fn manifest_agrees_with_the_files_and_the_latency_function() {
     let t = helpers::tempdir();
     for (name, flags) in CHECKED {
         let dir = t.path().join(name);
-        generate(&dir, flags, "5");
+        generate(&dir, flags, 5);
         let m = manifest(&dir);
         let cfg = config_of(&m);
         assert_eq!(m["rmapgen_version"], env!("CARGO_PKG_VERSION"));
@@ -378,7 +345,7 @@ fn manifest_agrees_with_the_files_and_the_latency_function() {
 fn bank_files_hold_the_scene_map_in_both_buffers() {
     let t = helpers::tempdir();
     let dir = t.path().join("d");
-    generate(&dir, &[], "1");
+    generate(&dir, &[], 1);
     let cfg = Config::default();
     let entries = |f: &str| -> Vec<u32> {
         std::fs::read_to_string(dir.join(f))
@@ -415,23 +382,9 @@ fn verilator_lint_is_silent_and_icarus_compiles() {
     let t = helpers::tempdir();
     for (name, flags) in CHECKED {
         let dir = t.path().join(name);
-        generate(&dir, flags, "1");
+        generate(&dir, flags, 1);
         let files = design_files(&dir);
-        let o = Command::new("verilator")
-            .args(["--lint-only", "-Wall", "--top-module", "rmap_top"])
-            .args(&files)
-            .current_dir(&dir)
-            .output()
-            .expect("verilator runs");
-        let said = format!(
-            "{}{}",
-            String::from_utf8_lossy(&o.stdout),
-            String::from_utf8_lossy(&o.stderr)
-        );
-        assert!(
-            o.status.success() && said.trim().is_empty(),
-            "verilator -Wall on {name}:\n{said}"
-        );
+        crate::hdl::assert_lint_clean(name, &dir);
         let o = Command::new("iverilog")
             .args(["-g2005", "-Wall", "-o", "/dev/null"])
             .args(&files)
@@ -457,7 +410,7 @@ fn default_synthesises_without_latches_into_block_ram() {
     }
     let t = helpers::tempdir();
     let dir = t.path().join("rtl");
-    generate(&dir, &[], "1");
+    generate(&dir, &[], 1);
     let o = Command::new(helpers::root().join("scripts/synth.sh"))
         .arg(&dir)
         .arg(t.path().join("synth"))

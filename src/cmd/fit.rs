@@ -1,0 +1,176 @@
+//! `rmapgen fit`: the cheapest configuration whose error on the scene's test image meets a
+//! target; prints the decision and writes the chosen design as `generate` does.
+
+use super::generate;
+use crate::config::Config;
+use crate::fit::{self, CostKind, Options, Outcome, Target};
+use crate::model::map_fit::MapFit;
+use crate::scene::Scene;
+use anyhow::Result;
+use clap::Args;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::path::PathBuf;
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+#[derive(Args, Debug)]
+#[command(group(clap::ArgGroup::new("target").required(true).multiple(true).args(["max_error", "rmse"])))]
+pub struct FitArgs {
+    /// Scene whose sphere test image the error is measured on (its maps fill the design).
+    #[arg(long, value_name = "FILE")]
+    pub scene: PathBuf,
+    /// Largest absolute error allowed on any output, in its LSBs (intensity: map-bits wide;
+    /// colour channels: 8 bits).
+    #[arg(long, value_name = "E")]
+    pub max_error: Option<u32>,
+    /// Largest RMS intensity error allowed, in output LSBs.
+    #[arg(long, value_name = "R")]
+    pub rmse: Option<f64>,
+    /// What "cheapest" means: ROM + map bits, or cells of Yosys synthesis.
+    #[arg(long, value_enum, default_value_t = CostKind::Bits)]
+    pub cost: CostKind,
+    /// Output directory for the chosen design, as `generate` writes it, plus fit.json
+    /// (replaced whole on success; nothing is written on failure).
+    #[arg(long, value_name = "DIR", default_value = "out/fit")]
+    pub out: PathBuf,
+    /// Gradient component width of the source (fixed, not searched) [8..=16].
+    #[arg(long, value_name = "G", default_value_t = 12)]
+    pub grad_bits: u32,
+    /// Output intensity (map entry) width: the error target's LSB (fixed, not searched)
+    /// [6..=12].
+    #[arg(long, value_name = "M", default_value_t = 8)]
+    pub map_bits: u32,
+    /// Pipeline depth of the generated design (does not change the error) [0..=2].
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub pipeline_depth: u32,
+    /// Valid/ready handshake on the generated top.
+    #[arg(long)]
+    pub handshake: bool,
+    /// How the maps are filled [default: the scene's map_fit].
+    #[arg(long, value_enum)]
+    pub map_fit: Option<MapFit>,
+    /// Side of the sphere test image [16..=4096].
+    #[arg(long, value_name = "N", default_value_t = 512)]
+    pub size: u32,
+    /// Passing configurations listed after the choice.
+    #[arg(long, value_name = "K", default_value_t = 3)]
+    pub runners_up: usize,
+    /// With --cost cells: how many passing configurations to synthesise, shared equally by
+    /// the four combinations of compensation and interpolation (the cheapest passing ones in
+    /// bits of each) [1..=64].
+    #[arg(long, value_name = "S", default_value_t = 8)]
+    pub synth_limit: usize,
+    /// Seeded random vectors per stage in the written design (as generate --vectors).
+    #[arg(long, value_name = "N", default_value_t = 2000)]
+    pub vectors: usize,
+    /// Seed of the random vectors.
+    #[arg(long, value_name = "S", default_value_t = 1)]
+    pub seed: u64,
+}
+
+pub fn run(a: &FitArgs) -> Result<()> {
+    let scene = Scene::from_toml_file(&a.scene)?;
+    let base = Config {
+        grad_bits: a.grad_bits,
+        map_bits: a.map_bits,
+        pipeline_depth: a.pipeline_depth,
+        handshake: a.handshake,
+        color: scene.color.is_some(),
+        ..Config::default()
+    };
+    base.validate()?;
+    anyhow::ensure!(
+        (16..=4096).contains(&a.size),
+        "size {} is out of range; allowed 16..=4096",
+        a.size
+    );
+    anyhow::ensure!(
+        (1..=64).contains(&a.synth_limit),
+        "synth-limit {} is out of range; allowed 1..=64",
+        a.synth_limit
+    );
+    let opts = Options {
+        base,
+        size: a.size,
+        target: Target {
+            max_error: a.max_error,
+            rmse: a.rmse,
+        },
+        cost: a.cost,
+        runners_up: a.runners_up,
+        synth_limit: a.synth_limit,
+        map_fit: a.map_fit.unwrap_or(scene.map_fit),
+    };
+    // A progress bar, shown once the search has run for a second (on a terminal).
+    let bar = ProgressBar::with_draw_target(Some(0), ProgressDrawTarget::hidden());
+    bar.set_style(
+        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} {msg}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    let start = Instant::now();
+    let shown = Mutex::new(false);
+    let outcome = fit::search(&scene, &opts, &|done, total, msg| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+        bar.set_message(msg.to_string());
+        let mut s = shown.lock().expect("progress");
+        if !*s && start.elapsed() > Duration::from_secs(1) {
+            *s = true;
+            bar.set_draw_target(ProgressDrawTarget::stderr());
+        }
+    });
+    bar.finish_and_clear();
+    let d = match outcome? {
+        Outcome::Found(d) => d,
+        Outcome::Unreachable(u) => anyhow::bail!(u.message(&a.scene.display().to_string())),
+    };
+    let json = serde_json::to_string_pretty(&d)?;
+    let cfg = &d.chosen.config;
+    let (p, manifest) = generate::write_dir(
+        cfg,
+        &scene,
+        &a.out,
+        a.vectors,
+        a.seed,
+        &[("fit.json".to_string(), json)],
+    )?;
+    println!(
+        "fit: {} ({}), {}x{} sphere ({} pixels), maps {}; target {}; cost {}",
+        a.scene.display(),
+        d.scene_terms,
+        d.image_size,
+        d.image_size,
+        d.pixels,
+        d.map_fit.name(),
+        d.target.describe(),
+        match d.cost {
+            CostKind::Bits => "ROM + map bits",
+            CostKind::Cells => "Yosys cells",
+        }
+    );
+    match d.cost {
+        CostKind::Bits => println!(
+            "fit: {} configurations, {} measured in {:.1} s; every one cheaper than the choice ({}) measured and rejected",
+            d.space, d.measured, d.seconds, d.cheaper_rejected
+        ),
+        CostKind::Cells => println!(
+            "fit: {} configurations, {} measured in {:.1} s; the {} cheaper in bits than the cheapest passing one measured and rejected; cells of the {} synthesised (per combination of compensation and interpolation, its cheapest passing configurations in bits)",
+            d.space,
+            d.measured,
+            d.seconds,
+            d.cheaper_rejected,
+            d.synthesised
+        ),
+    }
+    print!("{}", d.table());
+    let modules: Vec<&str> = manifest.modules.iter().map(|m| m.name).collect();
+    println!(
+        "fit: wrote {} ({} memory bits; modules {}) to {}",
+        cfg.summary(),
+        manifest.memory_bits,
+        modules.join(" "),
+        p.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,84 @@
+//! `rmapgen fpga`: place and route the design for an iCE40 (Yosys synth_ice40, nextpnr-ice40)
+//! and print the post-route Fmax, logic cells, block RAMs and the critical path. Fails when
+//! a memory falls back to logic; a missed timing target is reported, not an error.
+
+use super::config_args::ConfigArgs;
+use crate::rtl::fpga::{self, Options};
+use anyhow::{Context, Result};
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct FpgaArgs {
+    /// An already generated design directory (e.g. rtl_out); without it, the configuration
+    /// given by the flags below is generated into a temporary directory.
+    #[arg(long, value_name = "DIR")]
+    pub dir: Option<PathBuf>,
+    #[command(flatten)]
+    pub cfg: ConfigArgs,
+    /// nextpnr-ice40 device: hx8k, hx4k, hx1k, lp8k, lp4k, lp1k, lp384, up5k, up3k, u4k, ...
+    #[arg(long, default_value = "hx8k")]
+    pub device: String,
+    /// Package: ct256, tq144, cm81, cb132, bg121, sg48, ...
+    #[arg(long, default_value = "ct256")]
+    pub package: String,
+    /// Target clock the placer aims at, MHz.
+    #[arg(long, value_name = "MHZ", default_value_t = 125.0)]
+    pub freq: f64,
+    /// Placer seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Directory for the logs, netlist, bitstream text (.asc) and report.json.
+    #[arg(long, value_name = "DIR", default_value = "build/fpga")]
+    pub logs: PathBuf,
+    /// Fail (exit 2) when the post-route Fmax is below --freq; without it a missed target is
+    /// reported as a figure.
+    #[arg(long)]
+    pub require_timing: bool,
+}
+
+pub fn run(a: &FpgaArgs) -> Result<()> {
+    let opts = Options {
+        device: a.device.clone(),
+        package: a.package.clone(),
+        freq_mhz: a.freq,
+        seed: a.seed,
+        logs: Some(a.logs.clone()),
+        ..Options::default()
+    };
+    let (what, report) = match &a.dir {
+        Some(d) => (d.display().to_string(), fpga::run_dir(d, &opts)?),
+        None => {
+            let cfg = a.cfg.resolve()?;
+            (cfg.summary(), fpga::ice40_report(&cfg, &opts)?)
+        }
+    };
+    print!("fpga: rmap_top of {what}\n{}", report.summary());
+    let json = serde_json::to_string_pretty(&report)?;
+    let path = a.logs.join("report.json");
+    std::fs::write(&path, json + "\n")
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    println!(
+        "fpga: {} ({:.2} MHz, {} logic cells, {} block RAMs); report {}",
+        if report.timing_met {
+            "timing met"
+        } else {
+            "TIMING NOT MET"
+        },
+        report.fmax_mhz,
+        report.logic_cells,
+        report.block_rams,
+        path.display()
+    );
+    anyhow::ensure!(
+        report.timing_met || !a.require_timing,
+        "post-route Fmax {:.2} MHz is below the {} MHz target (--require-timing); critical path {}",
+        report.fmax_mhz,
+        a.freq,
+        report
+            .critical_path
+            .as_ref()
+            .map_or("unknown".into(), |c| format!("{} -> {}", c.from, c.to))
+    );
+    Ok(())
+}

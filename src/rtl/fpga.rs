@@ -1,0 +1,483 @@
+//! The design on a real FPGA flow: Yosys `synth_ice40` and `nextpnr-ice40` place and route
+//! `rmap_top` for an iCE40 (the HX8K in its ct256 package by default), and [`FpgaReport`]
+//! gives what they measured: the post-route Fmax (the last "Max frequency" line nextpnr
+//! prints), logic cells and block RAMs used, the LUTs, carries and flip-flops Yosys mapped,
+//! the critical path, and where every memory of the manifest went.
+//!
+//! Every memory (reciprocal ROM, both compensation-ROM copies, every map bank with both
+//! buffers) must be in `SB_RAM40_4K` block RAM; a memory that Yosys turned into logic is an
+//! error naming it. A timing failure is a figure ([`FpgaReport::timing_met`] false), not an
+//! error; a device or package nextpnr does not know, or a design that does not fit, is an
+//! error whose one line quotes nextpnr's complaint.
+//!
+//! `rmapgen fpga` and `make fpga` print the report; `rmapgen bench` and `fit --cost cells`
+//! call [`ice40_report`].
+
+use super::manifest;
+use crate::config::Config;
+use crate::output::StagedDir;
+use crate::scene::Scene;
+use anyhow::{bail, Context, Result};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Where and how to place and route.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// nextpnr-ice40's device flag without the dashes: hx8k, hx4k, hx1k, lp8k, up5k, ...
+    pub device: String,
+    /// The package: ct256, tq144, cm81, sg48, ...
+    pub package: String,
+    /// The clock the placer aims at, MHz.
+    pub freq_mhz: f64,
+    /// nextpnr's placer seed (fixed, so a run is reproducible).
+    pub seed: u64,
+    pub yosys: String,
+    pub nextpnr: String,
+    /// Keep the logs, netlist and report here (else in a temporary directory).
+    pub logs: Option<PathBuf>,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            device: "hx8k".into(),
+            package: "ct256".into(),
+            freq_mhz: 125.0,
+            seed: 1,
+            yosys: std::env::var("YOSYS").unwrap_or_else(|_| "yosys".into()),
+            nextpnr: std::env::var("NEXTPNR").unwrap_or_else(|_| "nextpnr-ice40".into()),
+            logs: None,
+        }
+    }
+}
+
+/// One memory of the manifest and the block RAMs that hold it.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct MemoryPlacement {
+    pub instance: String,
+    pub bits: u64,
+    /// `SB_RAM40_4K` cells named after the memory (0: it fell back to logic).
+    pub block_rams: u32,
+}
+
+/// The slowest register-to-register path after routing.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct CriticalPath {
+    /// The signal (net or register) the path starts from and the one it ends at.
+    pub from: String,
+    pub to: String,
+    /// The named signals it passes, in order, repeats merged.
+    pub through: Vec<String>,
+    pub logic_ns: f64,
+    pub routing_ns: f64,
+}
+
+/// What the flow measured.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct FpgaReport {
+    pub device: String,
+    pub package: String,
+    pub seed: u64,
+    pub target_mhz: f64,
+    /// Post-route Fmax: the last "Max frequency" line of nextpnr.
+    pub fmax_mhz: f64,
+    pub timing_met: bool,
+    /// Logic cells (ICESTORM_LC: a LUT4, a carry and a flip-flop) used and available.
+    pub logic_cells: u32,
+    pub logic_cells_available: u32,
+    /// Block RAMs (ICESTORM_RAM, SB_RAM40_4K) used and available.
+    pub block_rams: u32,
+    pub block_rams_available: u32,
+    /// What Yosys mapped: SB_LUT4, SB_CARRY, flip-flops (SB_DFF*), all cells.
+    pub luts: u32,
+    pub carries: u32,
+    pub flip_flops: u32,
+    pub yosys_cells: u32,
+    pub memories: Vec<MemoryPlacement>,
+    pub critical_path: Option<CriticalPath>,
+}
+
+impl FpgaReport {
+    /// Memories that are not in block RAM.
+    pub fn in_logic(&self) -> Vec<&MemoryPlacement> {
+        self.memories.iter().filter(|m| m.block_rams == 0).collect()
+    }
+
+    /// The report as lines for people.
+    pub fn summary(&self) -> String {
+        let mut s = format!(
+            "Fmax {:.2} MHz ({} at {:.0} MHz), {} logic cells of {}, {} block RAMs of {} (iCE40 {} {}, seed {})\n",
+            self.fmax_mhz,
+            if self.timing_met { "PASS" } else { "FAIL" },
+            self.target_mhz,
+            self.logic_cells,
+            self.logic_cells_available,
+            self.block_rams,
+            self.block_rams_available,
+            self.device,
+            self.package,
+            self.seed
+        );
+        s += &format!(
+            "Yosys: {} cells: {} SB_LUT4, {} SB_CARRY, {} flip-flops\n",
+            self.yosys_cells, self.luts, self.carries, self.flip_flops
+        );
+        let mems: Vec<String> = self
+            .memories
+            .iter()
+            .map(|m| format!("{} {}", m.instance, m.block_rams))
+            .collect();
+        s += &format!("block RAMs per memory: {}\n", mems.join(", "));
+        if let Some(c) = &self.critical_path {
+            s += &format!(
+                "critical path: {} -> {} ({:.1} ns logic, {:.1} ns routing) through {}\n",
+                c.from,
+                c.to,
+                c.logic_ns,
+                c.routing_ns,
+                c.through.join(", ")
+            );
+        }
+        s
+    }
+}
+
+/// Whether Yosys and nextpnr-ice40 both run.
+pub fn tools_available(opts: &Options) -> bool {
+    let runs = |tool: &str, arg: &str| {
+        Command::new(tool)
+            .arg(arg)
+            .output()
+            .map(|o| o.status.success())
+            .unwrap_or(false)
+    };
+    runs(&opts.yosys, "-V") && runs(&opts.nextpnr, "--version")
+}
+
+/// Generates `cfg`'s design (the standard scene's maps) into a temporary directory and runs
+/// the flow on it.
+pub fn ice40_report(cfg: &Config, opts: &Options) -> Result<FpgaReport> {
+    cfg.validate()?;
+    let tmp = tempfile::tempdir().context("cannot make a temporary directory")?;
+    let out = StagedDir::new(&tmp.path().join("rtl"))?;
+    super::write_design(cfg, &Scene::standard(), &out)?;
+    let dir = out.commit()?;
+    run_dir(&dir, opts)
+}
+
+/// The signal a netlist cell of Yosys/nextpnr belongs to: its name up to the first suffix
+/// the tools add (`_SB_`, `$`, `_DFFLC`, `_LC`).
+fn signal(cell: &str) -> String {
+    let mut end = cell.len();
+    for pat in ["_SB_", "$", "_DFFLC", "_LC"] {
+        if let Some(i) = cell.find(pat) {
+            end = end.min(i);
+        }
+    }
+    cell[..end].to_string()
+}
+
+/// The first line of a tool's output that says what went wrong.
+fn complaint(text: &str) -> String {
+    let lines: Vec<&str> = text
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect();
+    lines
+        .iter()
+        .find(|l| l.starts_with("ERROR:"))
+        .or_else(|| {
+            lines
+                .iter()
+                .find(|l| l.contains("unrecognised option") || l.contains("unknown option"))
+        })
+        .or(lines.last())
+        .map(|l| l.to_string())
+        .unwrap_or_else(|| "no output".into())
+}
+
+/// Runs the flow on a generated directory (it needs `manifest.json` and the `.v` and `.hex`
+/// files `generate` writes there).
+pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
+    anyhow::ensure!(
+        opts.freq_mhz > 0.0 && opts.freq_mhz <= 1000.0,
+        "target frequency {} MHz is out of range; allowed (0, 1000]",
+        opts.freq_mhz
+    );
+    let text = std::fs::read_to_string(dir.join(manifest::FILE)).with_context(|| {
+        format!(
+            "no {} in {}: generate the design first (rmapgen generate --out {})",
+            manifest::FILE,
+            dir.display(),
+            dir.display()
+        )
+    })?;
+    let m: serde_json::Value = serde_json::from_str(&text)
+        .with_context(|| format!("{} in {} is not JSON", manifest::FILE, dir.display()))?;
+    let files: Vec<String> = m["modules"]
+        .as_array()
+        .context("the manifest lists no modules")?
+        .iter()
+        .filter_map(|x| x["file"].as_str().map(String::from))
+        .collect();
+    let top = m["top"].as_str().unwrap_or("rmap_top").to_string();
+    let mems: Vec<(String, u64)> = m["memories"]
+        .as_array()
+        .context("the manifest lists no memories")?
+        .iter()
+        .map(|x| {
+            (
+                x["instance"].as_str().unwrap_or_default().to_string(),
+                x["bits"].as_u64().unwrap_or(0),
+            )
+        })
+        .collect();
+
+    // nextpnr checks the device and package without a design, in milliseconds: a name it
+    // does not know fails here, before the synthesis.
+    let check = Command::new(&opts.nextpnr)
+        .arg(format!("--{}", opts.device))
+        .args(["--package", &opts.package])
+        .output()
+        .with_context(|| format!("cannot run {} (make fpga installs it)", opts.nextpnr))?;
+    if !check.status.success() {
+        bail!(
+            "{} --{} --package {}: {}",
+            opts.nextpnr,
+            opts.device,
+            opts.package,
+            complaint(&format!(
+                "{}\n{}",
+                String::from_utf8_lossy(&check.stdout),
+                String::from_utf8_lossy(&check.stderr)
+            ))
+        );
+    }
+
+    let tmp;
+    let logs = match &opts.logs {
+        Some(p) => {
+            std::fs::create_dir_all(p).with_context(|| format!("cannot create {}", p.display()))?;
+            p.canonicalize()?
+        }
+        None => {
+            tmp = tempfile::tempdir().context("cannot make a temporary directory")?;
+            tmp.path().to_path_buf()
+        }
+    };
+    let json = logs.join(format!("{top}.json"));
+    let stat = logs.join("yosys_stat.txt");
+
+    // Yosys, from the design directory so that $readmemh finds the hex files.
+    let script = format!(
+        "read_verilog {}; synth_ice40 -top {top} -json {}; tee -q -o {} stat",
+        files.join(" "),
+        json.display(),
+        stat.display()
+    );
+    let run = Command::new(&opts.yosys)
+        .current_dir(dir)
+        .args(["-q", "-l"])
+        .arg(logs.join("yosys.log"))
+        .args(["-p", &script])
+        .output()
+        .with_context(|| format!("cannot run {} (make fpga installs it)", opts.yosys))?;
+    if !run.status.success() {
+        let log = std::fs::read_to_string(logs.join("yosys.log")).unwrap_or_default();
+        bail!(
+            "yosys synth_ice40 failed: {}",
+            complaint(&format!("{log}\n{}", String::from_utf8_lossy(&run.stderr)))
+        );
+    }
+    let stat_text = std::fs::read_to_string(&stat)?;
+    let count = |name: &str| -> u32 {
+        stat_text
+            .lines()
+            .rev()
+            .filter_map(|l| {
+                let mut w = l.split_whitespace();
+                let (a, b) = (w.next()?, w.next()?);
+                (a == name).then(|| b.parse::<u32>().ok())?
+            })
+            .next()
+            .unwrap_or(0)
+    };
+    let ffs: u32 = stat_text
+        .lines()
+        .filter_map(|l| {
+            let mut w = l.split_whitespace();
+            let (a, b) = (w.next()?, w.next()?);
+            a.starts_with("SB_DFF").then(|| b.parse::<u32>().ok())?
+        })
+        .sum();
+    let yosys_cells = stat_text
+        .lines()
+        .rev()
+        .find_map(|l| l.trim().strip_prefix("Number of cells:"))
+        .and_then(|n| n.trim().parse().ok())
+        .unwrap_or(0);
+
+    // Which block RAMs hold which memory: memory_bram names them <memory>.<row>.<column>.
+    let netlist: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json)?)
+        .context("Yosys wrote a netlist that is not JSON")?;
+    let cells = netlist["modules"][&top]["cells"]
+        .as_object()
+        .context("no top module in the netlist")?;
+    let rams: Vec<&String> = cells
+        .iter()
+        .filter(|(_, c)| c["type"] == "SB_RAM40_4K")
+        .map(|(n, _)| n)
+        .collect();
+    let memories: Vec<MemoryPlacement> = mems
+        .iter()
+        .map(|(inst, bits)| MemoryPlacement {
+            instance: inst.clone(),
+            bits: *bits,
+            block_rams: rams
+                .iter()
+                .filter(|n| n.starts_with(&format!("{inst}.")))
+                .count() as u32,
+        })
+        .collect();
+    let lost: Vec<&str> = memories
+        .iter()
+        .filter(|x| x.block_rams == 0)
+        .map(|x| x.instance.as_str())
+        .collect();
+    if !lost.is_empty() {
+        bail!(
+            "memories fell back to logic instead of SB_RAM40_4K block RAM: {} (log: {})",
+            lost.join(", "),
+            logs.join("yosys.log").display()
+        );
+    }
+
+    // nextpnr: a timing failure is allowed (it is a figure); anything else is an error.
+    let report = logs.join("nextpnr_report.json");
+    let log = logs.join("nextpnr.log");
+    let run = Command::new(&opts.nextpnr)
+        .arg(format!("--{}", opts.device))
+        .args(["--package", &opts.package, "--json"])
+        .arg(&json)
+        .arg("--asc")
+        .arg(logs.join(format!("{top}.asc")))
+        .args(["--freq", &format!("{}", opts.freq_mhz)])
+        .args(["--seed", &opts.seed.to_string()])
+        .arg("--timing-allow-fail")
+        .arg("--report")
+        .arg(&report)
+        .arg("--log")
+        .arg(&log)
+        .output()
+        .with_context(|| format!("cannot run {} (make fpga installs it)", opts.nextpnr))?;
+    let out = format!(
+        "{}\n{}",
+        String::from_utf8_lossy(&run.stdout),
+        String::from_utf8_lossy(&run.stderr)
+    );
+    if !run.status.success() {
+        bail!(
+            "{} --{} --package {}: {}",
+            opts.nextpnr,
+            opts.device,
+            opts.package,
+            complaint(&out)
+        );
+    }
+    let log_text = std::fs::read_to_string(&log).unwrap_or(out);
+    let fmax_line = log_text
+        .lines()
+        .rev()
+        .find(|l| l.contains("Max frequency for clock"))
+        .context("nextpnr printed no Max frequency line")?;
+    let fmax_mhz: f64 = fmax_line
+        .split("': ")
+        .nth(1)
+        .and_then(|r| r.split_whitespace().next())
+        .and_then(|v| v.parse().ok())
+        .with_context(|| format!("cannot read the Fmax in {fmax_line:?}"))?;
+    let rep: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report)?)
+        .context("nextpnr's report is not JSON")?;
+    let util = |k: &str, f: &str| rep["utilization"][k][f].as_u64().unwrap_or(0) as u32;
+    let critical_path = rep["critical_paths"]
+        .as_array()
+        .and_then(|ps| {
+            ps.iter().find(|p| {
+                p["from"] == p["to"] && p["from"].as_str().unwrap_or("").contains("posedge")
+            })
+        })
+        .and_then(|p| p["path"].as_array())
+        .map(|steps| {
+            let mut through: Vec<String> = Vec::new();
+            let (mut logic, mut routing) = (0.0, 0.0);
+            for s in steps {
+                let d = s["delay"].as_f64().unwrap_or(0.0);
+                if s["type"] == "routing" {
+                    routing += d;
+                } else {
+                    logic += d;
+                }
+                let sig = signal(s["from"]["cell"].as_str().unwrap_or(""));
+                if !sig.is_empty() && through.last() != Some(&sig) {
+                    through.push(sig);
+                }
+            }
+            let to = steps
+                .last()
+                .map(|s| signal(s["to"]["cell"].as_str().unwrap_or("")))
+                .unwrap_or_default();
+            CriticalPath {
+                from: through.first().cloned().unwrap_or_default(),
+                to,
+                through,
+                logic_ns: logic,
+                routing_ns: routing,
+            }
+        });
+    Ok(FpgaReport {
+        device: opts.device.clone(),
+        package: opts.package.clone(),
+        seed: opts.seed,
+        target_mhz: opts.freq_mhz,
+        fmax_mhz,
+        timing_met: fmax_mhz >= opts.freq_mhz,
+        logic_cells: util("ICESTORM_LC", "used"),
+        logic_cells_available: util("ICESTORM_LC", "available"),
+        block_rams: util("ICESTORM_RAM", "used"),
+        block_rams_available: util("ICESTORM_RAM", "available"),
+        luts: count("SB_LUT4"),
+        carries: count("SB_CARRY"),
+        flip_flops: ffs,
+        yosys_cells,
+        memories,
+        critical_path,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn signals_and_complaints() {
+        assert_eq!(
+            signal("u_normalise.pb_l1_0_q_SB_CARRY_I0_9$CARRY"),
+            "u_normalise.pb_l1_0_q"
+        );
+        assert_eq!(
+            signal("u_atan_rom.pv_q2_SB_DFF_Q_5_DFFLC"),
+            "u_atan_rom.pv_q2"
+        );
+        assert_eq!(
+            complaint("Info: x\nERROR: Unsupported package 'ct257'.\n0 warnings, 1 error\n"),
+            "ERROR: Unsupported package 'ct257'."
+        );
+        assert_eq!(
+            complaint("unrecognised option '--hx9k'\n"),
+            "unrecognised option '--hx9k'"
+        );
+    }
+}
