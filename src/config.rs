@@ -52,7 +52,7 @@ pub const COLOR_BITS: u32 = 8;
 pub const RANGES: &[(&str, u32, u32)] = &[
     ("grad_bits", 8, 16),
     ("red_bits", 6, 12),
-    ("recip_bits", 4, 20),
+    ("recip_bits", 5, 20),
     ("frac_bits", 4, 12),
     ("index_bits", 2, 6),
     ("interp_bits", 0, 5),

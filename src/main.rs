@@ -16,7 +16,7 @@ enum Command {
     /// Generate the Verilog, ROM/map files, manifest, test vectors and testbenches of one
     /// configuration.
     ///
-    /// Ranges: grad-bits 8..=16, red-bits 6..=12 (<= grad-bits), recip-bits 4..=20
+    /// Ranges: grad-bits 8..=16, red-bits 6..=12 (<= grad-bits), recip-bits 5..=20
     /// (>= frac-bits + 1), frac-bits 4..=12, index-bits 2..=6, interp-bits 0..=5 (0 exactly
     /// when --no-interpolation), map-bits 6..=12.
     Generate(cmd::generate::GenerateArgs),

@@ -17,7 +17,7 @@ pub struct ConfigArgs {
     /// Magnitude width after sort & shift [6..=12, <= grad-bits, default 8].
     #[arg(long)]
     pub red_bits: Option<u32>,
-    /// Reciprocal ROM entry width [4..=20, >= frac-bits + 1, default 10].
+    /// Reciprocal ROM entry width [5..=20, >= frac-bits + 1, default 10].
     #[arg(long)]
     pub recip_bits: Option<u32>,
     /// Normalised fraction width; 2^frac-bits compensation ROM entries [4..=12, default 8].
