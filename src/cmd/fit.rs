@@ -40,9 +40,10 @@ pub struct FitArgs {
     /// [6..=12].
     #[arg(long, value_name = "M", default_value_t = 8)]
     pub map_bits: u32,
-    /// Pipeline depth of the generated design (does not change the error) [0..=2].
-    #[arg(long, value_name = "N", default_value_t = 0)]
-    pub pipeline_depth: u32,
+    /// Pipeline depth of the generated design (does not change the error) [0..=2, default
+    /// as generate: 2].
+    #[arg(long, value_name = "N")]
+    pub pipeline_depth: Option<u32>,
     /// Valid/ready handshake on the generated top.
     #[arg(long)]
     pub handshake: bool,
@@ -73,7 +74,7 @@ pub fn run(a: &FitArgs) -> Result<()> {
     let base = Config {
         grad_bits: a.grad_bits,
         map_bits: a.map_bits,
-        pipeline_depth: a.pipeline_depth,
+        pipeline_depth: a.pipeline_depth.unwrap_or(Config::default().pipeline_depth),
         handshake: a.handshake,
         color: scene.color.is_some(),
         ..Config::default()

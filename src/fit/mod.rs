@@ -24,6 +24,7 @@ pub mod space;
 use crate::config::Config;
 use crate::model::map_fit::{self, MapFit};
 use crate::model::Maps;
+use crate::rtl::fpga;
 use crate::scene::Scene;
 use anyhow::{Context, Result};
 use measure::{Errors, Limits, TestImage};
@@ -541,40 +542,19 @@ fn best(
     ctx.candidate(&cands[i], e, target)
 }
 
-/// Cells of Yosys synthesis for the iCE40 (`synth_ice40`, as `make synth` runs it: memories
-/// in block RAM, each SB_RAM40_4K one cell) of a configuration's design with the scene's maps:
-/// the one place `fit` runs Yosys. `YOSYS` names the tool.
+/// Cells of Yosys synthesis for the iCE40 (`synth_ice40` through [`fpga::synth_ice40`], as
+/// `rmapgen fpga` runs it: memories in block RAM, each SB_RAM40_4K one cell) of a
+/// configuration's design with the scene's maps. `YOSYS` names the tool.
 pub fn cells(cfg: &Config, scene: &Scene) -> Result<u64> {
     let tmp = tempfile::tempdir().context("cannot create a synthesis directory")?;
-    let dir = tmp.path().join("design");
-    let out = crate::output::StagedDir::new(&dir)?;
-    crate::rtl::write_design(cfg, scene, &out)?;
-    out.commit()?;
-    let yosys = std::env::var("YOSYS").unwrap_or_else(|_| "yosys".into());
-    let run = std::process::Command::new(&yosys)
-        .current_dir(&dir)
-        .args([
-            "-q",
-            "-p",
-            "read_verilog *.v; hierarchy -check -top rmap_top; synth_ice40 -top rmap_top; tee -q -o cells.txt stat",
-        ])
-        .output()
-        .with_context(|| format!("cannot run {yosys}: --cost cells needs Yosys (make tools)"))?;
-    anyhow::ensure!(
-        run.status.success(),
-        "yosys failed on {}: {}",
-        cfg.summary(),
-        String::from_utf8_lossy(&run.stderr)
-            .lines()
-            .last()
-            .unwrap_or("")
-    );
-    let stat = std::fs::read_to_string(dir.join("cells.txt"))?;
-    stat.lines()
-        .rev()
-        .find_map(|l| l.trim().strip_prefix("Number of cells:"))
-        .and_then(|n| n.trim().parse().ok())
-        .with_context(|| format!("yosys printed no cell count for {}", cfg.summary()))
+    let out = crate::output::StagedDir::new(&tmp.path().join("design"))?;
+    let manifest = crate::rtl::write_design(cfg, scene, &out)?;
+    let dir = out.commit()?;
+    let files: Vec<String> = manifest.modules.iter().map(|m| m.file.clone()).collect();
+    let yosys = fpga::Options::default().yosys;
+    let stat = fpga::synth_ice40(&dir, "rmap_top", &files, tmp.path(), &yosys)
+        .with_context(|| format!("--cost cells: synthesis of {}", cfg.summary()))?;
+    Ok(stat.cells as u64)
 }
 
 impl Decision {

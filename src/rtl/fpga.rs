@@ -199,6 +199,86 @@ fn complaint(text: &str) -> String {
         .unwrap_or_else(|| "no output".into())
 }
 
+/// What Yosys's `synth_ice40` mapped the design to.
+#[derive(Clone, Debug, PartialEq)]
+pub struct YosysStat {
+    /// Every cell, each SB_RAM40_4K one.
+    pub cells: u32,
+    pub luts: u32,
+    pub carries: u32,
+    /// SB_DFF* of every kind.
+    pub flip_flops: u32,
+}
+
+/// Yosys `synth_ice40` of `top` from `files` in the generated directory `dir` (run there, so
+/// that `$readmemh` finds the hex files): the netlist `<top>.json`, `yosys.log` and the
+/// statistics go to `logs`. The one place rmapgen runs synth_ice40 (`rmapgen fpga`, bench,
+/// `fit --cost cells`).
+pub fn synth_ice40(
+    dir: &Path,
+    top: &str,
+    files: &[String],
+    logs: &Path,
+    yosys: &str,
+) -> Result<YosysStat> {
+    let json = logs.join(format!("{top}.json"));
+    let stat = logs.join("yosys_stat.txt");
+    let script = format!(
+        "read_verilog {}; synth_ice40 -top {top} -json {}; tee -q -o {} stat",
+        files.join(" "),
+        json.display(),
+        stat.display()
+    );
+    let run = Command::new(yosys)
+        .current_dir(dir)
+        .args(["-q", "-l"])
+        .arg(logs.join("yosys.log"))
+        .args(["-p", &script])
+        .output()
+        .with_context(|| format!("cannot run {yosys} (make tools installs it)"))?;
+    if !run.status.success() {
+        let log = std::fs::read_to_string(logs.join("yosys.log")).unwrap_or_default();
+        bail!(
+            "yosys synth_ice40 failed: {}",
+            complaint(&format!("{log}\n{}", String::from_utf8_lossy(&run.stderr)))
+        );
+    }
+    let stat_text = std::fs::read_to_string(&stat)?;
+    // The last count of each cell type: stat prints the top module last.
+    let count = |name: &str| -> u32 {
+        stat_text
+            .lines()
+            .rev()
+            .filter_map(|l| {
+                let mut w = l.split_whitespace();
+                let (a, b) = (w.next()?, w.next()?);
+                (a == name).then(|| b.parse::<u32>().ok())?
+            })
+            .next()
+            .unwrap_or(0)
+    };
+    let flip_flops: u32 = stat_text
+        .lines()
+        .filter_map(|l| {
+            let mut w = l.split_whitespace();
+            let (a, b) = (w.next()?, w.next()?);
+            a.starts_with("SB_DFF").then(|| b.parse::<u32>().ok())?
+        })
+        .sum();
+    let cells = stat_text
+        .lines()
+        .rev()
+        .find_map(|l| l.trim().strip_prefix("Number of cells:"))
+        .and_then(|n| n.trim().parse().ok())
+        .context("yosys printed no cell count")?;
+    Ok(YosysStat {
+        cells,
+        luts: count("SB_LUT4"),
+        carries: count("SB_CARRY"),
+        flip_flops,
+    })
+}
+
 /// Runs the flow on a generated directory (it needs `manifest.json` and the `.v` and `.hex`
 /// files `generate` writes there).
 pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
@@ -269,56 +349,7 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
         }
     };
     let json = logs.join(format!("{top}.json"));
-    let stat = logs.join("yosys_stat.txt");
-
-    // Yosys, from the design directory so that $readmemh finds the hex files.
-    let script = format!(
-        "read_verilog {}; synth_ice40 -top {top} -json {}; tee -q -o {} stat",
-        files.join(" "),
-        json.display(),
-        stat.display()
-    );
-    let run = Command::new(&opts.yosys)
-        .current_dir(dir)
-        .args(["-q", "-l"])
-        .arg(logs.join("yosys.log"))
-        .args(["-p", &script])
-        .output()
-        .with_context(|| format!("cannot run {} (make fpga installs it)", opts.yosys))?;
-    if !run.status.success() {
-        let log = std::fs::read_to_string(logs.join("yosys.log")).unwrap_or_default();
-        bail!(
-            "yosys synth_ice40 failed: {}",
-            complaint(&format!("{log}\n{}", String::from_utf8_lossy(&run.stderr)))
-        );
-    }
-    let stat_text = std::fs::read_to_string(&stat)?;
-    let count = |name: &str| -> u32 {
-        stat_text
-            .lines()
-            .rev()
-            .filter_map(|l| {
-                let mut w = l.split_whitespace();
-                let (a, b) = (w.next()?, w.next()?);
-                (a == name).then(|| b.parse::<u32>().ok())?
-            })
-            .next()
-            .unwrap_or(0)
-    };
-    let ffs: u32 = stat_text
-        .lines()
-        .filter_map(|l| {
-            let mut w = l.split_whitespace();
-            let (a, b) = (w.next()?, w.next()?);
-            a.starts_with("SB_DFF").then(|| b.parse::<u32>().ok())?
-        })
-        .sum();
-    let yosys_cells = stat_text
-        .lines()
-        .rev()
-        .find_map(|l| l.trim().strip_prefix("Number of cells:"))
-        .and_then(|n| n.trim().parse().ok())
-        .unwrap_or(0);
+    let stat = synth_ice40(dir, &top, &files, &logs, &opts.yosys)?;
 
     // Which block RAMs hold which memory: memory_bram names them <memory>.<row>.<column>.
     let netlist: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json)?)
@@ -448,10 +479,10 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
         logic_cells_available: util("ICESTORM_LC", "available"),
         block_rams: util("ICESTORM_RAM", "used"),
         block_rams_available: util("ICESTORM_RAM", "available"),
-        luts: count("SB_LUT4"),
-        carries: count("SB_CARRY"),
-        flip_flops: ffs,
-        yosys_cells,
+        luts: stat.luts,
+        carries: stat.carries,
+        flip_flops: stat.flip_flops,
+        yosys_cells: stat.cells,
         memories,
         critical_path,
     })

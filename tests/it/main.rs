@@ -3,6 +3,7 @@
 mod bench;
 mod cmd_render;
 mod fast;
+mod fit;
 mod grid;
 mod hdl;
 mod helpers;
