@@ -23,7 +23,7 @@ use crate::render::{self, metrics, sphere_gradients};
 use crate::rtl::fpga::{self, FpgaReport};
 use crate::scene::Scene;
 use crate::vectors::rng::SplitMix64;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use octahedral::Octahedral;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -76,6 +76,9 @@ pub struct Row {
     pub ice40_cells: Option<u32>,
     pub ice40_brams: Option<u32>,
     pub fmax_mhz: Option<f64>,
+    /// The flow ran and the design does not fit the HX8K (the cells, RAMs and Fmax are then
+    /// None).
+    pub ice40_too_big: bool,
     pub pareto_cost: bool,
     pub pareto_speed: bool,
 }
@@ -198,19 +201,32 @@ fn uniform(n: usize) -> Vec<[i32; 3]> {
         .collect()
 }
 
-/// The iCE40 figures of each configuration (in parallel, one flow per core), or None for all
-/// when Yosys or nextpnr-ice40 is missing.
-pub fn ice40_figures(configs: &[Config]) -> Result<Vec<Option<FpgaReport>>> {
+/// What the iCE40 flow gave for one configuration.
+#[derive(Clone, Debug)]
+pub enum Ice40 {
+    /// Yosys or nextpnr-ice40 is not installed (or the flow was not asked for).
+    NotRun,
+    /// The design needs more of the device than it has (nextpnr's complaint).
+    DoesNotFit(String),
+    Placed(Box<FpgaReport>),
+}
+
+/// The iCE40 figures of each configuration (in parallel, one flow per core); `NotRun` for
+/// all when Yosys or nextpnr-ice40 is missing. A design too big for the HX8K is a figure, any
+/// other failure an error.
+pub fn ice40_figures(configs: &[Config]) -> Result<Vec<Ice40>> {
     let opts = fpga::Options::default();
     if !fpga::tools_available(&opts) {
-        return Ok(vec![None; configs.len()]);
+        return Ok(vec![Ice40::NotRun; configs.len()]);
     }
     configs
         .par_iter()
-        .map(|c| {
-            fpga::ice40_report(c, &opts)
-                .map(Some)
-                .with_context(|| format!("iCE40 flow of {}", c.summary()))
+        .map(|c| match fpga::ice40_report(c, &opts) {
+            Ok(r) => Ok(Ice40::Placed(Box::new(r))),
+            Err(e) => match e.downcast_ref::<fpga::DoesNotFit>() {
+                Some(d) => Ok(Ice40::DoesNotFit(d.message.clone())),
+                None => Err(e.context(format!("iCE40 flow of {}", c.summary()))),
+            },
         })
         .collect()
 }
@@ -247,9 +263,13 @@ pub fn run(opts: &Options, progress: &dyn Fn(&str)) -> Result<Vec<Row>> {
         let cs: Vec<Config> = configs.iter().map(|c| c.1.clone()).collect();
         ice40_figures(&cs)?
     } else {
-        vec![None; configs.len()]
+        vec![Ice40::NotRun; configs.len()]
     };
     for ((design, cfg), fig) in configs.into_iter().zip(figures) {
+        let placed = match &fig {
+            Ice40::Placed(r) => Some(r.as_ref()),
+            _ => None,
+        };
         let model = Model::new(&cfg);
         let fast = FastShader::new(
             &model,
@@ -297,9 +317,10 @@ pub fn run(opts: &Options, progress: &dyn Fn(&str)) -> Result<Vec<Row>> {
                     map_build_us: build * 1e6,
                     rom_bits: cfg.rom_total_bits(),
                     map_bits: cfg.map_total_bits(),
-                    ice40_cells: fig.as_ref().map(|f| f.logic_cells),
-                    ice40_brams: fig.as_ref().map(|f| f.block_rams),
-                    fmax_mhz: fig.as_ref().map(|f| f.fmax_mhz),
+                    ice40_cells: placed.map(|f| f.logic_cells),
+                    ice40_brams: placed.map(|f| f.block_rams),
+                    fmax_mhz: placed.map(|f| f.fmax_mhz),
+                    ice40_too_big: matches!(fig, Ice40::DoesNotFit(_)),
                     pareto_cost: false,
                     pareto_speed: false,
                 });
@@ -351,6 +372,7 @@ pub fn run(opts: &Options, progress: &dyn Fn(&str)) -> Result<Vec<Row>> {
             ice40_cells: None,
             ice40_brams: None,
             fmax_mhz: None,
+            ice40_too_big: false,
             pareto_cost: false,
             pareto_speed: false,
         });
@@ -410,7 +432,11 @@ pub fn markdown(rows: &[Row]) -> String {
             r.float_ratio,
             r.map_build_us,
             r.bits(),
-            r.ice40_cells.map_or("-".into(), |c| c.to_string()),
+            if r.ice40_too_big {
+                "does not fit".into()
+            } else {
+                r.ice40_cells.map_or("-".into(), |c| c.to_string())
+            },
             r.ice40_brams.map_or("-".into(), |c| c.to_string()),
             r.fmax_mhz.map_or("-".into(), |f| format!("{f:.1}")),
             pareto
@@ -421,10 +447,10 @@ pub fn markdown(rows: &[Row]) -> String {
 
 /// The rows as CSV with a header line.
 pub fn csv(rows: &[Row]) -> String {
-    let mut s = String::from("scene,design,config,map_fit,entries,max_abs_error,rmse,psnr_db,msamples_1_thread,msamples_all_cores,float_ratio,map_build_us,rom_bits,map_bits,ice40_cells,ice40_brams,fmax_mhz,pareto_cost,pareto_speed\n");
+    let mut s = String::from("scene,design,config,map_fit,entries,max_abs_error,rmse,psnr_db,msamples_1_thread,msamples_all_cores,float_ratio,map_build_us,rom_bits,map_bits,ice40_cells,ice40_brams,fmax_mhz,ice40_too_big,pareto_cost,pareto_speed\n");
     for r in rows {
         s += &format!(
-            "{},{},\"{}\",{},{},{},{:.4},{:.3},{:.2},{:.2},{:.2},{:.1},{},{},{},{},{},{},{}\n",
+            "{},{},\"{}\",{},{},{},{:.4},{:.3},{:.2},{:.2},{:.2},{:.1},{},{},{},{},{},{},{},{}\n",
             r.scene,
             r.design,
             r.config,
@@ -442,6 +468,7 @@ pub fn csv(rows: &[Row]) -> String {
             r.ice40_cells.map_or(String::new(), |c| c.to_string()),
             r.ice40_brams.map_or(String::new(), |c| c.to_string()),
             r.fmax_mhz.map_or(String::new(), |f| format!("{f:.2}")),
+            r.ice40_too_big,
             r.pareto_cost,
             r.pareto_speed
         );

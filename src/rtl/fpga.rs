@@ -199,6 +199,15 @@ fn complaint(text: &str) -> String {
         .unwrap_or_else(|| "no output".into())
 }
 
+/// The design needs more of some resource (logic cells, block RAMs, pins) than the device
+/// has: an error a caller may tell apart (`anyhow::Error::downcast_ref`), for instance to
+/// report "does not fit" as a figure. The message is nextpnr's complaint.
+#[derive(Debug, thiserror::Error)]
+#[error("{message}")]
+pub struct DoesNotFit {
+    pub message: String,
+}
+
 /// What Yosys's `synth_ice40` mapped the design to.
 #[derive(Clone, Debug, PartialEq)]
 pub struct YosysStat {
@@ -410,13 +419,18 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
         String::from_utf8_lossy(&run.stderr)
     );
     if !run.status.success() {
-        bail!(
+        let message = format!(
             "{} --{} --package {}: {}",
             opts.nextpnr,
             opts.device,
             opts.package,
             complaint(&out)
         );
+        if out.contains("no BELs remaining") || out.contains("Unable to find a placement location")
+        {
+            return Err(DoesNotFit { message }.into());
+        }
+        bail!(message);
     }
     let log_text = std::fs::read_to_string(&log).unwrap_or(out);
     let fmax_line = log_text

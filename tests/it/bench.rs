@@ -22,6 +22,7 @@ fn row(scene: &str, bits: u64, speed: f64, rmse: f64) -> Row {
         map_bits: bits,
         ice40_cells: None,
         ice40_brams: None,
+        ice40_too_big: false,
         fmax_mhz: None,
         pareto_cost: false,
         pareto_speed: false,
@@ -57,7 +58,28 @@ fn pareto_fronts_per_scene() {
     assert!(md.lines().nth(2).unwrap().ends_with("| cost |"), "{md}");
     let csv = bench::csv(&rows);
     assert_eq!(csv.lines().count(), 1 + rows.len());
-    assert!(csv.lines().all(|l| l.split(',').count() == 19), "{csv}");
+    assert!(csv.lines().all(|l| l.split(',').count() == 20), "{csv}");
+}
+
+#[test]
+fn a_design_too_big_for_the_device_is_a_figure() {
+    let mut placed = row("s", 100, 1.0, 1.0);
+    placed.ice40_cells = Some(1714);
+    placed.ice40_brams = Some(11);
+    placed.fmax_mhz = Some(154.44);
+    let mut big = row("s", 200, 1.0, 0.5);
+    big.ice40_too_big = true;
+    let md = bench::markdown(&[placed.clone(), big.clone()]);
+    let lines: Vec<&str> = md.lines().collect();
+    assert!(lines[2].contains("| 1714 | 11 | 154.4 |"), "{md}");
+    assert!(lines[3].contains("| does not fit | - | - |"), "{md}");
+    let csv = bench::csv(&[placed, big]);
+    let last: Vec<&str> = csv.lines().last().unwrap().split(',').collect();
+    assert_eq!(
+        last[last.len() - 6..last.len() - 2],
+        ["", "", "", "true"],
+        "{csv}"
+    );
 }
 
 #[test]
