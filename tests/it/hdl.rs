@@ -11,6 +11,24 @@ use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+/// The narrowest widths every range allows, as `generate` flags.
+pub const NARROWEST: &[&str] = &[
+    "--grad-bits",
+    "8",
+    "--red-bits",
+    "6",
+    "--frac-bits",
+    "4",
+    "--recip-bits",
+    "5",
+    "--index-bits",
+    "2",
+    "--interp-bits",
+    "1",
+    "--map-bits",
+    "6",
+];
+
 /// Whether `tool` is on PATH; panics when it is not and CI=true.
 pub fn require(tool: &str) -> bool {
     let found = std::env::var_os("PATH")

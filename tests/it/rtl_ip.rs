@@ -29,24 +29,7 @@ fn every_depth_passes_every_testbench_under_icarus() {
     let configs: [&[&str]; 3] = [
         &["--pipeline-depth", "0", "--color"],
         &["--pipeline-depth", "1", "--no-compensation", "--color"],
-        &[
-            "--pipeline-depth",
-            "1",
-            "--grad-bits",
-            "8",
-            "--red-bits",
-            "6",
-            "--frac-bits",
-            "4",
-            "--recip-bits",
-            "5",
-            "--index-bits",
-            "2",
-            "--interp-bits",
-            "1",
-            "--map-bits",
-            "6",
-        ],
+        &[&["--pipeline-depth", "1"], hdl::NARROWEST].concat(),
     ];
     let mut latencies = Vec::new();
     for flags in configs {
@@ -245,23 +228,7 @@ fn fpga_fails_on_a_memory_in_logic_and_on_a_design_too_big() {
     // The narrow configuration's ROMs are small enough that Yosys would build them from LUTs
     // without the ram_style attribute.
     let dir = tmp.path().join("d");
-    let flags = [
-        "--grad-bits",
-        "8",
-        "--red-bits",
-        "6",
-        "--frac-bits",
-        "4",
-        "--recip-bits",
-        "5",
-        "--index-bits",
-        "2",
-        "--interp-bits",
-        "1",
-        "--map-bits",
-        "6",
-    ];
-    hdl::generate(&dir, &flags, 1);
+    hdl::generate(&dir, hdl::NARROWEST, 1);
     sabotage(
         &dir,
         "recip_rom.v",

@@ -39,22 +39,7 @@ fn every_testbench_passes_under_icarus() {
     let configs: [&[&str]; 3] = [
         &[],
         &["--no-compensation", "--no-interpolation", "--color"],
-        &[
-            "--grad-bits",
-            "8",
-            "--red-bits",
-            "6",
-            "--frac-bits",
-            "4",
-            "--recip-bits",
-            "5",
-            "--index-bits",
-            "2",
-            "--interp-bits",
-            "1",
-            "--map-bits",
-            "6",
-        ],
+        hdl::NARROWEST,
     ];
     for flags in configs {
         let tmp = helpers::tempdir();
