@@ -45,17 +45,7 @@ fn every_testbench_passes_under_icarus() {
         let tmp = helpers::tempdir();
         let dir = tmp.path().join("d");
         generate(&dir, flags);
-        let mut tbs: Vec<String> = std::fs::read_dir(dir.join("tb"))
-            .unwrap()
-            .filter_map(|e| {
-                e.unwrap()
-                    .file_name()
-                    .to_str()?
-                    .strip_suffix("_tb.v")
-                    .map(String::from)
-            })
-            .collect();
-        tbs.sort();
+        let tbs = hdl::testbenches(&dir);
         assert!(
             tbs.contains(&"rmap_top".to_string()) && tbs.len() >= 7,
             "{tbs:?}"
