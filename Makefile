@@ -29,10 +29,10 @@ tools:
 cargo-test:
 	$(CARGO) test
 
-# Only the $$readmemh files of the default design, refreshed in place in $(OUT).
+# Only the $$readmemh files of the default design, refreshed in place in $(OUT) (its other
+# files kept; refused if $(OUT) holds anything rmapgen did not write).
 roms: build
-	$(RMAPGEN) roms --out build/roms
-	cp build/roms/*.hex $(OUT)/
+	$(RMAPGEN) roms --update $(OUT)
 
 # Everything: cargo tests (model, golden rtl_out/, vectors, CLI errors, sampled stress), Verilator
 # lint, Yosys synthesis, and every testbench in Icarus and Verilator plus the 1M-vector harness.

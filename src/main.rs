@@ -51,6 +51,9 @@ enum Command {
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
+    // Staged output is removed on Ctrl-C, SIGTERM and SIGHUP (src/output/signals.rs).
+    rmapgen::output::signals::install()
+        .map_err(|e| anyhow::anyhow!("cannot install the signal handler: {e}"))?;
     match cli.command {
         Command::Generate(a) => cmd::generate::run(&a),
         Command::Roms(a) => cmd::roms::run(&a),

@@ -13,6 +13,8 @@ pub struct BenchArgs {
     /// Output directory for bench.md, bench.csv, bench.json and the plots (replaced whole).
     #[arg(long, value_name = "DIR", default_value = "out/bench")]
     pub out: PathBuf,
+    #[command(flatten)]
+    pub force: super::force::ForceArg,
     /// Sphere image side for the error figures [16..=4096].
     #[arg(long, value_name = "N", default_value_t = 512)]
     pub size: u32,
@@ -38,7 +40,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         "seconds {} is out of range; allowed (0, 60]",
         a.seconds
     );
-    let out = StagedDir::new(&a.out)?;
+    let out = StagedDir::new(&a.out, &a.force.policy(&[]))?;
     let opts = Options {
         size: a.size,
         seconds: a.seconds,

@@ -33,6 +33,8 @@ pub struct FitArgs {
     /// (replaced whole on success; nothing is written on failure).
     #[arg(long, value_name = "DIR", default_value = "out/fit")]
     pub out: PathBuf,
+    #[command(flatten)]
+    pub force: super::force::ForceArg,
     /// Gradient component width of the source (fixed, not searched) [8..=16].
     #[arg(long, value_name = "G", default_value_t = 12)]
     pub grad_bits: u32,
@@ -132,6 +134,7 @@ pub fn run(a: &FitArgs) -> Result<()> {
         cfg,
         &scene,
         &a.out,
+        &a.force.policy(&[Some(&a.scene)]),
         a.vectors,
         a.seed,
         &[("fit.json".to_string(), json)],

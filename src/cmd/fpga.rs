@@ -3,10 +3,11 @@
 //! a memory falls back to logic; a missed timing target is reported, not an error.
 
 use super::config_args::ConfigArgs;
+use crate::output::StagedDir;
 use crate::rtl::fpga::{self, Options};
 use anyhow::{Context, Result};
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
 pub struct FpgaArgs {
@@ -28,9 +29,12 @@ pub struct FpgaArgs {
     /// Placer seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Directory for the logs, netlist, bitstream text (.asc) and report.json.
+    /// Directory for the logs, netlist, bitstream text (.asc) and report.json (replaced whole,
+    /// also when the flow fails, so its logs can be read).
     #[arg(long, value_name = "DIR", default_value = "build/fpga")]
     pub logs: PathBuf,
+    #[command(flatten)]
+    pub force: super::force::ForceArg,
     /// Fail (exit 2) when the post-route Fmax is below --freq; without it a missed target is
     /// reported as a figure.
     #[arg(long)]
@@ -38,26 +42,14 @@ pub struct FpgaArgs {
 }
 
 pub fn run(a: &FpgaArgs) -> Result<()> {
-    let opts = Options {
-        device: a.device.clone(),
-        package: a.package.clone(),
-        freq_mhz: a.freq,
-        seed: a.seed,
-        logs: Some(a.logs.clone()),
-        ..Options::default()
-    };
-    let (what, report) = match &a.dir {
-        Some(d) => (d.display().to_string(), fpga::run_dir(d, &opts)?),
-        None => {
-            let cfg = a.cfg.resolve()?;
-            (cfg.summary(), fpga::ice40_report(&cfg, &opts)?)
-        }
-    };
-    print!("fpga: rmap_top of {what}\n{}", report.summary());
-    let json = serde_json::to_string_pretty(&report)?;
-    let path = a.logs.join("report.json");
-    std::fs::write(&path, json + "\n")
-        .with_context(|| format!("cannot write {}", path.display()))?;
+    let logs = StagedDir::new(
+        &a.logs,
+        &a.force.policy(&[a.dir.as_deref(), a.cfg.config.as_deref()]),
+    )?;
+    let result = flow(a, logs.path());
+    let dir = logs.commit()?;
+    let report = result?;
+    let path = dir.join("report.json");
     println!(
         "fpga: {} ({:.2} MHz, {} logic cells, {} block RAMs); report {}",
         if report.timing_met {
@@ -81,4 +73,29 @@ pub fn run(a: &FpgaArgs) -> Result<()> {
             .map_or("unknown".into(), |c| format!("{} -> {}", c.from, c.to))
     );
     Ok(())
+}
+
+/// Runs the flow with its logs in `logs` and writes report.json there.
+fn flow(a: &FpgaArgs, logs: &Path) -> Result<fpga::FpgaReport> {
+    let opts = Options {
+        device: a.device.clone(),
+        package: a.package.clone(),
+        freq_mhz: a.freq,
+        seed: a.seed,
+        logs: Some(logs.to_path_buf()),
+        ..Options::default()
+    };
+    let (what, report) = match &a.dir {
+        Some(d) => (d.display().to_string(), fpga::run_dir(d, &opts)?),
+        None => {
+            let cfg = a.cfg.resolve()?;
+            (cfg.summary(), fpga::ice40_report(&cfg, &opts)?)
+        }
+    };
+    print!("fpga: rmap_top of {what}\n{}", report.summary());
+    let json = serde_json::to_string_pretty(&report)?;
+    let path = logs.join("report.json");
+    std::fs::write(&path, json + "\n")
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(report)
 }

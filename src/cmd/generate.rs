@@ -4,7 +4,7 @@
 
 use super::config_args::ConfigArgs;
 use crate::config::Config;
-use crate::output::StagedDir;
+use crate::output::{Policy, StagedDir};
 use crate::rtl::Manifest;
 use crate::scene::Scene;
 use crate::vectors::MapSet;
@@ -23,6 +23,8 @@ pub struct GenerateArgs {
     /// Output directory (replaced whole on success).
     #[arg(long, value_name = "DIR", default_value = "rtl_out")]
     pub out: PathBuf,
+    #[command(flatten)]
+    pub force: super::force::ForceArg,
     /// Seeded random vectors per stage, after the hand-picked corner cases.
     #[arg(long, value_name = "N", default_value_t = 2000)]
     pub vectors: usize,
@@ -37,7 +39,10 @@ pub fn run(a: &GenerateArgs) -> Result<()> {
         Some(p) => Scene::from_toml_file(p)?,
         None => Scene::standard(),
     };
-    let (p, manifest) = write_dir(&cfg, &scene, &a.out, a.vectors, a.seed, &[])?;
+    let policy = a
+        .force
+        .policy(&[a.cfg.config.as_deref(), a.scene.as_deref()]);
+    let (p, manifest) = write_dir(&cfg, &scene, &a.out, &policy, a.vectors, a.seed, &[])?;
     eprintln!(
         "rmapgen: wrote {} ({} modules, latency {}, {} memory bits) to {}",
         cfg.summary(),
@@ -50,18 +55,19 @@ pub fn run(a: &GenerateArgs) -> Result<()> {
 }
 
 /// Everything `generate` writes for one validated configuration and scene, into `out`
-/// (replaced whole on success, untouched on failure), plus `extra` files (relative name,
+/// (replaced whole on success as `policy` allows, untouched on failure), plus `extra` files (relative name,
 /// text) beside them. `rmapgen fit` writes its chosen design through this too. Returns the
 /// directory and the manifest.
 pub fn write_dir(
     cfg: &Config,
     scene: &Scene,
     out: &Path,
+    policy: &Policy,
     vectors: usize,
     seed: u64,
     extra: &[(String, String)],
 ) -> Result<(PathBuf, Manifest)> {
-    let out = StagedDir::new(out)?;
+    let out = StagedDir::new(out, policy)?;
     let manifest = rtl::write_design(cfg, scene, &out)?;
     // The vectors see the same maps as the design: this scene's, and the alternate scene's
     // that testbenches load through the host port.

@@ -3,6 +3,7 @@
 pub mod bench;
 pub mod config_args;
 pub mod fit;
+pub mod force;
 pub mod fpga;
 pub mod generate;
 pub mod render;

@@ -30,6 +30,8 @@ pub struct RenderArgs {
     /// whole on success).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
+    #[command(flatten)]
+    pub force: super::force::ForceArg,
 }
 
 pub fn run(a: &RenderArgs) -> Result<()> {
@@ -43,7 +45,10 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         shrink: a.shrink,
     };
     options.validate(&cfg)?;
-    let out = StagedDir::new(&a.out)?;
+    let policy = a
+        .force
+        .policy(&[a.cfg.config.as_deref(), a.scene.as_deref()]);
+    let out = StagedDir::new(&a.out, &policy)?;
     let rtl = if a.rtl {
         Some(crate::rtl::verilated::VerilatedTop::build(&cfg, &scene)?)
     } else {

@@ -3,6 +3,7 @@
 use super::config_args::ConfigArgs;
 use crate::output::StagedDir;
 use crate::scene::Scene;
+use anyhow::Context;
 use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
@@ -19,7 +20,18 @@ pub struct RomsArgs {
     pub map_fit: Option<crate::model::map_fit::MapFit>,
     /// Output directory (replaced whole on success).
     #[arg(long, value_name = "DIR")]
-    pub out: PathBuf,
+    pub out: Option<PathBuf>,
+    #[command(flatten)]
+    pub force: super::force::ForceArg,
+    /// Refresh only the hex files of the generated directory DIR, keeping its other files
+    /// (`make roms`); DIR must hold only what rmapgen wrote there.
+    #[arg(
+        long,
+        value_name = "DIR",
+        conflicts_with = "out",
+        required_unless_present = "out"
+    )]
+    pub update: Option<PathBuf>,
 }
 
 pub fn run(a: &RomsArgs) -> Result<()> {
@@ -31,9 +43,27 @@ pub fn run(a: &RomsArgs) -> Result<()> {
     if let Some(f) = a.map_fit {
         scene.map_fit = f;
     }
-    let out = StagedDir::new(&a.out)?;
+    let target = a
+        .out
+        .as_ref()
+        .or(a.update.as_ref())
+        .context("--out or --update")?;
+    let policy = a
+        .force
+        .policy(&[a.cfg.config.as_deref(), a.scene.as_deref()]);
+    if a.update.is_some() && crate::output::stamp::read(target).is_none() {
+        anyhow::bail!(
+            "--update {}: not a directory rmapgen generated (it has no {})",
+            target.display(),
+            crate::output::stamp::NAME
+        );
+    }
+    let out = StagedDir::new(target, &policy)?;
     for (name, text) in crate::rtl::hex_files(&cfg, &scene) {
         out.write_text(&name, &text)?;
+    }
+    if a.update.is_some() {
+        out.keep_others()?;
     }
     let p = out.commit()?;
     eprintln!("rmapgen: wrote ROM and map hex files to {}", p.display());

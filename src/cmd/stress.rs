@@ -3,6 +3,7 @@
 
 use super::config_args::ConfigArgs;
 use crate::hexfile;
+use crate::output::StagedFile;
 use crate::scene::Scene;
 use crate::stress::{self, exhaustive, Report, Setup};
 use anyhow::{Context, Result};
@@ -32,6 +33,8 @@ pub struct StressArgs {
     /// Also write the full report as JSON.
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
+    #[command(flatten)]
+    pub force: super::force::ForceArg,
 }
 
 pub fn run(a: &StressArgs) -> Result<()> {
@@ -43,6 +46,16 @@ pub fn run(a: &StressArgs) -> Result<()> {
     if let Some(f) = a.map_fit {
         scene.map_fit = f;
     }
+    // Claimed before the run, so a refused path fails at once rather than after it.
+    let json = match &a.json {
+        Some(p) => Some(StagedFile::new(
+            p,
+            &a.force
+                .policy(&[a.cfg.config.as_deref(), a.scene.as_deref()]),
+            stress::is_report_json,
+        )?),
+        None => None,
+    };
     let setup = Setup::new(&cfg, &scene, hexfile::scene_maps(&cfg, &scene));
     let report = if a.exhaustive {
         let bar = ProgressBar::new(1u64 << (3 * cfg.grad_bits.min(exhaustive::MAX_GRAD_BITS)));
@@ -60,9 +73,11 @@ pub fn run(a: &StressArgs) -> Result<()> {
         stress::sampled(&setup, a.samples, a.seed)
     };
     print!("{}", summary(&report));
-    if let Some(p) = &a.json {
+    if let Some(out) = json {
         let text = serde_json::to_string_pretty(&report)?;
-        std::fs::write(p, text + "\n").with_context(|| format!("cannot write {}", p.display()))?;
+        std::fs::write(out.path(), text + "\n")
+            .with_context(|| format!("cannot write {}", out.path().display()))?;
+        out.commit()?;
     }
     anyhow::ensure!(
         report.mismatches == 0,

@@ -2,9 +2,10 @@
 //! Verilator C++ harness `tb/top_stream.cpp`, which checks millions of samples per run.
 
 use super::config_args::ConfigArgs;
+use crate::output::StagedFile;
 use crate::scene::Scene;
 use crate::vectors::{self, MapSet};
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -29,6 +30,8 @@ pub struct VectorsArgs {
     /// Vector file to write (replaced only when complete).
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
+    #[command(flatten)]
+    pub force: super::force::ForceArg,
 }
 
 pub fn run(a: &VectorsArgs) -> Result<()> {
@@ -40,24 +43,14 @@ pub fn run(a: &VectorsArgs) -> Result<()> {
         }
         (None, None) => MapSet::standard(&cfg),
     };
-    let name = a
-        .out
-        .file_name()
-        .with_context(|| format!("{} is not a file name", a.out.display()))?;
-    let partial = a.out.with_file_name(format!(
-        ".{}.partial-{}",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    let n = match vectors::write_top_stream(&cfg, &maps, &partial, a.count, a.seed) {
-        Ok(n) => n,
-        Err(e) => {
-            std::fs::remove_file(&partial).ok();
-            return Err(e);
-        }
-    };
-    std::fs::rename(&partial, &a.out)
-        .with_context(|| format!("cannot write {}", a.out.display()))?;
+    let policy = a.force.policy(&[
+        a.cfg.config.as_deref(),
+        a.scene.as_deref(),
+        a.maps.as_deref(),
+    ]);
+    let out = StagedFile::new(&a.out, &policy, vectors::is_vector_stream)?;
+    let n = vectors::write_top_stream(&cfg, &maps, out.path(), a.count, a.seed)?;
+    out.commit()?;
     eprintln!(
         "rmapgen: wrote {n} top vectors ({}) to {}",
         cfg.summary(),

@@ -87,6 +87,8 @@ pub struct VolumeArgs {
     /// whole on success).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
+    #[command(flatten)]
+    pub force: super::force::ForceArg,
 }
 
 /// Parses `X,Y,Z` into three numbers.
@@ -303,7 +305,12 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
     let vol = volume(a)?;
     let load_ms = t.elapsed().as_secs_f64() * 1e3;
 
-    let out = StagedDir::new(&a.out)?;
+    let policy = a.force.policy(&[
+        a.cfg.config.as_deref(),
+        a.scene.as_deref(),
+        a.input.as_deref(),
+    ]);
+    let out = StagedDir::new(&a.out, &policy)?;
     let t = Instant::now();
     let p = Prepared::new(&vol, cfg.grad_bits, opts.brick);
     let prepare_ms = t.elapsed().as_secs_f64() * 1e3;

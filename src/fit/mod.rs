@@ -546,8 +546,8 @@ fn best(
 /// `rmapgen fpga` runs it: memories in block RAM, each SB_RAM40_4K one cell) of a
 /// configuration's design with the scene's maps. `YOSYS` names the tool.
 pub fn cells(cfg: &Config, scene: &Scene) -> Result<u64> {
-    let tmp = tempfile::tempdir().context("cannot create a synthesis directory")?;
-    let out = crate::output::StagedDir::new(&tmp.path().join("design"))?;
+    let tmp = crate::output::Scratch::new()?;
+    let out = crate::output::StagedDir::new(&tmp.path().join("design"), &Default::default())?;
     let manifest = crate::rtl::write_design(cfg, scene, &out)?;
     let dir = out.commit()?;
     let files: Vec<String> = manifest.modules.iter().map(|m| m.file.clone()).collect();

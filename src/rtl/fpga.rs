@@ -160,8 +160,8 @@ pub fn tools_available(opts: &Options) -> bool {
 /// the flow on it.
 pub fn ice40_report(cfg: &Config, opts: &Options) -> Result<FpgaReport> {
     cfg.validate()?;
-    let tmp = tempfile::tempdir().context("cannot make a temporary directory")?;
-    let out = StagedDir::new(&tmp.path().join("rtl"))?;
+    let tmp = crate::output::Scratch::new()?;
+    let out = StagedDir::new(&tmp.path().join("rtl"), &Default::default())?;
     super::write_design(cfg, &Scene::standard(), &out)?;
     let dir = out.commit()?;
     run_dir(&dir, opts)
@@ -353,7 +353,7 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
             p.canonicalize()?
         }
         None => {
-            tmp = tempfile::tempdir().context("cannot make a temporary directory")?;
+            tmp = crate::output::Scratch::new()?;
             tmp.path().to_path_buf()
         }
     };

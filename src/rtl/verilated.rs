@@ -16,7 +16,7 @@ const HARNESS: &str = include_str!("../../tb/top_apply.cpp");
 /// A Verilated `rmap_top` with the scene's map in its RAM (both buffers).
 pub struct VerilatedTop {
     cfg: Config,
-    _dir: tempfile::TempDir,
+    _dir: crate::output::Scratch,
     design: PathBuf,
     exe: PathBuf,
 }
@@ -48,9 +48,9 @@ fn run_tool(cmd: &mut Command, what: &str) -> Result<()> {
 impl VerilatedTop {
     /// Generates the design for `cfg` with `scene`'s map and builds it with Verilator.
     pub fn build(cfg: &Config, scene: &Scene) -> Result<VerilatedTop> {
-        let dir = tempfile::tempdir().context("cannot create a build directory")?;
+        let dir = crate::output::Scratch::new()?;
         let design = dir.path().join("design");
-        let staged = StagedDir::new(&design)?;
+        let staged = StagedDir::new(&design, &Default::default())?;
         super::write_design(cfg, scene, &staged)?;
         crate::tb::write_all(cfg, &staged)?;
         staged.commit()?;

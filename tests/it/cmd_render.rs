@@ -39,7 +39,13 @@ fn writes_images_and_metrics() {
     );
     assert_eq!(
         entries(&out),
-        ["error50.png", "metrics.json", "model.png", "reference.png"]
+        [
+            ".rmapgen-files",
+            "error50.png",
+            "metrics.json",
+            "model.png",
+            "reference.png"
+        ]
     );
     assert_eq!(entries(tmp.path()), ["sphere"], "no staging directory left");
     for name in ["error50.png", "model.png", "reference.png"] {

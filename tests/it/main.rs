@@ -10,6 +10,7 @@ mod helpers;
 mod hexfile;
 mod map_fit;
 mod model_stages;
+mod output_safety;
 mod render;
 mod rtl_generate;
 mod rtl_in_loop;

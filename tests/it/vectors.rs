@@ -53,7 +53,7 @@ fn configs() -> Vec<Config> {
 fn write(cfg: &Config, random: usize, seed: u64) -> (tempfile::TempDir, std::path::PathBuf) {
     let tmp = helpers::tempdir();
     let target = tmp.path().join("out");
-    let out = StagedDir::new(&target).unwrap();
+    let out = StagedDir::new(&target, &Default::default()).unwrap();
     vectors::write_all(cfg, &out, random, seed).unwrap();
     out.commit().unwrap();
     (tmp, target)

@@ -50,7 +50,13 @@ fn synthetic_writes_images_and_metrics() {
     );
     assert_eq!(
         entries(&out),
-        ["error50.png", "metrics.json", "model.png", "reference.png"]
+        [
+            ".rmapgen-files",
+            "error50.png",
+            "metrics.json",
+            "model.png",
+            "reference.png"
+        ]
     );
     assert_eq!(entries(tmp.path()), ["v"], "no staging directory left");
     for name in ["error50.png", "model.png", "reference.png"] {
@@ -184,6 +190,10 @@ fn skipping_off_gives_the_same_files_and_timing_reports() {
         assert!(t[k]["median_ms"].as_f64().unwrap() > 0.0, "{k}");
     }
     assert!(t["skipped_fraction"].as_f64().unwrap() > 0.5);
+    // The stamps list different files; everything else must agree.
+    for d in [&on, &timed] {
+        std::fs::remove_file(d.join(".rmapgen-files")).unwrap();
+    }
     assert_eq!(
         first_difference(&on, &timed).unwrap(),
         format!(

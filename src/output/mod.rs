@@ -1,0 +1,347 @@
+//! Output that appears whole or not at all, and never at the cost of a user's files.
+//!
+//! Every command writes into a staging directory (or a `.partial` file) beside its target,
+//! which replaces the target only when the command succeeds; a failing command leaves the
+//! target as it was and removes what it staged. Before anything is replaced, [`Policy`]
+//! checks that the target holds only what rmapgen wrote there (the [`stamp`] every output
+//! directory carries), that it is not the current directory or one of its ancestors, and that
+//! it holds none of the command's inputs. [`signals`] removes staged output on SIGINT,
+//! SIGTERM and SIGHUP.
+
+mod policy;
+pub mod signals;
+pub mod stamp;
+
+pub use policy::{absolute, Policy};
+
+use anyhow::{Context, Result};
+use signals::{Token, Undo};
+use std::path::{Path, PathBuf};
+
+/// Marks a staging directory as rmapgen's while it is being written; removed before commit.
+const STAGING_MARK: &str = ".rmapgen-staging";
+
+pub struct StagedDir {
+    target: PathBuf,
+    staging: PathBuf,
+    policy: Policy,
+    token: Option<Token>,
+    created: CreatedParents,
+}
+
+impl StagedDir {
+    /// Starts writing directory `target` under `policy`. Fails at once, before any work, if
+    /// the policy refuses the target or its parent is not writable.
+    pub fn new(target: &Path, policy: &Policy) -> Result<StagedDir> {
+        policy.check_dir(target)?;
+        let name = target
+            .file_name()
+            .with_context(|| format!("output path {} has no directory name", target.display()))?
+            .to_string_lossy()
+            .into_owned();
+        let parent = parent_of(target);
+        let created = CreatedParents::make(&parent)
+            .with_context(|| format!("cannot write output directory {}", target.display()))?;
+        remove_stale(&parent, &format!(".{name}.staging-"));
+        let staging = parent.join(format!(".{name}.staging-{}", std::process::id()));
+        let token = signals::register(Undo::Remove(staging.clone()));
+        let made = std::fs::create_dir(&staging)
+            .and_then(|()| std::fs::write(staging.join(STAGING_MARK), b""));
+        let dir = StagedDir {
+            target: target.to_path_buf(),
+            staging,
+            policy: policy.clone(),
+            token: Some(token),
+            created,
+        };
+        made.with_context(|| format!("cannot write output directory {}", target.display()))?;
+        Ok(dir)
+    }
+
+    /// Where to write files now.
+    pub fn path(&self) -> &Path {
+        &self.staging
+    }
+
+    /// Writes one file (relative path; parents created), adding a final newline if missing.
+    pub fn write_text(&self, rel: &str, text: &str) -> Result<()> {
+        let mut t = text.to_string();
+        if !t.ends_with('\n') {
+            t.push('\n');
+        }
+        self.write_bytes(rel, t.as_bytes())
+    }
+
+    pub fn write_bytes(&self, rel: &str, bytes: &[u8]) -> Result<()> {
+        let p = self.staging.join(rel);
+        // Held so an interrupt cannot remove the staging directory under a half-made file
+        // (create_dir_all would bring it back after the cleanup).
+        let _held = signals::hold();
+        if let Some(d) = p.parent() {
+            std::fs::create_dir_all(d).with_context(|| format!("cannot create {}", d.display()))?;
+        }
+        std::fs::write(&p, bytes).with_context(|| format!("cannot write {}", p.display()))
+    }
+
+    /// Copies into the staging directory every file of the existing target that this run
+    /// has not written, so a command can refresh some files of an output in place.
+    pub fn keep_others(&self) -> Result<()> {
+        self.policy.check_dir(&self.target)?;
+        let Some(old) = stamp::read(&self.target) else {
+            return Ok(());
+        };
+        for rel in old.keys() {
+            let to = self.staging.join(rel);
+            if !to.exists() {
+                let from = self.target.join(rel);
+                let bytes = std::fs::read(&from)
+                    .with_context(|| format!("cannot read {}", from.display()))?;
+                self.write_bytes(rel, &bytes)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Replaces the target with the staging directory, stamped with what it holds. The
+    /// target is checked again first: files may have appeared in it since [`StagedDir::new`].
+    pub fn commit(mut self) -> Result<PathBuf> {
+        self.policy.check_dir(&self.target)?;
+        let shown = self.target.display().to_string();
+        std::fs::remove_file(self.staging.join(STAGING_MARK))
+            .with_context(|| format!("cannot finish {shown}"))?;
+        stamp::write(&self.staging).with_context(|| format!("cannot finish {shown}"))?;
+        let old = self.staging.with_extension("old");
+        let token = self.token.take().expect("registered until commit");
+        {
+            // Both renames under one hold: an interrupt sees the old output or the new one.
+            let mut held = signals::hold();
+            if self.target.exists() {
+                if let Err(e) = std::fs::rename(&self.target, &old) {
+                    self.token = Some(token);
+                    return Err(e).with_context(|| format!("cannot replace {shown}"));
+                }
+                held.replace(
+                    &token,
+                    Undo::Restore {
+                        from: old.clone(),
+                        to: self.target.clone(),
+                    },
+                );
+            }
+            if let Err(e) = std::fs::rename(&self.staging, &self.target) {
+                if old.exists() {
+                    std::fs::rename(&old, &self.target).ok();
+                }
+                held.replace(&token, Undo::Remove(self.staging.clone()));
+                self.token = Some(token);
+                return Err(e).with_context(|| format!("cannot move output into {shown}"));
+            }
+            held.replace(&token, Undo::Remove(old.clone()));
+        }
+        // The old output passed the policy: everything in it was rmapgen's (or forced).
+        if old.exists() {
+            std::fs::remove_dir_all(&old).ok();
+        }
+        token.release();
+        self.created.keep();
+        Ok(self.target.clone())
+    }
+}
+
+impl Drop for StagedDir {
+    fn drop(&mut self) {
+        if let Some(token) = self.token.take() {
+            std::fs::remove_dir_all(&self.staging).ok();
+            token.release();
+        }
+    }
+}
+
+/// One output file that appears whole or not at all: written as `.NAME.partial-PID` beside
+/// the target and renamed over it on [`StagedFile::commit`].
+pub struct StagedFile {
+    target: PathBuf,
+    partial: PathBuf,
+    policy: Policy,
+    ours: fn(&[u8]) -> bool,
+    token: Option<Token>,
+    created: CreatedParents,
+}
+
+impl StagedFile {
+    /// Starts writing file `target` under `policy`; `ours` recognises (from its first bytes)
+    /// a file of this kind that rmapgen wrote, which may be replaced without `--force`.
+    pub fn new(target: &Path, policy: &Policy, ours: fn(&[u8]) -> bool) -> Result<StagedFile> {
+        policy.check_file(target, ours)?;
+        let name = target
+            .file_name()
+            .with_context(|| format!("output path {} has no file name", target.display()))?
+            .to_string_lossy()
+            .into_owned();
+        let parent = parent_of(target);
+        let created = CreatedParents::make(&parent)
+            .with_context(|| format!("cannot write {}", target.display()))?;
+        remove_stale(&parent, &format!(".{name}.partial-"));
+        let partial = parent.join(format!(".{name}.partial-{}", std::process::id()));
+        let token = signals::register(Undo::Remove(partial.clone()));
+        Ok(StagedFile {
+            target: target.to_path_buf(),
+            partial,
+            policy: policy.clone(),
+            ours,
+            token: Some(token),
+            created,
+        })
+    }
+
+    /// Where to write the file now.
+    pub fn path(&self) -> &Path {
+        &self.partial
+    }
+
+    /// Renames the finished file over the target (checked again first).
+    pub fn commit(mut self) -> Result<PathBuf> {
+        self.policy.check_file(&self.target, self.ours)?;
+        {
+            let _held = signals::hold();
+            std::fs::rename(&self.partial, &self.target)
+                .with_context(|| format!("cannot write {}", self.target.display()))?;
+        }
+        if let Some(t) = self.token.take() {
+            t.release();
+        }
+        self.created.keep();
+        Ok(self.target.clone())
+    }
+}
+
+impl Drop for StagedFile {
+    fn drop(&mut self) {
+        if let Some(token) = self.token.take() {
+            std::fs::remove_file(&self.partial).ok();
+            token.release();
+        }
+    }
+}
+
+/// A temporary directory (synthesis runs, Verilator builds) that an interrupt removes too.
+pub struct Scratch {
+    dir: tempfile::TempDir,
+    token: Option<Token>,
+}
+
+impl Scratch {
+    pub fn new() -> Result<Scratch> {
+        let dir = tempfile::Builder::new()
+            .prefix("rmapgen-")
+            .tempdir()
+            .context("cannot make a temporary directory")?;
+        let token = signals::register(Undo::Remove(dir.path().to_path_buf()));
+        Ok(Scratch {
+            dir,
+            token: Some(token),
+        })
+    }
+
+    pub fn path(&self) -> &Path {
+        self.dir.path()
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        // TempDir removes the directory after this; the registration goes first so an
+        // interrupt never races it.
+        if let Some(t) = self.token.take() {
+            t.release();
+        }
+    }
+}
+
+/// The directory an output goes into ("." for a bare name).
+fn parent_of(target: &Path) -> PathBuf {
+    match target.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// The parent directories an output needed that did not exist, made now and removed again
+/// (if still empty) when the command fails or is interrupted.
+struct CreatedParents {
+    dirs: Vec<(PathBuf, Token)>,
+}
+
+impl CreatedParents {
+    fn make(parent: &Path) -> std::io::Result<CreatedParents> {
+        let mut missing = Vec::new();
+        let mut p = Some(parent);
+        while let Some(d) = p.filter(|d| !d.as_os_str().is_empty() && !d.exists()) {
+            missing.push(d.to_path_buf());
+            p = d.parent();
+        }
+        let mut made = CreatedParents { dirs: Vec::new() };
+        for d in missing.into_iter().rev() {
+            let token = signals::register(Undo::RemoveIfEmpty(d.clone()));
+            std::fs::create_dir(&d)?;
+            made.dirs.push((d, token));
+        }
+        Ok(made)
+    }
+
+    /// The output is in place: its parents stay.
+    fn keep(&mut self) {
+        for (_, t) in self.dirs.drain(..) {
+            t.release();
+        }
+    }
+}
+
+impl Drop for CreatedParents {
+    fn drop(&mut self) {
+        for (d, t) in self.dirs.drain(..).rev() {
+            std::fs::remove_dir(&d).ok();
+            t.release();
+        }
+    }
+}
+
+/// Removes leftovers of runs that were killed outright (SIGKILL, power loss): entries of
+/// `parent` named `<prefix><pid>` (or `<prefix><pid>.old`) whose process no longer exists.
+/// A staging directory counts only if it still carries rmapgen's staging mark.
+fn remove_stale(parent: &Path, prefix: &str) {
+    let Ok(entries) = std::fs::read_dir(parent) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let Some(rest) = name.strip_prefix(prefix) else {
+            continue;
+        };
+        let pid = rest.strip_suffix(".old").unwrap_or(rest);
+        if pid.is_empty() || !pid.bytes().all(|b| b.is_ascii_digit()) || process_alive(pid) {
+            continue;
+        }
+        let p = e.path();
+        match std::fs::symlink_metadata(&p) {
+            Ok(m) if m.is_dir() && stamp_or_mark(&p) => {
+                std::fs::remove_dir_all(&p).ok();
+            }
+            Ok(m) if m.is_file() => {
+                std::fs::remove_file(&p).ok();
+            }
+            _ => {}
+        }
+    }
+}
+
+/// A leftover directory is rmapgen's if it has the staging mark or (a moved-aside old
+/// output) a stamp.
+fn stamp_or_mark(p: &Path) -> bool {
+    p.join(STAGING_MARK).is_file() || stamp::read(p).is_some()
+}
+
+fn process_alive(pid: &str) -> bool {
+    // Where /proc is missing, assume alive: never remove what might still be in use.
+    !Path::new("/proc/self").exists() || Path::new("/proc").join(pid).exists()
+}

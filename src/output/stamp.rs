@@ -1,0 +1,140 @@
+//! The stamp file: the record, in every directory rmapgen writes, of each file it wrote there
+//! and its SHA-256. It is what lets a later run replace the directory safely: an entry the
+//! stamp does not list, or a file whose bytes changed since, was not written by rmapgen.
+//!
+//! The format is `sha256sum`'s (`<hex digest>  <relative path>`, one file a line, sorted), so a
+//! user can check a design with `sha256sum -c .rmapgen-files` inside it.
+
+use anyhow::{Context, Result};
+use sha2::{Digest, Sha256};
+use std::collections::BTreeMap;
+use std::io::Read;
+use std::path::Path;
+
+/// The stamp's file name, inside the directory it describes.
+pub const NAME: &str = ".rmapgen-files";
+
+/// The stamp's largest accepted size: a stamp lists at most a few thousand files, so anything
+/// much bigger is not one (and is not read whole into memory).
+const MAX_BYTES: u64 = 16 << 20;
+
+/// Relative path ('/'-separated) to hex SHA-256.
+pub type Stamp = BTreeMap<String, String>;
+
+/// The SHA-256 of a file, as lower-case hex.
+pub fn digest(path: &Path) -> Result<String> {
+    let mut f =
+        std::fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let mut h = Sha256::new();
+    let mut buf = vec![0u8; 1 << 16];
+    loop {
+        let n = f
+            .read(&mut buf)
+            .with_context(|| format!("cannot read {}", path.display()))?;
+        if n == 0 {
+            break;
+        }
+        h.update(&buf[..n]);
+    }
+    Ok(h.finalize().iter().map(|b| format!("{b:02x}")).collect())
+}
+
+/// The stamp of directory `dir`, or None when it has none or it is not a well-formed stamp
+/// (then no entry of `dir` counts as written by rmapgen).
+pub fn read(dir: &Path) -> Option<Stamp> {
+    let p = dir.join(NAME);
+    let meta = std::fs::symlink_metadata(&p).ok()?;
+    if !meta.is_file() || meta.len() > MAX_BYTES {
+        return None;
+    }
+    let text = std::fs::read_to_string(&p).ok()?;
+    let mut stamp = Stamp::new();
+    for line in text.lines() {
+        let (hash, rel) = line.split_once("  ")?;
+        let well_formed = hash.len() == 64
+            && hash.bytes().all(|b| b.is_ascii_hexdigit())
+            && !rel.is_empty()
+            && rel
+                .split('/')
+                .all(|c| !c.is_empty() && c != "." && c != "..");
+        if !well_formed {
+            return None;
+        }
+        stamp.insert(rel.to_string(), hash.to_string());
+    }
+    Some(stamp)
+}
+
+/// Writes the stamp of every file under `dir` (which rmapgen has just written whole).
+pub fn write(dir: &Path) -> Result<()> {
+    let mut files = Vec::new();
+    walk(dir, "", &mut files)?;
+    let mut text = String::new();
+    for rel in files.iter().filter(|r| r.as_str() != NAME) {
+        let hash = digest(&dir.join(rel))?;
+        text.push_str(&format!("{hash}  {rel}\n"));
+    }
+    let p = dir.join(NAME);
+    std::fs::write(&p, text).with_context(|| format!("cannot write {}", p.display()))
+}
+
+/// Every file under `dir`, relative and '/'-separated, in sorted order.
+fn walk(dir: &Path, prefix: &str, out: &mut Vec<String>) -> Result<()> {
+    for (name, ty) in sorted_entries(dir)? {
+        let rel = format!("{prefix}{name}");
+        if ty.is_dir() {
+            walk(&dir.join(&name), &format!("{rel}/"), out)?;
+        } else {
+            out.push(rel);
+        }
+    }
+    Ok(())
+}
+
+/// The entries of a directory with their types (symbolic links not followed), sorted by name.
+pub fn sorted_entries(dir: &Path) -> Result<Vec<(String, std::fs::FileType)>> {
+    let mut v = Vec::new();
+    for e in std::fs::read_dir(dir).with_context(|| format!("cannot read {}", dir.display()))? {
+        let e = e.with_context(|| format!("cannot read {}", dir.display()))?;
+        let ty = e
+            .file_type()
+            .with_context(|| format!("cannot read {}", e.path().display()))?;
+        v.push((e.file_name().to_string_lossy().into_owned(), ty));
+    }
+    v.sort_by(|a, b| a.0.cmp(&b.0));
+    Ok(v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trip_lists_every_file_with_its_digest() {
+        let d = tempfile::tempdir().unwrap();
+        std::fs::create_dir(d.path().join("tb")).unwrap();
+        std::fs::write(d.path().join("a.v"), "module a;\n").unwrap();
+        std::fs::write(d.path().join("tb/b.hex"), "00\n").unwrap();
+        write(d.path()).unwrap();
+        let s = read(d.path()).expect("a stamp");
+        assert_eq!(s.keys().collect::<Vec<_>>(), ["a.v", "tb/b.hex"]);
+        // sha256("00\n")
+        assert_eq!(
+            s["tb/b.hex"],
+            "d9b2aefb1febe2dd6e403f634e18917a8c0dd1a440c976e9fe126b465ae9fc8d"
+        );
+    }
+
+    #[test]
+    fn a_malformed_stamp_is_no_stamp() {
+        let d = tempfile::tempdir().unwrap();
+        for bad in [
+            "notes about my design\n",
+            "abc  a.v\n",
+            &format!("{}  ../x\n", "0".repeat(64)),
+        ] {
+            std::fs::write(d.path().join(NAME), bad).unwrap();
+            assert!(read(d.path()).is_none(), "{bad:?}");
+        }
+    }
+}

@@ -1,0 +1,490 @@
+//! Output directories and files (src/output): rmapgen replaces only what it wrote, never the
+//! current directory, its ancestors or a directory holding an input, and an interrupted run
+//! leaves nothing behind.
+
+use crate::helpers::{self, assert_error, first_difference, tempdir, tree};
+use std::os::unix::process::ExitStatusExt;
+use std::path::Path;
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+/// rmapgen run with `dir` as the working directory.
+fn run_in(dir: &Path, args: &[&str]) -> Output {
+    helpers::rmapgen()
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("rmapgen runs")
+}
+
+fn ok(out: &Output) {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// A user's folder of notes, and a snapshot of it to compare after.
+fn notes(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
+    std::fs::create_dir_all(dir.join("sub")).unwrap();
+    std::fs::write(dir.join("todo.txt"), "buy solder\n").unwrap();
+    std::fs::write(dir.join("sub/plan.md"), "# plan\n").unwrap();
+    tree(dir)
+}
+
+/// Nothing but `names` in `dir` (no staging directories or partial files beside an output).
+fn only(dir: &Path, names: &[&str]) {
+    let mut got: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    got.sort();
+    let mut want: Vec<String> = names.iter().map(|s| s.to_string()).collect();
+    want.sort();
+    assert_eq!(got, want, "entries of {}", dir.display());
+}
+
+#[test]
+fn foreign_files_in_out_are_never_replaced() {
+    let t = tempdir();
+    let d = t.path().join("notes");
+    let before = notes(&d);
+    for args in [
+        &["render", "--size", "16", "--out", "notes"][..],
+        &["generate", "--out", "notes"],
+        &["roms", "--out", "notes"],
+        &["volume", "--synthetic", "--size", "16", "--out", "notes"],
+        &["bench", "--quick", "--no-yosys", "--out", "notes"],
+        &["fpga", "--logs", "notes"],
+    ] {
+        let out = run_in(t.path(), args);
+        assert_error(
+            &out,
+            "will not replace notes: it holds sub/, which rmapgen did not write",
+        );
+        assert_eq!(tree(&d), before, "{args:?} changed the folder");
+        only(t.path(), &["notes"]);
+    }
+    // --force is the user's word that the folder may go.
+    ok(&run_in(
+        t.path(),
+        &["render", "--size", "16", "--out", "notes", "--force"],
+    ));
+    assert!(d.join("model.png").is_file() && !d.join("todo.txt").exists());
+}
+
+#[test]
+fn generate_without_out_keeps_a_users_file_in_rtl_out() {
+    let t = tempdir();
+    ok(&run_in(t.path(), &["generate"]));
+    std::fs::write(
+        t.path().join("rtl_out/my_wrapper.v"),
+        "module w;\nendmodule\n",
+    )
+    .unwrap();
+    let before = tree(&t.path().join("rtl_out"));
+    let out = run_in(t.path(), &["generate"]);
+    assert_error(&out, "it holds my_wrapper.v, which rmapgen did not write");
+    assert_eq!(tree(&t.path().join("rtl_out")), before);
+}
+
+#[test]
+fn own_output_is_replaced_but_an_edited_file_is_not() {
+    let t = tempdir();
+    ok(&run_in(t.path(), &["render", "--size", "16", "--out", "r"]));
+    ok(&run_in(t.path(), &["render", "--size", "20", "--out", "r"]));
+    // A file rmapgen wrote but a user changed since counts as theirs.
+    std::fs::write(t.path().join("r/metrics.json"), "{}\n").unwrap();
+    let out = run_in(t.path(), &["render", "--size", "16", "--out", "r"]);
+    assert_error(&out, "metrics.json was changed since rmapgen wrote it");
+    assert_eq!(
+        std::fs::read(t.path().join("r/metrics.json")).unwrap(),
+        b"{}\n"
+    );
+    // An empty directory of theirs inside counts too.
+    std::fs::write(t.path().join("r/metrics.json"), "{}\n").unwrap();
+    ok(&run_in(
+        t.path(),
+        &["render", "--size", "16", "--out", "r", "--force"],
+    ));
+    std::fs::create_dir(t.path().join("r/keep")).unwrap();
+    let out = run_in(t.path(), &["render", "--size", "16", "--out", "r"]);
+    assert_error(&out, "it holds keep/, which rmapgen did not write");
+    // An empty or absent directory is fine.
+    std::fs::create_dir(t.path().join("empty")).unwrap();
+    ok(&run_in(
+        t.path(),
+        &["render", "--size", "16", "--out", "empty"],
+    ));
+    ok(&run_in(
+        t.path(),
+        &["render", "--size", "16", "--out", "new/deeper/r"],
+    ));
+    only(t.path(), &["empty", "new", "r"]);
+}
+
+#[test]
+fn an_input_inside_out_is_never_replaced_even_forced() {
+    let t = tempdir();
+    let d = t.path().join("d");
+    std::fs::create_dir(&d).unwrap();
+    std::fs::copy(
+        helpers::root().join("scenes/standard.toml"),
+        d.join("my_scene.toml"),
+    )
+    .unwrap();
+    std::fs::write(d.join("cfg.toml"), "index_bits = 4\n").unwrap();
+    std::fs::write(d.join("scan.raw"), vec![7u8; 8 * 8 * 8]).unwrap();
+    let before = tree(&d);
+    for (args, input) in [
+        (
+            &[
+                "render",
+                "--scene",
+                "d/my_scene.toml",
+                "--size",
+                "16",
+                "--out",
+                "d",
+            ][..],
+            "my_scene.toml",
+        ),
+        (
+            &["generate", "--config", "d/cfg.toml", "--out", "d"],
+            "cfg.toml",
+        ),
+        (
+            &[
+                "volume",
+                "d/scan.raw",
+                "--dims",
+                "8,8,8",
+                "--size",
+                "16",
+                "--out",
+                "d",
+            ],
+            "scan.raw",
+        ),
+        (
+            &["roms", "--scene", "d/my_scene.toml", "--out", "d"],
+            "my_scene.toml",
+        ),
+    ] {
+        for force in [false, true] {
+            let mut a = args.to_vec();
+            if force {
+                a.push("--force");
+            }
+            let out = run_in(t.path(), &a);
+            assert_error(
+                &out,
+                &format!("d/{input}, an input of this command (not even with --force)"),
+            );
+            assert_eq!(tree(&d), before, "{a:?}");
+        }
+    }
+    // The same input given through another spelling of the path.
+    let abs = d.join("my_scene.toml");
+    let out = run_in(
+        t.path(),
+        &[
+            "render",
+            "--scene",
+            abs.to_str().unwrap(),
+            "--size",
+            "16",
+            "--out",
+            "./d/../d",
+            "--force",
+        ],
+    );
+    assert_error(&out, "an input of this command");
+    only(t.path(), &["d"]);
+}
+
+#[test]
+fn regenerating_in_place_from_the_written_config_works() {
+    let t = tempdir();
+    ok(&run_in(
+        t.path(),
+        &["generate", "--index-bits", "4", "--out", "g"],
+    ));
+    let first = tree(&t.path().join("g"));
+    let out = run_in(
+        t.path(),
+        &["generate", "--config", "g/tb/config.toml", "--out", "g"],
+    );
+    ok(&out);
+    assert_eq!(tree(&t.path().join("g")), first, "same config, same design");
+}
+
+#[test]
+fn the_current_directory_and_its_ancestors_are_never_replaced() {
+    let t = tempdir();
+    let cwd = t.path().join("work");
+    std::fs::create_dir(&cwd).unwrap();
+    ok(&run_in(&cwd, &["render", "--size", "16", "--out", "r"]));
+    // Even a directory of rmapgen's own output, once it is where the user stands.
+    let inside = cwd.join("r");
+    let parent = t.path().to_str().unwrap().to_string();
+    for (dir, out_arg) in [
+        (&cwd, cwd.to_str().unwrap().to_string()),
+        (&cwd, parent.clone()),
+        (&inside, inside.to_str().unwrap().to_string()),
+        (&inside, "../r".to_string()),
+    ] {
+        let before = tree(t.path());
+        for force in [false, true] {
+            let mut a = vec!["render", "--size", "16", "--out", out_arg.as_str()];
+            if force {
+                a.push("--force");
+            }
+            let out = run_in(dir, &a);
+            assert_error(&out, "it is the current directory or holds it");
+            assert_eq!(tree(t.path()), before, "{a:?} in {}", dir.display());
+        }
+    }
+    for dot in [".", ".."] {
+        assert_error(
+            &run_in(&inside, &["render", "--out", dot]),
+            "has no directory name",
+        );
+    }
+}
+
+#[test]
+fn a_symlinked_out_is_refused() {
+    let t = tempdir();
+    let real = t.path().join("real");
+    let before = notes(&real);
+    std::os::unix::fs::symlink(&real, t.path().join("link")).unwrap();
+    let out = run_in(
+        t.path(),
+        &["render", "--size", "16", "--out", "link", "--force"],
+    );
+    assert_error(&out, "is a symbolic link");
+    assert_eq!(tree(&real), before);
+}
+
+#[test]
+fn single_output_files_replace_only_their_own_kind() {
+    let t = tempdir();
+    std::fs::write(t.path().join("notes.txt"), "my notes\n").unwrap();
+    let out = run_in(
+        t.path(),
+        &["vectors", "--count", "10", "--out", "notes.txt"],
+    );
+    assert_error(
+        &out,
+        "will not replace notes.txt: it exists and was not written by rmapgen",
+    );
+    let out = run_in(
+        t.path(),
+        &["stress", "--samples", "1000", "--json", "notes.txt"],
+    );
+    assert_error(&out, "will not replace notes.txt");
+    assert!(
+        String::from_utf8_lossy(&out.stdout).is_empty(),
+        "refused before the run"
+    );
+    assert_eq!(
+        std::fs::read(t.path().join("notes.txt")).unwrap(),
+        b"my notes\n"
+    );
+    // A vector file or report rmapgen wrote is replaced.
+    ok(&run_in(
+        t.path(),
+        &["vectors", "--count", "10", "--out", "v.hex"],
+    ));
+    ok(&run_in(
+        t.path(),
+        &["vectors", "--count", "20", "--out", "v.hex"],
+    ));
+    ok(&run_in(
+        t.path(),
+        &["stress", "--samples", "1000", "--json", "s.json"],
+    ));
+    ok(&run_in(
+        t.path(),
+        &["stress", "--samples", "1000", "--json", "s.json"],
+    ));
+    // An input is never the output, forced or not.
+    std::fs::copy(
+        helpers::root().join("scenes/standard.toml"),
+        t.path().join("s.toml"),
+    )
+    .unwrap();
+    let out = run_in(
+        t.path(),
+        &[
+            "vectors", "--count", "10", "--scene", "s.toml", "--out", "s.toml", "--force",
+        ],
+    );
+    assert_error(
+        &out,
+        "will not replace s.toml: it is an input of this command",
+    );
+    // A directory given as the file names the right problem and leaves nothing.
+    std::fs::create_dir(t.path().join("some_dir")).unwrap();
+    for p in ["some_dir", "some_dir/", "missing_dir/"] {
+        let out = run_in(t.path(), &["vectors", "--count", "10", "--out", p]);
+        assert_error(&out, "is a directory; give the name of a file to write");
+    }
+    only(
+        t.path(),
+        &["notes.txt", "s.json", "s.toml", "some_dir", "v.hex"],
+    );
+    assert!(!helpers::nonempty(&t.path().join("some_dir")));
+}
+
+#[test]
+fn roms_update_refreshes_hex_files_and_keeps_the_rest() {
+    let t = tempdir();
+    ok(&run_in(t.path(), &["generate", "--out", "g"]));
+    let before = tree(&t.path().join("g"));
+    // A hex file out of date (as after a change to the ROM maths) is rewritten.
+    std::fs::write(t.path().join("g/extra.txt"), "x\n").unwrap();
+    assert_error(
+        &run_in(t.path(), &["roms", "--update", "g"]),
+        "it holds extra.txt, which rmapgen did not write",
+    );
+    std::fs::remove_file(t.path().join("g/extra.txt")).unwrap();
+    ok(&run_in(t.path(), &["roms", "--update", "g"]));
+    assert_eq!(
+        first_difference(&t.path().join("g"), &t.path().join("g")),
+        None
+    );
+    assert_eq!(tree(&t.path().join("g")), before);
+    std::fs::create_dir(t.path().join("plain")).unwrap();
+    std::fs::write(t.path().join("plain/a.hex"), "00\n").unwrap();
+    assert_error(
+        &run_in(t.path(), &["roms", "--update", "plain"]),
+        "not a directory rmapgen generated",
+    );
+}
+
+#[test]
+fn leftovers_of_killed_runs_are_cleaned_but_nothing_else() {
+    let t = tempdir();
+    // A staging directory of a process that no longer exists, with rmapgen's mark…
+    let stale = t.path().join(".r.staging-4000000");
+    std::fs::create_dir(&stale).unwrap();
+    std::fs::write(stale.join(".rmapgen-staging"), "").unwrap();
+    std::fs::write(stale.join("model.png"), "x").unwrap();
+    // …and a look-alike without it, which is not rmapgen's to remove.
+    let lookalike = t.path().join(".r.staging-4000001");
+    std::fs::create_dir(&lookalike).unwrap();
+    std::fs::write(lookalike.join("mine.txt"), "x").unwrap();
+    ok(&run_in(t.path(), &["render", "--size", "16", "--out", "r"]));
+    assert!(!stale.exists(), "stale staging removed");
+    assert!(
+        lookalike.join("mine.txt").is_file(),
+        "unmarked look-alike kept"
+    );
+}
+
+/// Starts rmapgen, waits until `ready` holds (it has started writing), sends `signal` and
+/// returns how the process ended.
+fn interrupt(
+    dir: &Path,
+    args: &[&str],
+    signal: &str,
+    ready: impl Fn() -> bool,
+) -> std::process::ExitStatus {
+    let mut child = helpers::rmapgen()
+        .current_dir(dir)
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("rmapgen starts");
+    let t0 = Instant::now();
+    while !ready() {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "{args:?} ended before it could be interrupted"
+        );
+        assert!(
+            t0.elapsed() < Duration::from_secs(60),
+            "{args:?} never started writing"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let status = Command::new("kill")
+        .args([signal, &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    child.wait().unwrap()
+}
+
+fn staged(dir: &Path, prefix: &str) -> bool {
+    std::fs::read_dir(dir).is_ok_and(|d| {
+        d.flatten()
+            .any(|e| e.file_name().to_string_lossy().starts_with(prefix))
+    })
+}
+
+#[test]
+fn an_interrupted_vectors_run_leaves_nothing_and_keeps_the_old_file() {
+    let t = tempdir();
+    ok(&run_in(
+        t.path(),
+        &["vectors", "--count", "100", "--out", "v.hex"],
+    ));
+    let old = std::fs::read(t.path().join("v.hex")).unwrap();
+    let partial_grew = || {
+        std::fs::read_dir(t.path()).unwrap().flatten().any(|e| {
+            e.file_name()
+                .to_string_lossy()
+                .starts_with(".v.hex.partial-")
+                && e.metadata().is_ok_and(|m| m.len() > 1 << 20)
+        })
+    };
+    let st = interrupt(
+        t.path(),
+        &["vectors", "--count", "500000000", "--out", "v.hex"],
+        "-INT",
+        partial_grew,
+    );
+    assert_eq!(st.signal(), Some(2), "ended by SIGINT: {st:?}");
+    only(t.path(), &["v.hex"]);
+    assert_eq!(std::fs::read(t.path().join("v.hex")).unwrap(), old);
+    // Parent directories it made for the output go too.
+    let sub = t.path().join("new/sub");
+    let st = interrupt(
+        t.path(),
+        &["vectors", "--count", "500000000", "--out", "new/sub/v.hex"],
+        "-TERM",
+        || staged(&sub, ".v.hex.partial-"),
+    );
+    assert_eq!(st.signal(), Some(15), "ended by SIGTERM: {st:?}");
+    only(t.path(), &["v.hex"]);
+}
+
+#[test]
+fn an_interrupted_generate_leaves_nothing_and_keeps_the_old_design() {
+    let t = tempdir();
+    ok(&run_in(t.path(), &["generate", "--out", "g"]));
+    let old = tree(&t.path().join("g"));
+    for signal in ["-TERM", "-INT", "-HUP"] {
+        let st = interrupt(
+            t.path(),
+            &["generate", "--vectors", "400000", "--out", "g"],
+            signal,
+            || staged(t.path(), ".g.staging-"),
+        );
+        assert!(
+            st.signal().is_some(),
+            "{signal}: ended by the signal: {st:?}"
+        );
+        only(t.path(), &["g"]);
+        assert_eq!(
+            tree(&t.path().join("g")),
+            old,
+            "{signal}: the previous design is intact"
+        );
+    }
+}
