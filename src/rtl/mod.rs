@@ -9,7 +9,7 @@ pub mod manifest;
 pub mod package;
 pub mod pipe;
 pub mod ports;
-pub mod sum;
+pub mod adder_tree;
 pub mod templates;
 pub mod verilated;
 

@@ -9,7 +9,7 @@
 //! | 1 | + the output of every ROM and RAM read (a fabric register after the block RAM's own), the sort & shift magnitudes, every second adder level |
 //! | 2 | + every adder level (one LUT level and one carry chain per clock) |
 
-use super::sum::{self, registered_at, Built, Sig, Step, Sum, Term, Tree};
+use super::adder_tree::{self, registered_at, Built, Sig, Step, Sum, Term, Tree};
 use crate::config::{Config, COLOR_BITS};
 use crate::model::color_mul;
 
@@ -82,14 +82,14 @@ pub fn normalise(cfg: &Config) -> NormalisePlan {
         bound: None,
     };
     let trees = [tree("pa", "a"), tree("pb", "b")];
-    let n = sum::levels(&trees[0]);
+    let n = adder_tree::levels(&trees[0]);
     // The last level and the saturation share a clock, except at depth 2.
     let anchor = if d >= 2 { n } else { n - 1 };
     let Built {
         steps,
         sums,
         riders,
-    } = sum::build(
+    } = adder_tree::build(
         "a * recip and b * recip",
         &trees,
         &[
@@ -137,8 +137,8 @@ pub fn linear_index(cfg: &Config) -> LinearPlan {
         bound: Some((cfg.pos_max() as u128) << cfg.frac_bits | cfg.frac_half() as u128),
     };
     let trees = [tree("su", "ux"), tree("sv", "vx")];
-    let n = sum::levels(&trees[0]);
-    let b = sum::build("u' * POS_MAX and v' * POS_MAX", &trees, &[], &|k, _| {
+    let n = adder_tree::levels(&trees[0]);
+    let b = adder_tree::build("u' * POS_MAX and v' * POS_MAX", &trees, &[], &|k, _| {
         registered_at(d, n, k)
     });
     let latency = pre_reg as u32 + regs(&b.steps);
@@ -204,8 +204,8 @@ pub fn interpolate(cfg: &Config) -> InterpolatePlan {
         pass("a0", e("e00"), e("e10"), "wu", "wuc", s / 2, a_max),
         pass("a1", e("e01"), e("e11"), "wu", "wuc", s / 2, a_max),
     ];
-    let nu = sum::levels(&u[0]);
-    let bu = sum::build(
+    let nu = adder_tree::levels(&u[0]);
+    let bu = adder_tree::build(
         "u pass",
         &u,
         &[
@@ -238,8 +238,8 @@ pub fn interpolate(cfg: &Config) -> InterpolatePlan {
         terms: v_terms,
         bound: Some(r_max),
     }];
-    let nv = sum::levels(&v[0]);
-    let bv = sum::build("v pass", &v, &[], &|k, _| registered_at(d, nv, k));
+    let nv = adder_tree::levels(&v[0]);
+    let bv = adder_tree::build("v pass", &v, &[], &|k, _| registered_at(d, nv, k));
     let mut steps = bu.steps;
     steps.extend(bv.steps);
     let latency = in_reg as u32 + regs(&steps);
@@ -281,8 +281,8 @@ pub fn color_mul(cfg: &Config) -> ColorPlan {
             bound: Some(n_max),
         })
         .collect();
-    let n1 = sum::levels(&num[0]);
-    let b1 = sum::build("numerators 2 c i + D", &num, &[], &|kk, _| {
+    let n1 = adder_tree::levels(&num[0]);
+    let b1 = adder_tree::build("numerators 2 c i + D", &num, &[], &|kk, _| {
         registered_at(d, n1, kk)
     });
     let prod: Vec<Tree> = chans
@@ -300,8 +300,8 @@ pub fn color_mul(cfg: &Config) -> ColorPlan {
             bound: Some(n_max * k as u128),
         })
         .collect();
-    let n2 = sum::levels(&prod[0]);
-    let b2 = sum::build("products n * K", &prod, &[], &|kk, _| {
+    let n2 = adder_tree::levels(&prod[0]);
+    let b2 = adder_tree::build("products n * K", &prod, &[], &|kk, _| {
         registered_at(d, n2, kk)
     });
     let mut steps = b1.steps;

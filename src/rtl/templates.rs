@@ -2,7 +2,7 @@
 //! written `{= expr =}`). Every number a template prints comes from a `Config` method, the
 //! model's constants or [`super::latency`]; templates only name them.
 
-use super::sum::Step;
+use super::adder_tree::Step;
 use super::{banks, latency, pipe, ports, Module};
 use crate::config::{Config, COLOR_BITS};
 use crate::model::color_mul;
