@@ -2,6 +2,7 @@
 //! flags that override single fields. The result is validated once, here.
 
 use crate::config::Config;
+use crate::toml_input;
 use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
@@ -52,13 +53,28 @@ pub struct ConfigArgs {
 }
 
 impl ConfigArgs {
+    /// The configuration file with the flags applied, validated once: a file that is invalid
+    /// alone but valid with the flags (`interp_bits = 0` and `--no-interpolation`) is
+    /// accepted. An error names where each value it is about came from (a flag, the file's
+    /// line and column, or the default).
     pub fn resolve(&self) -> Result<Config> {
-        let mut c = match &self.config {
-            Some(p) => Config::from_toml_file(p)?,
-            None => Config::default(),
+        let file = match &self.config {
+            Some(p) => {
+                let text = toml_input::read(p, "config")?;
+                let what = format!("config {}", p.display());
+                let c: Config = toml_input::parse(&text, &what)?;
+                Some((c, text, what))
+            }
+            None => None,
         };
+        let mut c = file.as_ref().map_or_else(Config::default, |f| f.0.clone());
+        // The fields set by a flag, with the flag.
+        let mut flags: Vec<(&'static str, String)> = Vec::new();
         macro_rules! set {
-            ($($f:ident),*) => { $( if let Some(v) = self.$f { c.$f = v; } )* };
+            ($($f:ident),*) => { $( if let Some(v) = self.$f {
+                c.$f = v;
+                flags.push((stringify!($f), format!("--{} {v}", stringify!($f).replace('_', "-"))));
+            } )* };
         }
         set!(
             grad_bits,
@@ -71,21 +87,62 @@ impl ConfigArgs {
         );
         if self.no_compensation {
             c.compensation = false;
+            flags.push(("compensation", "--no-compensation".into()));
         }
         if self.no_interpolation {
             c.interpolation = false;
             c.interp_bits = 0;
+            flags.push(("interpolation", "--no-interpolation".into()));
+            flags.push(("interp_bits", "--no-interpolation".into()));
         }
         if let Some(p) = self.interp_bits {
             c.interp_bits = p;
+            flags.retain(|f| f.0 != "interp_bits");
+            flags.push(("interp_bits", format!("--interp-bits {p}")));
         }
         if self.color {
             c.color = true;
+            flags.push(("color", "--color".into()));
         }
         if self.handshake {
             c.handshake = true;
+            flags.push(("handshake", "--handshake".into()));
         }
-        c.validate()?;
-        Ok(c)
+        let Err(e) = c.validate() else {
+            return Ok(c);
+        };
+        let fields = e.fields();
+        let flag = |f: &str| flags.iter().find(|x| x.0 == f).map(|x| x.1.clone());
+        match &file {
+            // Every value involved is the file's: point at the first one in it.
+            Some((_, text, what)) if fields.iter().all(|f| flag(f).is_none()) => {
+                let key = fields
+                    .iter()
+                    .find(|f| toml_input::span_of(text, f).is_some())
+                    .unwrap_or(&fields[0]);
+                Err(toml_input::invalid(
+                    text,
+                    what,
+                    &toml_input::Invalid::new(*key, e.to_string()),
+                ))
+            }
+            _ => {
+                let from: Vec<String> = fields
+                    .iter()
+                    .map(|f| match (flag(f), &file) {
+                        (Some(fl), _) => format!("{f} from {fl}"),
+                        (None, Some((_, text, what))) => match toml_input::span_of(text, f) {
+                            Some(s) => {
+                                let (l, col) = toml_input::line_col(text, s.start);
+                                format!("{f} from {what}:{l}:{col}")
+                            }
+                            None => format!("{f} by default"),
+                        },
+                        (None, None) => format!("{f} by default"),
+                    })
+                    .collect();
+                anyhow::bail!("{e} ({})", from.join(", "))
+            }
+        }
     }
 }

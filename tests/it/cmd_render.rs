@@ -127,7 +127,7 @@ fn nan_light_direction() {
             "{MATERIAL}[[light]]\ndirection = [nan, 0.0, 1.0]\n"
         )),
         &[],
-        "light 1 direction [NaN, 0.0, 1.0] is not finite",
+        "scene.toml:7:13: light[0].direction = [NaN, 0.0, 1.0] is not finite",
     );
 }
 
@@ -138,7 +138,7 @@ fn zero_light_direction() {
             "{MATERIAL}[[light]]\ndirection = [0.0, 0.0, 0.0]\n"
         )),
         &[],
-        "light 1 direction [0.0, 0.0, 0.0] has zero length",
+        "scene.toml:7:13: light[0].direction = [0.0, 0.0, 0.0] has zero length",
     );
 }
 
