@@ -1,6 +1,7 @@
 //! The configuration flags shared by every command that builds a design: a TOML file, then
 //! flags that override single fields. The result is validated once, here.
 
+use super::parse;
 use crate::config::Config;
 use crate::toml_input;
 use anyhow::Result;
@@ -13,25 +14,25 @@ pub struct ConfigArgs {
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
     /// Gradient component width, two's complement [8..=16, default 12].
-    #[arg(long)]
+    #[arg(long, value_parser = parse::field("grad_bits"))]
     pub grad_bits: Option<u32>,
     /// Magnitude width after sort & shift [6..=12, <= grad-bits, default 8].
-    #[arg(long)]
+    #[arg(long, value_parser = parse::field("red_bits"))]
     pub red_bits: Option<u32>,
     /// Reciprocal ROM entry width [5..=20, >= frac-bits + 1, default 10].
-    #[arg(long)]
+    #[arg(long, value_parser = parse::field("recip_bits"))]
     pub recip_bits: Option<u32>,
     /// Normalised fraction width; 2^frac-bits compensation ROM entries [4..=12, default 8].
-    #[arg(long)]
+    #[arg(long, value_parser = parse::field("frac_bits"))]
     pub frac_bits: Option<u32>,
     /// Map index bits per component [2..=6, default 3].
-    #[arg(long)]
+    #[arg(long, value_parser = parse::field("index_bits"))]
     pub index_bits: Option<u32>,
     /// Interpolation fraction bits [0..=5, 0 iff interpolation is off, default 3].
-    #[arg(long)]
+    #[arg(long, value_parser = parse::field("interp_bits"))]
     pub interp_bits: Option<u32>,
     /// Map entry and output intensity width [6..=12, default 8].
-    #[arg(long)]
+    #[arg(long, value_parser = parse::field("map_bits"))]
     pub map_bits: Option<u32>,
     /// Leave out distortion compensation (no atan ROM; linear index).
     #[arg(long)]
@@ -44,7 +45,7 @@ pub struct ConfigArgs {
     pub color: bool,
     /// Pipeline registers: 0 compact (lowest latency), 1 and 2 add registers for clock rate
     /// [0..=2, default 2].
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", value_parser = parse::field("pipeline_depth"))]
     pub pipeline_depth: Option<u32>,
     /// Valid/ready handshake on the top (backpressure stalls the pipeline) instead of a
     /// plain valid stream.

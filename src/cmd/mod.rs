@@ -5,6 +5,7 @@ pub mod config_args;
 pub mod fit;
 pub mod fpga;
 pub mod generate;
+pub mod parse;
 pub mod render;
 pub mod roms;
 pub mod stress;

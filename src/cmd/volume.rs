@@ -57,16 +57,16 @@ pub struct VolumeArgs {
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
     pub view: Option<String>,
     /// Image width and height in pixels [1..=4096].
-    #[arg(long, value_name = "N", default_value_t = 512)]
+    #[arg(long, value_name = "N", default_value_t = 512, value_parser = super::parse::count::<u32>())]
     pub size: u32,
     /// Sample step along a ray, in smallest voxel spacings [0.05..=4].
-    #[arg(long, value_name = "S", default_value_t = cast::DEFAULT_STEP)]
+    #[arg(long, value_name = "S", default_value_t = cast::DEFAULT_STEP, value_parser = super::parse::positive())]
     pub step: f64,
     /// Early ray termination: accumulated opacity at which a pixel counts as opaque (0, 1].
-    #[arg(long, value_name = "A", default_value_t = cast::DEFAULT_ERT)]
+    #[arg(long, value_name = "A", default_value_t = cast::DEFAULT_ERT, value_parser = super::parse::positive())]
     pub ert: f64,
     /// Brick side in cells for empty-space skipping [a power of two, 2..=64].
-    #[arg(long, value_name = "N", default_value_t = cast::DEFAULT_BRICK)]
+    #[arg(long, value_name = "N", default_value_t = cast::DEFAULT_BRICK, value_parser = super::parse::count::<usize>())]
     pub brick: usize,
     /// Turn skipping off (empty space, early termination, unshaded samples): same image,
     /// more work.
@@ -81,7 +81,7 @@ pub struct VolumeArgs {
     #[arg(long)]
     pub rtl: bool,
     /// Timed runs per measurement with --timing (the median is reported).
-    #[arg(long, value_name = "N", default_value_t = 5)]
+    #[arg(long, value_name = "N", default_value_t = 5, value_parser = super::parse::count::<u32>())]
     pub repeat: u32,
     /// Output directory for reference.png, model.png, error50.png and metrics.json (replaced
     /// whole on success).

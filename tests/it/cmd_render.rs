@@ -156,7 +156,7 @@ fn out_of_range_width() {
     fails(
         None,
         &["--grad-bits", "30"],
-        "grad_bits = 30 is out of range; allowed 8..=16",
+        "--grad-bits must be in 8..=16, not 30",
     );
 }
 
