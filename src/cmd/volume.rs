@@ -113,7 +113,9 @@ fn scene(a: &VolumeArgs) -> Result<Scene> {
         None => Scene::from_toml_str(ENGINE_SCENE_TOML).context("the built-in engine scene")?,
     };
     if let Some(v) = &a.view {
-        scene.view.direction = triple::<f64>("--view", v)?;
+        let d = triple::<f64>("--view", v)?;
+        crate::scene::check_direction("--view", d)?;
+        scene.view.direction = d;
     }
     if let Some(t) = &a.transfer {
         scene.transfer = Some(Transfer::parse(t)?);
@@ -320,6 +322,7 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
         rtl.as_ref()
             .map(|t| t as &dyn crate::render::IntensitySource),
     )?;
+    report::check_covered(&r, &vol)?;
     if let Some(n) = r.rtl_mismatches() {
         if n > 0 {
             bail!("the RTL image differs from the model image in {n} pixels");
