@@ -129,7 +129,7 @@ fn usage_line(e: &clap::Error) -> String {
             Some(t) => tips.push(t),
             None => {
                 let line = line.strip_prefix("error: ").unwrap_or(line);
-                if !out.is_empty() && !out.ends_with(':') {
+                if !out.is_empty() && !out.ends_with(':') && !line.starts_with('[') {
                     out.push(',');
                 }
                 if !out.is_empty() {

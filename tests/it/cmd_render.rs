@@ -194,11 +194,13 @@ fn failure_keeps_an_existing_output() {
             "--size",
             "16",
             "--red-bits",
-            "13",
+            "12",
+            "--grad-bits",
+            "10",
             "--out",
             out.to_str().unwrap(),
         ]),
-        "red_bits = 13",
+        "red_bits = 12 exceeds grad_bits = 10",
     );
     assert_eq!(std::fs::read(out.join("metrics.json")).unwrap(), before);
     assert_eq!(entries(tmp.path()), ["o"]);
