@@ -13,26 +13,19 @@ pub struct ConfigArgs {
     /// Configuration TOML (fields as in `Config`); flags below override it.
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
-    /// Gradient component width, two's complement [8..=16, default 12].
-    #[arg(long, value_parser = parse::field("grad_bits"))]
+    #[arg(long, value_parser = parse::field("grad_bits"), help = parse::field_help("grad_bits", "Gradient component width, two's complement", ""))]
     pub grad_bits: Option<u32>,
-    /// Magnitude width after sort & shift [6..=12, <= grad-bits, default 8].
-    #[arg(long, value_parser = parse::field("red_bits"))]
+    #[arg(long, value_parser = parse::field("red_bits"), help = parse::field_help("red_bits", "Magnitude width after sort & shift", ", <= grad-bits"))]
     pub red_bits: Option<u32>,
-    /// Reciprocal ROM entry width [5..=20, >= frac-bits + 1, default 10].
-    #[arg(long, value_parser = parse::field("recip_bits"))]
+    #[arg(long, value_parser = parse::field("recip_bits"), help = parse::field_help("recip_bits", "Reciprocal ROM entry width", ", >= frac-bits + 1"))]
     pub recip_bits: Option<u32>,
-    /// Normalised fraction width; 2^frac-bits compensation ROM entries [4..=12, default 8].
-    #[arg(long, value_parser = parse::field("frac_bits"))]
+    #[arg(long, value_parser = parse::field("frac_bits"), help = parse::field_help("frac_bits", "Normalised fraction width; 2^frac-bits compensation ROM entries", ""))]
     pub frac_bits: Option<u32>,
-    /// Map index bits per component [2..=6, default 3].
-    #[arg(long, value_parser = parse::field("index_bits"))]
+    #[arg(long, value_parser = parse::field("index_bits"), help = parse::field_help("index_bits", "Map index bits per component", ""))]
     pub index_bits: Option<u32>,
-    /// Interpolation fraction bits [0..=5, 0 iff interpolation is off, default 3].
-    #[arg(long, value_parser = parse::field("interp_bits"))]
+    #[arg(long, value_parser = parse::field("interp_bits"), help = parse::field_help("interp_bits", "Interpolation fraction bits", ", 0 iff interpolation is off"))]
     pub interp_bits: Option<u32>,
-    /// Map entry and output intensity width [6..=12, default 8].
-    #[arg(long, value_parser = parse::field("map_bits"))]
+    #[arg(long, value_parser = parse::field("map_bits"), help = parse::field_help("map_bits", "Map entry and output intensity width", ""))]
     pub map_bits: Option<u32>,
     /// Leave out distortion compensation (no atan ROM; linear index).
     #[arg(long)]
@@ -43,9 +36,7 @@ pub struct ConfigArgs {
     /// Add the 8-bit RGB colour multiplier.
     #[arg(long)]
     pub color: bool,
-    /// Pipeline registers: 0 compact (lowest latency), 1 and 2 add registers for clock rate
-    /// [0..=2, default 2].
-    #[arg(long, value_name = "N", value_parser = parse::field("pipeline_depth"))]
+    #[arg(long, value_name = "N", value_parser = parse::field("pipeline_depth"), help = parse::field_help("pipeline_depth", "Pipeline registers: 0 compact (lowest latency), 1 and 2 add registers for clock rate", ""))]
     pub pipeline_depth: Option<u32>,
     /// Valid/ready handshake on the top (backpressure stalls the pipeline) instead of a
     /// plain valid stream.

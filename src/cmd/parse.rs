@@ -84,6 +84,18 @@ pub fn field(name: &str) -> Whole<u32> {
     whole(min as u64, max as u64)
 }
 
+/// The help of a configuration field's flag: `what [min..=max<note>, default d]`, the range
+/// from [`crate::config::range_of`] and the default from [`crate::config::Config::default`].
+pub fn field_help(name: &str, what: &str, note: &str) -> String {
+    let (min, max) = crate::config::range_of(name).expect("a configuration field with a range");
+    let d = crate::config::Config::default();
+    let default = match name {
+        "pipeline_depth" => d.pipeline_depth,
+        _ => d.field(name),
+    };
+    format!("{what} [{min}..={max}{note}, default {default}]")
+}
+
 impl<T> TypedValueParser for Whole<T>
 where
     T: TryFrom<u64> + Clone + Send + Sync + 'static,
