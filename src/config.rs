@@ -73,8 +73,33 @@ pub enum ConfigError {
         min: u32,
         max: u32,
     },
-    #[error("{0}")]
-    Conflict(String),
+    /// Two or more fields that do not go together: the fields, and what to do.
+    #[error("{message}")]
+    Conflict {
+        fields: Vec<&'static str>,
+        message: String,
+    },
+}
+
+impl ConfigError {
+    /// The fields the error is about (the out-of-range one, or the conflicting ones).
+    pub fn fields(&self) -> Vec<&'static str> {
+        match self {
+            ConfigError::OutOfRange { field, .. } => vec![field],
+            ConfigError::Conflict { fields, .. } => fields.clone(),
+        }
+    }
+}
+
+/// The allowed range of a width field from [`RANGES`], or of `pipeline_depth`.
+pub fn range_of(field: &str) -> Option<(u32, u32)> {
+    if field == "pipeline_depth" {
+        return Some(PIPELINE_DEPTHS);
+    }
+    RANGES
+        .iter()
+        .find(|r| r.0 == field)
+        .map(|&(_, min, max)| (min, max))
 }
 
 impl Default for Config {
@@ -136,25 +161,30 @@ impl Config {
                 max,
             });
         }
-        let c = |s: String| Err(ConfigError::Conflict(s));
+        let c = |fields: &[&'static str], message: String| {
+            Err(ConfigError::Conflict {
+                fields: fields.to_vec(),
+                message,
+            })
+        };
         if self.red_bits > self.grad_bits {
-            return c(format!(
+            return c(&["red_bits", "grad_bits"], format!(
                 "red_bits = {} exceeds grad_bits = {}; the reduced magnitude cannot be wider than the gradient",
                 self.red_bits, self.grad_bits
             ));
         }
         if self.recip_bits < self.frac_bits + 1 {
-            return c(format!(
+            return c(&["recip_bits", "frac_bits"], format!(
                 "recip_bits = {} must be at least frac_bits + 1 = {} so the normalised fraction keeps its precision",
                 self.recip_bits,
                 self.frac_bits + 1
             ));
         }
         if self.interpolation && self.interp_bits == 0 {
-            return c("interp_bits = 0 with interpolation on; give interp_bits >= 1 or turn interpolation off".into());
+            return c(&["interp_bits", "interpolation"], "interp_bits = 0 with interpolation on; give interp_bits >= 1 or turn interpolation off".into());
         }
         if !self.interpolation && self.interp_bits != 0 {
-            return c(format!(
+            return c(&["interp_bits", "interpolation"], format!(
                 "interp_bits = {} with interpolation off; interp_bits must be 0 when interpolation is off",
                 self.interp_bits
             ));
@@ -162,16 +192,24 @@ impl Config {
         Ok(())
     }
 
-    /// Loads and validates a TOML configuration file.
+    /// Loads and validates a TOML configuration file; an error is one line naming the file,
+    /// the line and column and the key.
     pub fn from_toml_file(path: &Path) -> anyhow::Result<Config> {
-        use anyhow::Context;
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read config {}", path.display()))?;
-        let cfg: Config = toml::from_str(&text)
-            .map_err(|e| anyhow::anyhow!("{}", e.message()))
-            .with_context(|| format!("malformed config {}", path.display()))?;
-        cfg.validate()
-            .with_context(|| format!("invalid config {}", path.display()))?;
+        let text = crate::toml_input::read(path, "config")?;
+        Config::from_toml_named(&text, &format!("config {}", path.display()))
+    }
+
+    /// Parses and validates a configuration; errors start with `what` (e.g. `config c.toml`).
+    pub fn from_toml_named(text: &str, what: &str) -> anyhow::Result<Config> {
+        let cfg: Config = crate::toml_input::parse(text, what)?;
+        cfg.validate().map_err(|e| {
+            let key = e.fields()[0];
+            crate::toml_input::invalid(
+                text,
+                what,
+                &crate::toml_input::Invalid::new(key, e.to_string()),
+            )
+        })?;
         Ok(cfg)
     }
 

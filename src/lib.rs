@@ -14,5 +14,6 @@ pub mod rtl;
 pub mod scene;
 pub mod stress;
 pub mod tb;
+pub mod toml_input;
 pub mod vectors;
 pub mod volume;

@@ -1,4 +1,4 @@
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use rmapgen::cmd;
 use std::process::ExitCode;
 
@@ -67,13 +67,104 @@ fn run(cli: Cli) -> anyhow::Result<()> {
     }
 }
 
+/// Parses the command line. Negative numbers are taken as values (`--grad-bits -1`), so
+/// they reach the flags' range checks. Help and version print as usual and exit 0; any
+/// other error is one line, the essential one of clap's message.
+fn parse() -> Result<Cli, ExitCode> {
+    let cmd = Cli::command().mut_subcommands(|s| s.allow_negative_numbers(true));
+    let parsed = cmd
+        .try_get_matches()
+        .and_then(|mut m| Cli::from_arg_matches_mut(&mut m));
+    parsed.map_err(|e| {
+        use clap::error::ErrorKind;
+        match e.kind() {
+            ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+                let _ = e.print();
+                ExitCode::SUCCESS
+            }
+            _ => {
+                eprintln!("rmapgen: error: {}", usage_line(&e));
+                ExitCode::from(2)
+            }
+        }
+    })
+}
+
+/// The essential line of a clap error: its first line without the `error: ` prefix, with
+/// clap's tips (a similar flag, how to pass a value starting with '-') after it.
+fn usage_line(e: &clap::Error) -> String {
+    use clap::error::ErrorKind;
+    if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+        || e.kind() == ErrorKind::MissingSubcommand
+    {
+        let names: Vec<String> = Cli::command()
+            .get_subcommands()
+            .map(|c| c.get_name().to_string())
+            .filter(|n| n != "help")
+            .collect();
+        return format!(
+            "give a command: {} (rmapgen --help describes them)",
+            names.join(", ")
+        );
+    }
+    if e.kind() == ErrorKind::ValueValidation {
+        // A negative number for a flag with the integer type's own parser (other flags
+        // have range-checking parsers, which name the range themselves).
+        use clap::error::{ContextKind, ContextValue};
+        if let (Some(ContextValue::String(arg)), Some(ContextValue::String(v))) = (
+            e.get(ContextKind::InvalidArg),
+            e.get(ContextKind::InvalidValue),
+        ) {
+            if v.starts_with('-') && v.parse::<f64>().is_ok() {
+                let flag = arg.split_whitespace().next().unwrap_or(arg);
+                return format!("{flag} must not be negative, not {v}");
+            }
+        }
+    }
+    let text = e.render().to_string();
+    let mut out = String::new();
+    let mut tips = Vec::new();
+    for line in text.lines().map(str::trim).filter(|l| !l.is_empty()) {
+        if line.starts_with("Usage:") || line.starts_with("For more information") {
+            break;
+        }
+        match line.strip_prefix("tip: ") {
+            Some(t) => tips.push(t),
+            None => {
+                let line = line.strip_prefix("error: ").unwrap_or(line);
+                if !out.is_empty() && !out.ends_with(':') && !line.starts_with('[') {
+                    out.push(',');
+                }
+                if !out.is_empty() {
+                    out.push(' ');
+                }
+                out.push_str(line);
+            }
+        }
+    }
+    if out.is_empty() {
+        out.push_str("invalid arguments");
+    }
+    for t in tips {
+        out.push_str(&format!("; {t}"));
+    }
+    if e.kind() != ErrorKind::ValueValidation && !out.contains("--help") {
+        out.push_str(" (see --help)");
+    }
+    out
+}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match parse() {
+        Ok(c) => c,
+        Err(code) => return code,
+    };
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             // One line, the whole cause chain.
-            eprintln!("rmapgen: error: {e:#}");
+            let msg = format!("{e:#}").replace(['\n', '\r'], " ");
+            eprintln!("rmapgen: error: {msg}");
             ExitCode::from(2)
         }
     }

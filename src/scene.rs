@@ -3,10 +3,11 @@
 //! validated; [`Scene::shade`] is the float light model that builds the maps and, evaluated
 //! at the float-normalised gradient, gives the reference every error is measured against.
 
-use anyhow::Context;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
+
+use crate::toml_input::{self, Invalid};
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -104,26 +105,71 @@ pub fn sym_dot(a: DVec3, b: DVec3) -> f64 {
     (p + q) + r
 }
 
-/// Normalisation with [`sym_dot`]: axis permutations commute with it exactly.
+/// Normalisation with [`sym_dot`]: axis permutations commute with it exactly. Overflows
+/// (to a zero vector) for components beyond about 1e154; directions from input go through
+/// [`unit_direction`].
 #[inline]
 pub fn sym_normalize(v: DVec3) -> DVec3 {
     v / sym_dot(v, v).sqrt()
 }
 
-fn check_dir(what: &str, d: [f64; 3]) -> anyhow::Result<DVec3> {
-    let v = DVec3::from_array(d);
+/// The unit vector along `v` for any finite non-zero `v`, however large or small its
+/// components (`[1e308, 1e308, 1e308]`, `[1e-320, 0, 0]`); `None` for a zero, NaN or
+/// infinite vector. `v` is first scaled by the power of two that brings its largest
+/// |component| into 1..2, so the squared length can neither overflow nor underflow; the
+/// scaling is exact, so the result is bit-identical to [`sym_normalize`] wherever that one
+/// is finite, and directions that differ by a power of two give the same unit vector. Axis
+/// permutations commute with it exactly. Every direction normalised from input (scene lights
+/// and view, the volume camera, the reference's gradients) goes through it.
+#[inline]
+pub fn unit_direction(v: DVec3) -> Option<DVec3> {
     if !v.is_finite() {
-        anyhow::bail!("{what} {d:?} is not finite");
+        return None;
     }
-    if v.length() < 1e-12 {
-        anyhow::bail!("{what} {d:?} has zero length");
+    let m = v.abs().max_element();
+    if m == 0.0 {
+        return None;
     }
-    Ok(sym_normalize(v))
+    // m = 2^e * 1.f (e from the exponent bits; subnormals have e = -1023 and stay below 2).
+    let e = ((m.to_bits() >> 52) & 0x7ff) as i32 - 1023;
+    let u = sym_normalize(v * pow2(-e));
+    debug_assert!(u.is_finite() && u != DVec3::ZERO, "{v} -> {u}");
+    Some(u)
 }
 
-fn check_coef(what: &str, x: f64) -> anyhow::Result<()> {
+/// 2^k exactly, for k in -1074..=1023.
+fn pow2(k: i32) -> f64 {
+    if k >= -1022 {
+        f64::from_bits(((k + 1023) as u64) << 52)
+    } else {
+        f64::from_bits(1u64 << (k + 1074))
+    }
+}
+
+/// A direction from input, checked: `key` is where it sits in the scene file
+/// (`light[2].direction`), and the error names it.
+pub fn check_direction(key: &str, d: [f64; 3]) -> Result<DVec3, Invalid> {
+    let v = DVec3::from_array(d);
+    if !v.is_finite() {
+        return Err(Invalid::new(
+            key,
+            format!("{key} = {d:?} is not finite; give three finite numbers"),
+        ));
+    }
+    unit_direction(v).ok_or_else(|| {
+        Invalid::new(
+            key,
+            format!("{key} = {d:?} has zero length; a direction needs a non-zero component"),
+        )
+    })
+}
+
+fn check_coef(key: &str, x: f64) -> Result<(), Invalid> {
     if !x.is_finite() || x < 0.0 {
-        anyhow::bail!("{what} = {x} must be a finite number >= 0");
+        return Err(Invalid::new(
+            key,
+            format!("{key} = {x} must be a finite number >= 0"),
+        ));
     }
     Ok(())
 }
@@ -138,35 +184,49 @@ impl Scene {
     }
 
     pub fn from_toml_str(text: &str) -> anyhow::Result<Scene> {
-        let s: Scene =
-            toml::from_str(text).map_err(|e| anyhow::anyhow!("{}", e.message().trim()))?;
-        s.validate()?;
+        Scene::from_toml_named(text, "scene")
+    }
+
+    /// Parses and validates a scene; errors are one line starting with `what` (e.g.
+    /// `scene s.toml`), the line and column, and the key.
+    pub fn from_toml_named(text: &str, what: &str) -> anyhow::Result<Scene> {
+        let s: Scene = toml_input::parse(text, what)?;
+        s.check().map_err(|e| toml_input::invalid(text, what, &e))?;
         Ok(s)
     }
 
     pub fn from_toml_file(path: &Path) -> anyhow::Result<Scene> {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read scene {}", path.display()))?;
-        Scene::from_toml_str(&text).with_context(|| format!("bad scene {}", path.display()))
+        let text = toml_input::read(path, "scene")?;
+        Scene::from_toml_named(&text, &format!("scene {}", path.display()))
     }
 
+    /// Checks every value, naming the first bad one by its key.
     pub fn validate(&self) -> anyhow::Result<()> {
-        check_dir("view direction", self.view.direction)?;
+        self.check().map_err(|e| anyhow::anyhow!(e.message))
+    }
+
+    /// [`Scene::validate`] with the key of the bad value, to locate it in a file.
+    pub fn check(&self) -> Result<(), Invalid> {
+        check_direction("view.direction", self.view.direction)?;
         let m = &self.material;
-        check_coef("ambient", m.ambient)?;
-        check_coef("diffuse", m.diffuse)?;
-        check_coef("specular", m.specular)?;
-        check_coef("shininess", m.shininess)?;
+        check_coef("material.ambient", m.ambient)?;
+        check_coef("material.diffuse", m.diffuse)?;
+        check_coef("material.specular", m.specular)?;
+        check_coef("material.shininess", m.shininess)?;
         for (i, l) in self.lights.iter().enumerate() {
-            check_dir(&format!("light {} direction", i + 1), l.direction)?;
-            check_coef(&format!("light {} intensity", i + 1), l.intensity)?;
+            check_direction(&format!("light[{i}].direction"), l.direction)?;
+            check_coef(&format!("light[{i}].intensity"), l.intensity)?;
         }
         if let Some(t) = &self.transfer {
-            t.validate()?;
+            t.validate()
+                .map_err(|e| Invalid::new("transfer.points", format!("{e:#}")))?;
         }
         if let Some(c) = self.color {
             if c.iter().any(|x| !(0.0..=1.0).contains(x)) {
-                anyhow::bail!("color {c:?} must have three components in 0..=1");
+                return Err(Invalid::new(
+                    "color",
+                    format!("color = {c:?} must have three components in 0..=1"),
+                ));
             }
         }
         Ok(())
@@ -184,7 +244,8 @@ impl Scene {
     /// contribute nothing dropped: lights of intensity 0, every light when the material has
     /// neither diffuse nor specular, the specular term when its coefficient is 0 (see
     /// [`PreparedScene::shade`]); lights with the same direction become one light of their
-    /// summed intensity (the light model is linear in a light's intensity).
+    /// summed intensity (the light model is linear in a light's intensity). For a validated
+    /// scene: a zero or non-finite direction panics rather than dropping the light.
     pub fn prepared(&self) -> PreparedScene {
         let m = &self.material;
         let mut lights: Vec<(DVec3, f64)> = Vec::new();
@@ -192,14 +253,14 @@ impl Scene {
             if l.intensity <= 0.0 || (m.diffuse <= 0.0 && m.specular <= 0.0) {
                 continue;
             }
-            let d = sym_normalize(DVec3::from_array(l.direction));
+            let d = unit_direction(DVec3::from_array(l.direction)).expect(VALIDATED);
             match lights.iter_mut().find(|(e, _)| *e == d) {
                 Some((_, i)) => *i += l.intensity,
                 None => lights.push((d, l.intensity)),
             }
         }
         PreparedScene {
-            view: sym_normalize(DVec3::from_array(self.view.direction)),
+            view: unit_direction(DVec3::from_array(self.view.direction)).expect(VALIDATED),
             two_sided: self.view.two_sided,
             ambient: m.ambient,
             diffuse: m.diffuse,
@@ -257,6 +318,9 @@ impl Scene {
         self.material.specular > 0.0 && self.lights.iter().any(|l| l.intensity > 0.0)
     }
 }
+
+const VALIDATED: &str =
+    "a validated scene (Scene::validate refuses zero and non-finite directions)";
 
 #[derive(Clone, Debug)]
 pub struct PreparedScene {

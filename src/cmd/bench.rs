@@ -16,10 +16,10 @@ pub struct BenchArgs {
     #[command(flatten)]
     pub force: super::force::ForceArg,
     /// Sphere image side for the error figures [16..=4096].
-    #[arg(long, value_name = "N", default_value_t = 512)]
+    #[arg(long, value_name = "N", default_value_t = 512, value_parser = super::parse::count::<u32>())]
     pub size: u32,
     /// Seconds spent timing each throughput figure.
-    #[arg(long, value_name = "S", default_value_t = 0.3)]
+    #[arg(long, value_name = "S", default_value_t = 0.3, value_parser = super::parse::positive())]
     pub seconds: f64,
     /// Skip the iCE40 place and route (Yosys, nextpnr-ice40) even when they are installed.
     #[arg(long)]

@@ -1,7 +1,9 @@
 //! The configuration flags shared by every command that builds a design: a TOML file, then
 //! flags that override single fields. The result is validated once, here.
 
+use super::parse;
 use crate::config::Config;
+use crate::toml_input;
 use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
@@ -11,26 +13,19 @@ pub struct ConfigArgs {
     /// Configuration TOML (fields as in `Config`); flags below override it.
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
-    /// Gradient component width, two's complement [8..=16, default 12].
-    #[arg(long)]
+    #[arg(long, value_parser = parse::field("grad_bits"), help = parse::field_help("grad_bits", "Gradient component width, two's complement", ""))]
     pub grad_bits: Option<u32>,
-    /// Magnitude width after sort & shift [6..=12, <= grad-bits, default 8].
-    #[arg(long)]
+    #[arg(long, value_parser = parse::field("red_bits"), help = parse::field_help("red_bits", "Magnitude width after sort & shift", ", <= grad-bits"))]
     pub red_bits: Option<u32>,
-    /// Reciprocal ROM entry width [5..=20, >= frac-bits + 1, default 10].
-    #[arg(long)]
+    #[arg(long, value_parser = parse::field("recip_bits"), help = parse::field_help("recip_bits", "Reciprocal ROM entry width", ", >= frac-bits + 1"))]
     pub recip_bits: Option<u32>,
-    /// Normalised fraction width; 2^frac-bits compensation ROM entries [4..=12, default 8].
-    #[arg(long)]
+    #[arg(long, value_parser = parse::field("frac_bits"), help = parse::field_help("frac_bits", "Normalised fraction width; 2^frac-bits compensation ROM entries", ""))]
     pub frac_bits: Option<u32>,
-    /// Map index bits per component [2..=6, default 3].
-    #[arg(long)]
+    #[arg(long, value_parser = parse::field("index_bits"), help = parse::field_help("index_bits", "Map index bits per component", ""))]
     pub index_bits: Option<u32>,
-    /// Interpolation fraction bits [0..=5, 0 iff interpolation is off, default 3].
-    #[arg(long)]
+    #[arg(long, value_parser = parse::field("interp_bits"), help = parse::field_help("interp_bits", "Interpolation fraction bits", ", 0 iff interpolation is off"))]
     pub interp_bits: Option<u32>,
-    /// Map entry and output intensity width [6..=12, default 8].
-    #[arg(long)]
+    #[arg(long, value_parser = parse::field("map_bits"), help = parse::field_help("map_bits", "Map entry and output intensity width", ""))]
     pub map_bits: Option<u32>,
     /// Leave out distortion compensation (no atan ROM; linear index).
     #[arg(long)]
@@ -41,9 +36,7 @@ pub struct ConfigArgs {
     /// Add the 8-bit RGB colour multiplier.
     #[arg(long)]
     pub color: bool,
-    /// Pipeline registers: 0 compact (lowest latency), 1 and 2 add registers for clock rate
-    /// [0..=2, default 2].
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", value_parser = parse::field("pipeline_depth"), help = parse::field_help("pipeline_depth", "Pipeline registers: 0 compact (lowest latency), 1 and 2 add registers for clock rate", ""))]
     pub pipeline_depth: Option<u32>,
     /// Valid/ready handshake on the top (backpressure stalls the pipeline) instead of a
     /// plain valid stream.
@@ -52,13 +45,28 @@ pub struct ConfigArgs {
 }
 
 impl ConfigArgs {
+    /// The configuration file with the flags applied, validated once: a file that is invalid
+    /// alone but valid with the flags (`interp_bits = 0` and `--no-interpolation`) is
+    /// accepted. An error names where each value it is about came from (a flag, the file's
+    /// line and column, or the default).
     pub fn resolve(&self) -> Result<Config> {
-        let mut c = match &self.config {
-            Some(p) => Config::from_toml_file(p)?,
-            None => Config::default(),
+        let file = match &self.config {
+            Some(p) => {
+                let text = toml_input::read(p, "config")?;
+                let what = format!("config {}", p.display());
+                let c: Config = toml_input::parse(&text, &what)?;
+                Some((c, text, what))
+            }
+            None => None,
         };
+        let mut c = file.as_ref().map_or_else(Config::default, |f| f.0.clone());
+        // The fields set by a flag, with the flag.
+        let mut flags: Vec<(&'static str, String)> = Vec::new();
         macro_rules! set {
-            ($($f:ident),*) => { $( if let Some(v) = self.$f { c.$f = v; } )* };
+            ($($f:ident),*) => { $( if let Some(v) = self.$f {
+                c.$f = v;
+                flags.push((stringify!($f), format!("--{} {v}", stringify!($f).replace('_', "-"))));
+            } )* };
         }
         set!(
             grad_bits,
@@ -71,21 +79,62 @@ impl ConfigArgs {
         );
         if self.no_compensation {
             c.compensation = false;
+            flags.push(("compensation", "--no-compensation".into()));
         }
         if self.no_interpolation {
             c.interpolation = false;
             c.interp_bits = 0;
+            flags.push(("interpolation", "--no-interpolation".into()));
+            flags.push(("interp_bits", "--no-interpolation".into()));
         }
         if let Some(p) = self.interp_bits {
             c.interp_bits = p;
+            flags.retain(|f| f.0 != "interp_bits");
+            flags.push(("interp_bits", format!("--interp-bits {p}")));
         }
         if self.color {
             c.color = true;
+            flags.push(("color", "--color".into()));
         }
         if self.handshake {
             c.handshake = true;
+            flags.push(("handshake", "--handshake".into()));
         }
-        c.validate()?;
-        Ok(c)
+        let Err(e) = c.validate() else {
+            return Ok(c);
+        };
+        let fields = e.fields();
+        let flag = |f: &str| flags.iter().find(|x| x.0 == f).map(|x| x.1.clone());
+        match &file {
+            // Every value involved is the file's: point at the first one in it.
+            Some((_, text, what)) if fields.iter().all(|f| flag(f).is_none()) => {
+                let key = fields
+                    .iter()
+                    .find(|f| toml_input::span_of(text, f).is_some())
+                    .unwrap_or(&fields[0]);
+                Err(toml_input::invalid(
+                    text,
+                    what,
+                    &toml_input::Invalid::new(*key, e.to_string()),
+                ))
+            }
+            _ => {
+                let from: Vec<String> = fields
+                    .iter()
+                    .map(|f| match (flag(f), &file) {
+                        (Some(fl), _) => format!("{f} from {fl}"),
+                        (None, Some((_, text, what))) => match toml_input::span_of(text, f) {
+                            Some(s) => {
+                                let (l, col) = toml_input::line_col(text, s.start);
+                                format!("{f} from {what}:{l}:{col}")
+                            }
+                            None => format!("{f} by default"),
+                        },
+                        (None, None) => format!("{f} by default"),
+                    })
+                    .collect();
+                anyhow::bail!("{e} ({})", from.join(", "))
+            }
+        }
     }
 }

@@ -2,6 +2,7 @@
 //! target; prints the decision and writes the chosen design as `generate` does.
 
 use super::generate;
+use super::parse;
 use crate::config::Config;
 use crate::fit::{self, CostKind, Options, Outcome, Target};
 use crate::model::map_fit::MapFit;
@@ -21,10 +22,10 @@ pub struct FitArgs {
     pub scene: PathBuf,
     /// Largest absolute error allowed on any output, in its LSBs (intensity: map-bits wide;
     /// colour channels: 8 bits).
-    #[arg(long, value_name = "E")]
+    #[arg(long, value_name = "E", value_parser = parse::at_least::<u32>(0))]
     pub max_error: Option<u32>,
     /// Largest RMS intensity error allowed, in output LSBs.
-    #[arg(long, value_name = "R")]
+    #[arg(long, value_name = "R", value_parser = parse::non_negative())]
     pub rmse: Option<f64>,
     /// What "cheapest" means: ROM + map bits, or cells of Yosys synthesis.
     #[arg(long, value_enum, default_value_t = CostKind::Bits)]
@@ -36,15 +37,15 @@ pub struct FitArgs {
     #[command(flatten)]
     pub force: super::force::ForceArg,
     /// Gradient component width of the source (fixed, not searched) [8..=16].
-    #[arg(long, value_name = "G", default_value_t = 12)]
+    #[arg(long, value_name = "G", default_value_t = 12, value_parser = parse::field("grad_bits"))]
     pub grad_bits: u32,
     /// Output intensity (map entry) width: the error target's LSB (fixed, not searched)
     /// [6..=12].
-    #[arg(long, value_name = "M", default_value_t = 8)]
+    #[arg(long, value_name = "M", default_value_t = 8, value_parser = parse::field("map_bits"))]
     pub map_bits: u32,
     /// Pipeline depth of the generated design (does not change the error) [0..=2, default
     /// as generate: 2].
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", value_parser = parse::field("pipeline_depth"))]
     pub pipeline_depth: Option<u32>,
     /// Valid/ready handshake on the generated top.
     #[arg(long)]
@@ -53,21 +54,21 @@ pub struct FitArgs {
     #[arg(long, value_enum)]
     pub map_fit: Option<MapFit>,
     /// Side of the sphere test image [16..=4096].
-    #[arg(long, value_name = "N", default_value_t = 512)]
+    #[arg(long, value_name = "N", default_value_t = 512, value_parser = parse::count::<u32>())]
     pub size: u32,
     /// Passing configurations listed after the choice.
-    #[arg(long, value_name = "K", default_value_t = 3)]
+    #[arg(long, value_name = "K", default_value_t = 3, value_parser = parse::count::<usize>())]
     pub runners_up: usize,
     /// With --cost cells: how many passing configurations to synthesise, shared equally by
     /// the four combinations of compensation and interpolation (the cheapest passing ones in
     /// bits of each) [1..=64].
-    #[arg(long, value_name = "S", default_value_t = 8)]
+    #[arg(long, value_name = "S", default_value_t = 8, value_parser = parse::count::<usize>())]
     pub synth_limit: usize,
     /// Seeded random vectors per stage in the written design (as generate --vectors).
-    #[arg(long, value_name = "N", default_value_t = 2000)]
+    #[arg(long, value_name = "N", default_value_t = 2000, value_parser = parse::count::<usize>())]
     pub vectors: usize,
     /// Seed of the random vectors.
-    #[arg(long, value_name = "S", default_value_t = 1)]
+    #[arg(long, value_name = "S", default_value_t = 1, value_parser = parse::at_least::<u64>(0))]
     pub seed: u64,
 }
 

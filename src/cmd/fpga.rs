@@ -24,10 +24,10 @@ pub struct FpgaArgs {
     #[arg(long, default_value = "ct256")]
     pub package: String,
     /// Target clock the placer aims at, MHz.
-    #[arg(long, value_name = "MHZ", default_value_t = 125.0)]
+    #[arg(long, value_name = "MHZ", default_value_t = 125.0, value_parser = super::parse::positive())]
     pub freq: f64,
     /// Placer seed.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = super::parse::at_least::<u64>(0))]
     pub seed: u64,
     /// Directory for the logs, netlist, bitstream text (.asc) and report.json (replaced whole,
     /// also when the flow fails, so its logs can be read).

@@ -26,10 +26,10 @@ pub struct GenerateArgs {
     #[command(flatten)]
     pub force: super::force::ForceArg,
     /// Seeded random vectors per stage, after the hand-picked corner cases.
-    #[arg(long, value_name = "N", default_value_t = 2000)]
+    #[arg(long, value_name = "N", default_value_t = 2000, value_parser = super::parse::count::<usize>())]
     pub vectors: usize,
     /// Seed of the random vectors.
-    #[arg(long, value_name = "S", default_value_t = 1)]
+    #[arg(long, value_name = "S", default_value_t = 1, value_parser = super::parse::at_least::<u64>(0))]
     pub seed: u64,
 }
 

@@ -6,6 +6,7 @@ pub mod fit;
 pub mod force;
 pub mod fpga;
 pub mod generate;
+pub mod parse;
 pub mod render;
 pub mod roms;
 pub mod stress;

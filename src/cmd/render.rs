@@ -17,10 +17,10 @@ pub struct RenderArgs {
     #[arg(long, value_name = "FILE")]
     pub scene: Option<PathBuf>,
     /// Image width and height in pixels [1..=4096].
-    #[arg(long, value_name = "N", default_value_t = render::DEFAULT_SIZE)]
+    #[arg(long, value_name = "N", default_value_t = render::DEFAULT_SIZE, value_parser = super::parse::count::<u32>())]
     pub size: u32,
     /// Scale the gradients down by 2^K, to exercise the leading-zero shift [0..=grad-bits - 1].
-    #[arg(long, value_name = "K", default_value_t = 0)]
+    #[arg(long, value_name = "K", default_value_t = 0, value_parser = super::parse::at_least::<u32>(0))]
     pub shrink: u32,
     /// Also shade every pixel with the generated RTL (Verilated top) and write rtl.png; fails
     /// unless the RTL image equals the model image pixel for pixel.

@@ -57,16 +57,16 @@ pub struct VolumeArgs {
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
     pub view: Option<String>,
     /// Image width and height in pixels [1..=4096].
-    #[arg(long, value_name = "N", default_value_t = 512)]
+    #[arg(long, value_name = "N", default_value_t = 512, value_parser = super::parse::count::<u32>())]
     pub size: u32,
     /// Sample step along a ray, in smallest voxel spacings [0.05..=4].
-    #[arg(long, value_name = "S", default_value_t = cast::DEFAULT_STEP)]
+    #[arg(long, value_name = "S", default_value_t = cast::DEFAULT_STEP, value_parser = super::parse::positive())]
     pub step: f64,
     /// Early ray termination: accumulated opacity at which a pixel counts as opaque (0, 1].
-    #[arg(long, value_name = "A", default_value_t = cast::DEFAULT_ERT)]
+    #[arg(long, value_name = "A", default_value_t = cast::DEFAULT_ERT, value_parser = super::parse::positive())]
     pub ert: f64,
     /// Brick side in cells for empty-space skipping [a power of two, 2..=64].
-    #[arg(long, value_name = "N", default_value_t = cast::DEFAULT_BRICK)]
+    #[arg(long, value_name = "N", default_value_t = cast::DEFAULT_BRICK, value_parser = super::parse::count::<usize>())]
     pub brick: usize,
     /// Turn skipping off (empty space, early termination, unshaded samples): same image,
     /// more work.
@@ -81,7 +81,7 @@ pub struct VolumeArgs {
     #[arg(long)]
     pub rtl: bool,
     /// Timed runs per measurement with --timing (the median is reported).
-    #[arg(long, value_name = "N", default_value_t = 5)]
+    #[arg(long, value_name = "N", default_value_t = 5, value_parser = super::parse::count::<u32>())]
     pub repeat: u32,
     /// Output directory for reference.png, model.png, error50.png and metrics.json (replaced
     /// whole on success).
@@ -115,7 +115,9 @@ fn scene(a: &VolumeArgs) -> Result<Scene> {
         None => Scene::from_toml_str(ENGINE_SCENE_TOML).context("the built-in engine scene")?,
     };
     if let Some(v) = &a.view {
-        scene.view.direction = triple::<f64>("--view", v)?;
+        let d = triple::<f64>("--view", v)?;
+        crate::scene::check_direction("--view", d)?;
+        scene.view.direction = d;
     }
     if let Some(t) = &a.transfer {
         scene.transfer = Some(Transfer::parse(t)?);
@@ -327,6 +329,7 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
         rtl.as_ref()
             .map(|t| t as &dyn crate::render::IntensitySource),
     )?;
+    report::check_covered(&r, &vol)?;
     if let Some(n) = r.rtl_mismatches() {
         if n > 0 {
             bail!("the RTL image differs from the model image in {n} pixels");

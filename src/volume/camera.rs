@@ -31,14 +31,12 @@ pub struct Camera {
 impl Camera {
     /// A camera framing the world box `lo..=hi`, looking along `-view`.
     pub fn new(lo: [f64; 3], hi: [f64; 3], view: [f64; 3], size: u32) -> Result<Camera> {
-        let v = DVec3::from_array(view);
-        if !v.is_finite() || v.length() < 1e-12 {
+        let Some(view) = crate::scene::unit_direction(DVec3::from_array(view)) else {
             bail!("view direction {view:?} must be a finite, non-zero vector");
-        }
+        };
         if size == 0 {
             bail!("image size must be at least 1");
         }
-        let view = v.normalize();
         let hint = if view.z.abs() > 0.99 {
             DVec3::Y
         } else {
@@ -116,6 +114,16 @@ mod tests {
             assert!(p.dot(c.right).abs() <= half && p.dot(c.up).abs() <= half);
         }
         assert!(Camera::new([0.0; 3], [8.0; 3], [0.0, 0.0, 0.0], 64).is_err());
+        assert!(Camera::new([0.0; 3], [8.0; 3], [f64::NAN, 0.0, 1.0], 64).is_err());
+        // Huge and tiny components give the view of the same direction.
+        let unit = Camera::new([0.0; 3], [8.0; 3], [1.0, 0.0, 0.0], 64).unwrap();
+        for v in [[1e200, 0.0, 0.0], [1e308, 0.0, 0.0], [1e-310, 0.0, 0.0]] {
+            assert_eq!(
+                Camera::new([0.0; 3], [8.0; 3], v, 64).unwrap(),
+                unit,
+                "{v:?}"
+            );
+        }
         // A box away from the origin is centred.
         let c = Camera::new([10.0, 20.0, 30.0], [12.0, 22.0, 32.0], [0.0, 0.0, 1.0], 8).unwrap();
         assert_eq!(c.centre, DVec3::new(11.0, 21.0, 31.0));

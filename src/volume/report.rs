@@ -107,6 +107,44 @@ pub fn scene_transfer(scene: &Scene) -> Result<&Transfer> {
     }
 }
 
+/// Refuses a render in which the transfer function made every sample transparent (no pixel
+/// covered): the image would be blank. The message gives the data's value distribution and
+/// the breakpoints, to choose breakpoints from.
+pub fn check_covered(r: &VolumeRender, vol: &super::Volume) -> Result<()> {
+    if r.covered.iter().any(|&c| c) {
+        return Ok(());
+    }
+    let t = scene_transfer(&r.scene)?;
+    let [min, p1, p50, p99, max] = percentiles(vol);
+    let points: Vec<String> = t
+        .points
+        .iter()
+        .map(|p| format!("{}:{}", p[0], p[1]))
+        .collect();
+    bail!(
+        "nothing covered: the transfer function makes every sample of the volume transparent (0 of {n}x{n} pixels); the data's values are min {min}, p1 {p1}, p50 {p50}, p99 {p99}, max {max}, and the transfer function's breakpoints (value:opacity) are {}; give breakpoints with opacity > 0 inside the data's range (--transfer or the scene's [transfer])",
+        points.join(","),
+        n = r.opts.size
+    )
+}
+
+/// Minimum, 1st, 50th and 99th percentile and maximum of the voxel values (nearest rank;
+/// the percentiles of an evenly strided sample of at most 2^22 values for larger volumes).
+pub fn percentiles(vol: &super::Volume) -> [f32; 5] {
+    let (min, max) = vol.range();
+    let stride = vol.data.len().div_ceil(1 << 22).max(1);
+    let mut v: Vec<f32> = vol.data.iter().step_by(stride).copied().collect();
+    if v.is_empty() {
+        return [min, min, min, max, max];
+    }
+    let mut at = |q: f64| {
+        let k = ((q * (v.len() - 1) as f64).round() as usize).min(v.len() - 1);
+        *v.select_nth_unstable_by(k, f32::total_cmp).1
+    };
+    let (p1, p50, p99) = (at(0.01), at(0.5), at(0.99));
+    [min, p1, p50, p99, max]
+}
+
 /// Renders a prepared volume with the scene's view direction and transfer function.
 pub fn render(
     p: &Prepared,

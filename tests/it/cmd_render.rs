@@ -133,7 +133,7 @@ fn nan_light_direction() {
             "{MATERIAL}[[light]]\ndirection = [nan, 0.0, 1.0]\n"
         )),
         &[],
-        "light 1 direction [NaN, 0.0, 1.0] is not finite",
+        "scene.toml:7:13: light[0].direction = [NaN, 0.0, 1.0] is not finite",
     );
 }
 
@@ -144,7 +144,7 @@ fn zero_light_direction() {
             "{MATERIAL}[[light]]\ndirection = [0.0, 0.0, 0.0]\n"
         )),
         &[],
-        "light 1 direction [0.0, 0.0, 0.0] has zero length",
+        "scene.toml:7:13: light[0].direction = [0.0, 0.0, 0.0] has zero length",
     );
 }
 
@@ -162,7 +162,7 @@ fn out_of_range_width() {
     fails(
         None,
         &["--grad-bits", "30"],
-        "grad_bits = 30 is out of range; allowed 8..=16",
+        "--grad-bits must be in 8..=16, not 30",
     );
 }
 
@@ -200,11 +200,13 @@ fn failure_keeps_an_existing_output() {
             "--size",
             "16",
             "--red-bits",
-            "13",
+            "12",
+            "--grad-bits",
+            "10",
             "--out",
             out.to_str().unwrap(),
         ]),
-        "red_bits = 13",
+        "red_bits = 12 exceeds grad_bits = 10",
     );
     assert_eq!(std::fs::read(out.join("metrics.json")).unwrap(), before);
     assert_eq!(entries(tmp.path()), ["o"]);

@@ -331,11 +331,11 @@ fn bad_input_is_one_line_exit_2_and_leaves_the_output_alone() {
     let cases: [(Vec<&str>, &str); 6] = [
         (
             vec!["--scene", &s, "--max-error", "4", "--grad-bits", "20"],
-            "grad_bits",
+            "--grad-bits must be in 8..=16, not 20",
         ),
         (
             vec!["--scene", &s, "--max-error", "4", "--map-bits", "5"],
-            "map_bits",
+            "--map-bits must be in 6..=12, not 5",
         ),
         (
             vec!["--scene", &s, "--max-error", "4", "--size", "8"],

@@ -2,6 +2,7 @@
 
 mod bench;
 mod cmd_render;
+mod errors;
 mod fast;
 mod fit;
 mod grid;

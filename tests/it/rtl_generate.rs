@@ -206,7 +206,7 @@ fn invalid_config_exits_2_and_writes_nothing() {
         "--grad-bits",
         "30",
     ]);
-    helpers::assert_error(&o, "grad_bits = 30");
+    helpers::assert_error(&o, "--grad-bits must be in 8..=16, not 30");
     assert!(!out.exists(), "an invalid config left {}", out.display());
     let o = helpers::run(&[
         "generate",

@@ -451,7 +451,7 @@ fn cli_writes_a_top_stream() {
         "--out",
         g.to_str().unwrap(),
     ]);
-    helpers::assert_error(&o, "grad_bits = 30");
+    helpers::assert_error(&o, "--grad-bits must be in 8..=16, not 30");
     assert!(!g.exists());
     let o = helpers::run(&[
         "vectors",

@@ -1,0 +1,217 @@
+//! Loading TOML input files (scenes and configurations) with errors a user can act on: one
+//! line naming the file, the line and column, and the key path (`light[9999].direction`),
+//! for a syntax error, a value of the wrong type or shape, and a value refused by validation
+//! after parsing.
+
+use anyhow::{bail, Result};
+use serde::de::DeserializeOwned;
+use std::ops::Range;
+use std::path::Path;
+
+/// A value refused by validation after parsing: the key path it sits at (as written in the
+/// file, e.g. `light[2].direction`, `material.shininess`) and a message that names it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Invalid {
+    pub key: String,
+    pub message: String,
+}
+
+impl Invalid {
+    pub fn new(key: impl Into<String>, message: impl Into<String>) -> Invalid {
+        Invalid {
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+}
+
+impl std::fmt::Display for Invalid {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for Invalid {}
+
+/// 1-based line and column (in characters) of byte offset `at` in `text`.
+pub fn line_col(text: &str, at: usize) -> (usize, usize) {
+    let mut at = at.min(text.len());
+    while !text.is_char_boundary(at) {
+        at -= 1;
+    }
+    let before = &text[..at];
+    let line = before.matches('\n').count() + 1;
+    let start = before.rfind('\n').map_or(0, |i| i + 1);
+    (line, before[start..].chars().count() + 1)
+}
+
+/// The one-line form of any message: newlines and other control characters become spaces.
+pub fn one_line(s: &str) -> String {
+    let s: String = s
+        .trim()
+        .chars()
+        .map(|c| if c.is_control() { ' ' } else { c })
+        .collect();
+    s
+}
+
+/// `what:line:col: ` (or `what: ` without a position).
+fn place(what: &str, text: &str, span: Option<Range<usize>>) -> String {
+    match span {
+        Some(s) => {
+            let (l, c) = line_col(text, s.start);
+            format!("{what}:{l}:{c}")
+        }
+        None => what.to_string(),
+    }
+}
+
+/// One path segment: a table key or an array index.
+enum Seg<'a> {
+    Key(&'a str),
+    Index(usize),
+}
+
+fn segments(path: &str) -> Option<Vec<Seg<'_>>> {
+    let mut out = Vec::new();
+    for part in path.split('.') {
+        let (name, mut rest) = match part.find('[') {
+            Some(i) => (&part[..i], &part[i..]),
+            None => (part, ""),
+        };
+        if !name.is_empty() {
+            out.push(Seg::Key(name));
+        }
+        while let Some(r) = rest.strip_prefix('[') {
+            let end = r.find(']')?;
+            out.push(Seg::Index(r[..end].parse().ok()?));
+            rest = &r[end + 1..];
+        }
+    }
+    Some(out)
+}
+
+/// The byte range of the value at `path` (`light[2].direction`) in the TOML `text`, or of
+/// the deepest part of the path that exists.
+pub fn span_of(text: &str, path: &str) -> Option<Range<usize>> {
+    let root = toml::de::DeTable::parse(text).ok()?;
+    let mut span = None;
+    let top = toml::de::DeValue::Table(root.into_inner());
+    let mut cur = &top;
+    for seg in segments(path)? {
+        let next = match seg {
+            Seg::Key(k) => cur.get(k),
+            Seg::Index(i) => cur.get(i),
+        };
+        match next {
+            Some(v) => {
+                span = Some(v.span());
+                cur = v.get_ref();
+            }
+            None => break,
+        }
+    }
+    span
+}
+
+/// Parses `text` as a `T`; an error is one line: `what:line:col: key.path: message`.
+pub fn parse<T: DeserializeOwned>(text: &str, what: &str) -> Result<T> {
+    let de = match toml::de::Deserializer::parse(text) {
+        Ok(d) => d,
+        Err(e) => bail!(syntax_error(text, what, &e)),
+    };
+    match serde_path_to_error::deserialize::<_, T>(de) {
+        Ok(v) => Ok(v),
+        Err(e) => {
+            let path = e.path().to_string();
+            let inner = e.into_inner();
+            let key = if path == "." || path.is_empty() {
+                None
+            } else {
+                Some(path)
+            };
+            let span = inner
+                .span()
+                .or_else(|| key.as_deref().and_then(|k| span_of(text, k)));
+            let mut msg = place(what, text, span);
+            if let Some(k) = key {
+                msg.push_str(&format!(": {k}"));
+            }
+            msg.push_str(&format!(": {}", one_line(inner.message())));
+            bail!(msg)
+        }
+    }
+}
+
+/// A syntax error, with the case of `key =` with nothing after it said plainly.
+fn syntax_error(text: &str, what: &str, e: &toml::de::Error) -> String {
+    let span = e.span();
+    if let Some(s) = &span {
+        let (l, _) = line_col(text, s.start);
+        if let Some(line) = text.lines().nth(l - 1) {
+            let code = line.split('#').next().unwrap_or("");
+            if let Some((key, value)) = code.split_once('=') {
+                let key = key.trim();
+                if value.trim().is_empty()
+                    && !key.is_empty()
+                    && !key.contains(['[', ']', '"', '\''])
+                {
+                    let col = line.find('=').map_or(1, |i| line[..=i].chars().count() + 1);
+                    return format!("{what}:{l}:{col}: {key} has no value; give one after '='");
+                }
+            }
+        }
+    }
+    format!("{}: {}", place(what, text, span), one_line(e.message()))
+}
+
+/// A validation error located in the file: `what:line:col: message`.
+pub fn invalid(text: &str, what: &str, e: &Invalid) -> anyhow::Error {
+    let span = span_of(text, &e.key);
+    anyhow::anyhow!("{}: {}", place(what, text, span), one_line(&e.message))
+}
+
+/// Reads a TOML input file: refuses a directory or an unreadable file in one line.
+/// `kind` is what the file holds ("scene", "config").
+pub fn read(path: &Path, kind: &str) -> Result<String> {
+    if path.is_dir() {
+        bail!("{kind} {} is a directory, not a TOML file", path.display());
+    }
+    match std::fs::read(path) {
+        Ok(bytes) => match String::from_utf8(bytes) {
+            Ok(s) => Ok(s),
+            Err(e) => {
+                let at = e.utf8_error().valid_up_to();
+                let (l, c) = line_col(&String::from_utf8_lossy(e.as_bytes()), at);
+                bail!(
+                    "{kind} {}:{l}:{c}: not UTF-8 text (TOML files are UTF-8)",
+                    path.display()
+                )
+            }
+        },
+        Err(e) => bail!("cannot read {kind} {}: {e}", path.display()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_and_columns() {
+        assert_eq!(line_col("ab\ncd\n", 0), (1, 1));
+        assert_eq!(line_col("ab\ncd\n", 4), (2, 2));
+        assert_eq!(line_col("é\nx", 3), (2, 1));
+        assert_eq!(line_col("ab", 99), (1, 3));
+    }
+
+    #[test]
+    fn spans_of_key_paths() {
+        let t = "a = 1\n[[light]]\nd = [1, 2]\n[[light]]\nd = [3]\n[m]\nx = 2\n";
+        let s = span_of(t, "light[1].d").unwrap();
+        assert_eq!(&t[s], "[3]");
+        let s = span_of(t, "m.x").unwrap();
+        assert_eq!(line_col(t, s.start), (7, 5));
+        assert!(span_of(t, "nothing").is_none());
+    }
+}
