@@ -3,13 +3,13 @@
 //! list, the ports and the latencies below are its tables in code, and everything that needs
 //! them (the templates, the manifest, the testbenches) reads them from here.
 
+pub mod adder_tree;
 pub mod banks;
 pub mod fpga;
 pub mod manifest;
 pub mod package;
 pub mod pipe;
 pub mod ports;
-pub mod adder_tree;
 pub mod templates;
 pub mod verilated;
 
