@@ -148,6 +148,9 @@ fn volume(a: &VolumeArgs) -> Result<Volume> {
         .input
         .as_ref()
         .expect("clap requires FILE without --synthetic");
+    if path.is_dir() {
+        bail!("{} is a directory, not a volume file", path.display());
+    }
     if load::is_nrrd(path) {
         if a.dims.is_some() || a.bits.is_some() || a.signed {
             bail!("--dims, --bits and --signed are for raw files; the NRRD header {} gives the layout", path.display());
