@@ -61,7 +61,8 @@ pub struct FitArgs {
     /// bits of each) [1..=64].
     #[arg(long, value_name = "S", default_value_t = 8)]
     pub synth_limit: usize,
-    /// Seeded random vectors per stage in the written design (as generate --vectors).
+    /// Seeded random vectors per stage in the written design (as generate --vectors)
+    /// [0..=1000000].
     #[arg(long, value_name = "N", default_value_t = 2000)]
     pub vectors: usize,
     /// Seed of the random vectors.
@@ -70,6 +71,7 @@ pub struct FitArgs {
 }
 
 pub fn run(a: &FitArgs) -> Result<()> {
+    crate::vectors::check_stage_vectors(a.vectors, "--vectors")?;
     let scene = Scene::from_toml_file(&a.scene)?;
     let base = Config {
         grad_bits: a.grad_bits,

@@ -23,7 +23,7 @@ pub struct GenerateArgs {
     /// Output directory (replaced whole on success).
     #[arg(long, value_name = "DIR", default_value = "rtl_out")]
     pub out: PathBuf,
-    /// Seeded random vectors per stage, after the hand-picked corner cases.
+    /// Seeded random vectors per stage, after the hand-picked corner cases [0..=1000000].
     #[arg(long, value_name = "N", default_value_t = 2000)]
     pub vectors: usize,
     /// Seed of the random vectors.
@@ -32,6 +32,7 @@ pub struct GenerateArgs {
 }
 
 pub fn run(a: &GenerateArgs) -> Result<()> {
+    vectors::check_stage_vectors(a.vectors, "--vectors")?;
     let cfg = a.cfg.resolve()?;
     let scene = match &a.scene {
         Some(p) => Scene::from_toml_file(p)?,
