@@ -80,7 +80,7 @@ pub struct VolumeArgs {
     /// unless the RTL image equals the model image pixel for pixel.
     #[arg(long)]
     pub rtl: bool,
-    /// Timed runs per measurement with --timing (the median is reported).
+    /// Timed runs per measurement with --timing (the median is reported) [1..=100].
     #[arg(long, value_name = "N", default_value_t = 5)]
     pub repeat: u32,
     /// Output directory for reference.png, model.png, error50.png and metrics.json (replaced
@@ -88,6 +88,9 @@ pub struct VolumeArgs {
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
 }
+
+/// Largest `--repeat`: each timed run renders a frame (up to seconds with skipping off).
+pub const MAX_REPEAT: u32 = 100;
 
 /// Parses `X,Y,Z` into three numbers.
 fn triple<T: std::str::FromStr>(flag: &str, s: &str) -> Result<[T; 3]> {
@@ -301,6 +304,12 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
     opts.validate()?;
     if a.timing && a.repeat == 0 {
         bail!("--repeat must be at least 1");
+    }
+    if a.repeat > MAX_REPEAT {
+        bail!(
+            "--repeat {} is more than the limit of {MAX_REPEAT}",
+            a.repeat
+        );
     }
     let t = Instant::now();
     let vol = volume(a)?;
