@@ -98,9 +98,10 @@ impl VoxelType {
         Ok(t)
     }
 
-    /// Appends packed voxels (a whole number of them) to `out` as f32. A finite value too
-    /// large for f32 (a double beyond 3.4e38) is an error naming it and its voxel, counted
-    /// from `first` (the index of the first voxel in `bytes`).
+    /// Appends packed voxels (a whole number of them) to `out` as f32, without any
+    /// temporary. A finite value too large for f32 (a double beyond 3.4e38) is an error
+    /// naming it and its voxel, counted from `first` (the index of the first voxel in
+    /// `bytes`).
     pub fn decode_into(
         self,
         bytes: &[u8],
@@ -108,57 +109,58 @@ impl VoxelType {
         first: usize,
         out: &mut Vec<f32>,
     ) -> std::result::Result<(), Overflow> {
-        if self == VoxelType::F64 {
-            for (i, c) in bytes.chunks_exact(8).enumerate() {
-                let a: [u8; 8] = c.try_into().expect("8 bytes");
-                let v = if big_endian {
-                    f64::from_be_bytes(a)
-                } else {
-                    f64::from_le_bytes(a)
-                };
-                let f = v as f32;
-                if v.is_finite() && !f.is_finite() {
-                    return Err(Overflow {
-                        index: first + i,
-                        value: v,
-                    });
-                }
-                out.push(f);
-            }
-            return Ok(());
+        macro_rules! conv {
+            ($t:ty, $n:expr) => {
+                out.extend(bytes.chunks_exact($n).map(|c| {
+                    let a: [u8; $n] = c.try_into().expect("whole voxels");
+                    (if big_endian {
+                        <$t>::from_be_bytes(a)
+                    } else {
+                        <$t>::from_le_bytes(a)
+                    }) as f32
+                }))
+            };
         }
-        out.extend(self.decode(bytes, big_endian));
+        match self {
+            VoxelType::I8 => out.extend(bytes.iter().map(|&b| b as i8 as f32)),
+            VoxelType::U8 => out.extend(bytes.iter().map(|&b| b as f32)),
+            VoxelType::I16 => conv!(i16, 2),
+            VoxelType::U16 => conv!(u16, 2),
+            VoxelType::I32 => conv!(i32, 4),
+            VoxelType::U32 => conv!(u32, 4),
+            VoxelType::F32 => conv!(f32, 4),
+            VoxelType::F64 => {
+                for (i, c) in bytes.chunks_exact(8).enumerate() {
+                    let a: [u8; 8] = c.try_into().expect("8 bytes");
+                    let v = if big_endian {
+                        f64::from_be_bytes(a)
+                    } else {
+                        f64::from_le_bytes(a)
+                    };
+                    let f = v as f32;
+                    if v.is_finite() && !f.is_finite() {
+                        return Err(Overflow {
+                            index: first + i,
+                            value: v,
+                        });
+                    }
+                    out.push(f);
+                }
+            }
+        }
         Ok(())
     }
 
     /// Converts packed voxels to f32 (a double too large for f32 becomes infinite; the
     /// loaders use [`VoxelType::decode_into`], which refuses it).
     pub fn decode(self, bytes: &[u8], big_endian: bool) -> Vec<f32> {
-        macro_rules! conv {
-            ($t:ty, $n:expr) => {
-                bytes
-                    .chunks_exact($n)
-                    .map(|c| {
-                        let a: [u8; $n] = c.try_into().unwrap();
-                        (if big_endian {
-                            <$t>::from_be_bytes(a)
-                        } else {
-                            <$t>::from_le_bytes(a)
-                        }) as f32
-                    })
-                    .collect()
-            };
+        let mut out = Vec::with_capacity(bytes.len() / self.bytes());
+        if let Err(o) = self.decode_into(bytes, big_endian, 0, &mut out) {
+            out.push(f32::INFINITY.copysign(o.value as f32));
+            let rest = &bytes[(o.index + 1) * 8..];
+            out.extend(self.decode(rest, big_endian));
         }
-        match self {
-            VoxelType::I8 => bytes.iter().map(|&b| b as i8 as f32).collect(),
-            VoxelType::U8 => bytes.iter().map(|&b| b as f32).collect(),
-            VoxelType::I16 => conv!(i16, 2),
-            VoxelType::U16 => conv!(u16, 2),
-            VoxelType::I32 => conv!(i32, 4),
-            VoxelType::U32 => conv!(u32, 4),
-            VoxelType::F32 => conv!(f32, 4),
-            VoxelType::F64 => conv!(f64, 8),
-        }
+        out
     }
 }
 
@@ -201,8 +203,9 @@ fn open_file(path: &Path, what: &str) -> Result<(std::fs::File, u64)> {
 }
 
 /// Reads exactly the voxel data of `dims` voxels of type `t` from `r` and decodes it in
-/// chunks into f32 values, reserving the values first (an allocation failure is an error,
-/// not an abort). `size_error(have)` builds the error for a stream that ends early (have <
+/// chunks into f32 values, reserved with `try_reserve_exact` (an allocation failure is an
+/// error, not an abort). `check_end` marks a stream of unknown length (gzip): its values
+/// are reserved as they arrive and it must end after the data. `size_error(have)` builds the error for a stream that ends early (have <
 /// want) or goes on (have = want + 1, when `check_end`).
 #[allow(clippy::too_many_arguments)]
 fn read_voxels(
@@ -217,12 +220,22 @@ fn read_voxels(
 ) -> Result<Vec<f32>> {
     let n = dims[0] * dims[1] * dims[2];
     let mut values: Vec<f32> = Vec::new();
-    values.try_reserve_exact(n).map_err(|_| {
-        anyhow::anyhow!(
-            "{what}: cannot allocate {} for {n} voxel values",
-            human_bytes(4 * n as u64)
-        )
-    })?;
+    let reserve = |values: &mut Vec<f32>, cap: usize| -> Result<()> {
+        values.try_reserve_exact(cap - values.len()).map_err(|_| {
+            anyhow::anyhow!(
+                "{what}: cannot allocate {} for {n} voxel values",
+                human_bytes(4 * n as u64)
+            )
+        })
+    };
+    // A stream of known length gets all its values at once; a gzip stream only as its data
+    // arrives (doubling, never beyond n), so a small file that claims many voxels allocates
+    // no more than it holds.
+    if check_end {
+        reserve(&mut values, n.min(CHUNK))?;
+    } else {
+        reserve(&mut values, n)?;
+    }
     let want = (n * t.bytes()) as u64;
     let chunk = (CHUNK / t.bytes()) * t.bytes();
     let mut buf = vec![0u8; chunk.min(want as usize)];
@@ -237,6 +250,11 @@ fn read_voxels(
                 Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
                 Err(e) => return Err(read_error(e)),
             }
+        }
+        let count = len / t.bytes();
+        if values.capacity() - values.len() < count {
+            let cap = n.min((2 * values.capacity()).max(values.len() + count));
+            reserve(&mut values, cap)?;
         }
         t.decode_into(&buf[..len], big_endian, values.len(), &mut values)
             .map_err(|o| anyhow::anyhow!(o.message(what, dims)))?;
@@ -307,7 +325,7 @@ pub fn load_raw(
         false,
         dims,
         &what,
-        true,
+        false,
         &|e| anyhow::anyhow!("cannot read {what}: {e}"),
         &|_| anyhow::anyhow!("{what} changed size while being read"),
     )?;

@@ -90,8 +90,9 @@ pub fn check_dims(dims: [i64; 3], what: &str) -> Result<[usize; 3]> {
             bail!("{what}: size {n} along {name} is too small; every size must be at least 2");
         }
     }
-    // Each size is positive and below 2^63, so the product fits in u128.
-    let total = dims.iter().fold(1u128, |acc, &n| acc * n as u128);
+    let total = dims
+        .iter()
+        .fold(1u128, |acc, &n| acc.saturating_mul(n as u128));
     if total > MAX_VOXELS as u128 {
         let need = total.saturating_mul(BYTES_PER_VOXEL as u128);
         bail!(
