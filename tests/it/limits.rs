@@ -776,3 +776,54 @@ proptest! {
         check(&r.map_err(|e| format!("{e:#}")), peak)?;
     }
 }
+
+#[test]
+fn readme_limits_table_quotes_the_constants() {
+    let readme = std::fs::read_to_string(helpers::root().join("README.md")).unwrap();
+    let table = readme
+        .split("## Limits")
+        .nth(1)
+        .expect("README has a Limits section")
+        .split("\n## ")
+        .next()
+        .unwrap();
+    let max = rmapgen::render::MAX_SIZE;
+    for want in [
+        format!("`0..={}` per stage", rmapgen::vectors::MAX_STAGE_VECTORS),
+        format!("`0..={}`", rmapgen::vectors::MAX_STREAM_VECTORS),
+        format!("`1..={}` (2^37)", rmapgen::stress::MAX_SAMPLES),
+        format!("`<= {}`", rmapgen::stress::exhaustive::MAX_GRAD_BITS),
+        format!("`1..={max}`"),
+        format!("`{}..={max}`", rmapgen::cmd::bench::MIN_SIZE),
+        format!("`{}..={max}`", rmapgen::cmd::fit::MIN_SIZE),
+        format!("`(0, {}]`", rmapgen::cmd::bench::MAX_SECONDS),
+        format!("`0..={}`", rmapgen::cmd::fit::MAX_RUNNERS_UP),
+        format!("`1..={}`", rmapgen::cmd::fit::MAX_SYNTH_LIMIT),
+        format!("`{}` voxels", rmapgen::volume::MAX_VOXELS),
+        format!(
+            "`{}`",
+            rmapgen::volume::human_bytes(rmapgen::volume::load::MAX_READ_BYTES).replace(".0", "")
+        ),
+        format!(
+            "`{}`",
+            rmapgen::volume::human_bytes(rmapgen::volume::load::MAX_HEADER_BYTES as u64)
+                .replace(".0", "")
+        ),
+        format!(
+            "`{}..={}` voxels",
+            rmapgen::volume::cast::MIN_STEP,
+            rmapgen::volume::cast::MAX_STEP
+        ),
+        format!("`2..={}`", rmapgen::volume::cast::MAX_BRICK),
+        format!("`1..={}`", rmapgen::cmd::volume::MAX_REPEAT),
+    ] {
+        assert!(
+            table.contains(&want),
+            "README Limits table should quote {want}"
+        );
+    }
+    assert!(table.contains(&format!(
+        "{} at the bound",
+        rmapgen::volume::human_bytes(rmapgen::volume::MEMORY_BUDGET).replace(".0", "")
+    )));
+}
