@@ -71,6 +71,7 @@ mod limits_in_help {
             "size",
             &format!("[{}..={MAX_SIZE}]", super::bench::MIN_SIZE),
         );
+        has::<super::fpga::FpgaArgs>("freq", &format!("(0, {}]", super::fpga::MAX_FREQ_MHZ));
         has::<super::bench::BenchArgs>("seconds", &format!("(0, {}]", super::bench::MAX_SECONDS));
     }
 

@@ -317,7 +317,7 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
 
     let out = StagedDir::new(&a.out)?;
     let t = Instant::now();
-    let p = Prepared::new(&vol, cfg.grad_bits, opts.brick);
+    let p = Prepared::try_new(&vol, cfg.grad_bits, opts.brick)?;
     let prepare_ms = t.elapsed().as_secs_f64() * 1e3;
     let rtl = if a.rtl {
         Some(crate::rtl::verilated::VerilatedTop::build(&cfg, &scene)?)

@@ -294,11 +294,27 @@ impl MapSet {
     }
 }
 
+/// Largest map file `vectors --maps` reads (16 MiB): the widest configuration's map has
+/// 32 768 entries of a few bytes each; a file far beyond that is not a map.
+pub const MAX_MAP_FILE_BYTES: u64 = 16 << 20;
+
 /// Reads the three `$readmemh` files `<prefix>_{x,y,z}.hex` (logical address order).
 pub fn read_maps(cfg: &Config, dir: &Path, prefix: &str) -> Result<Maps> {
     let mut data = Vec::with_capacity(3 * cfg.map_entries() as usize);
     for axis in ["x", "y", "z"] {
         let p = dir.join(format!("{prefix}_{axis}.hex"));
+        if p.is_dir() {
+            bail!("map {} is a directory, not a map file", p.display());
+        }
+        if let Ok(m) = std::fs::metadata(&p) {
+            if m.len() > MAX_MAP_FILE_BYTES {
+                bail!(
+                    "map {} is {} bytes, more than the limit of {MAX_MAP_FILE_BYTES} for a map file",
+                    p.display(),
+                    m.len()
+                );
+            }
+        }
         let text = std::fs::read_to_string(&p)
             .with_context(|| format!("cannot read map {}", p.display()))?;
         let before = data.len();

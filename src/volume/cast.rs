@@ -175,6 +175,16 @@ impl<'a> Prepared<'a> {
             bricks: Bricks::new(vol, brick),
         }
     }
+
+    /// [`Prepared::new`], refusing with an error a volume whose gradients the machine has no
+    /// memory for.
+    pub fn try_new(vol: &'a Volume, grad_bits: u32, brick: usize) -> anyhow::Result<Prepared<'a>> {
+        Ok(Prepared {
+            vol,
+            grads: super::gradient::try_gradients(vol, grad_bits)?,
+            bricks: Bricks::new(vol, brick),
+        })
+    }
 }
 
 /// Work counts of one image, summed over its rays.

@@ -459,6 +459,16 @@ fn size_and_count_flags_of_every_command_are_bounded() {
             "allowed 1..=64",
         ),
     ];
+    let cases = cases.into_iter().chain([
+        (
+            vec!["fpga", "--freq", "0", "--logs", o],
+            "allowed (0, 1000] MHz",
+        ),
+        (
+            vec!["fpga", "--freq", "NaN", "--logs", o],
+            "allowed (0, 1000] MHz",
+        ),
+    ]);
     for (args, needle) in cases {
         let t = std::time::Instant::now();
         refused(&args, needle, d.path(), &[]);
@@ -816,6 +826,8 @@ fn readme_limits_table_quotes_the_constants() {
         ),
         format!("`2..={}`", rmapgen::volume::cast::MAX_BRICK),
         format!("`1..={}`", rmapgen::cmd::volume::MAX_REPEAT),
+        format!("`(0, {}]` MHz", rmapgen::cmd::fpga::MAX_FREQ_MHZ),
+        format!("`{}` bytes each", rmapgen::vectors::MAX_MAP_FILE_BYTES),
     ] {
         assert!(
             table.contains(&want),
@@ -826,4 +838,44 @@ fn readme_limits_table_quotes_the_constants() {
         "{} at the bound",
         rmapgen::volume::human_bytes(rmapgen::volume::MEMORY_BUDGET).replace(".0", "")
     )));
+}
+
+#[test]
+fn an_oversized_or_directory_map_file_is_refused() {
+    let d = helpers::tempdir();
+    let maps = d.path().join("maps");
+    std::fs::create_dir(&maps).unwrap();
+    let f = std::fs::File::create(maps.join("map_x.hex")).unwrap();
+    f.set_len(rmapgen::vectors::MAX_MAP_FILE_BYTES + 1).unwrap();
+    let v = d.path().join("v.hex");
+    refused(
+        &[
+            "vectors",
+            "--maps",
+            s(&maps),
+            "--count",
+            "10",
+            "--out",
+            s(&v),
+        ],
+        "more than the limit of 16777216",
+        d.path(),
+        &["maps"],
+    );
+    std::fs::remove_file(maps.join("map_x.hex")).unwrap();
+    std::fs::create_dir(maps.join("map_x.hex")).unwrap();
+    refused(
+        &[
+            "vectors",
+            "--maps",
+            s(&maps),
+            "--count",
+            "10",
+            "--out",
+            s(&v),
+        ],
+        "is a directory, not a map file",
+        d.path(),
+        &["maps"],
+    );
 }
