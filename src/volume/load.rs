@@ -7,6 +7,11 @@
 //! `double`, all converted to f32 (exact for integers up to 2^24). The voxel spacing comes
 //! from `spacings` or from the lengths of `space directions` (orientation is ignored: the
 //! volume is rendered in its index frame). Anything else is refused with an error naming it.
+//!
+//! Bounds: the volume must fit [`super::MEMORY_BUDGET`] (checked from the header, before any
+//! data is read, with the size it needs); the data is streamed in chunks, never held whole,
+//! and everything read from it (line skips, byte skip, voxel data, after decompression)
+//! counts against [`MAX_READ_BYTES`]; a header is at most [`MAX_HEADER_BYTES`].
 
 use super::{check_dims, check_spacing, human_bytes, Volume, VolumeInfo};
 use anyhow::{bail, Context, Result};

@@ -242,6 +242,20 @@ fn gzip_nrrd_with_a_huge_byte_skip_is_refused_up_front() {
     b.extend(&body);
     std::fs::write(&p, b).unwrap();
     volume_refused(&p, &[], "read limit", d.path());
+    // A detached header (raw data in a file of its own) is held to the same limit.
+    std::fs::write(d.path().join("in/v.raw"), [0u8; 64]).unwrap();
+    let nhdr = d.path().join("in/v.nhdr");
+    std::fs::write(
+        &nhdr,
+        header(
+            "uchar",
+            "4 4 4",
+            "raw",
+            "byte skip: 9000000000000000000\ndata file: v.raw\n",
+        ),
+    )
+    .unwrap();
+    volume_refused(&nhdr, &[], "more than the read limit of 4.0 GiB", d.path());
 }
 
 #[test]
