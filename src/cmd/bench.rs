@@ -8,6 +8,13 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 
+/// Smallest sphere image side of the error figures (`--size`); the largest is
+/// [`crate::render::MAX_SIZE`].
+pub const MIN_SIZE: u32 = 16;
+/// Longest time spent timing one throughput figure (`--seconds`): a bench times about 60
+/// figures, so 60 s each is already an hour.
+pub const MAX_SECONDS: f64 = 60.0;
+
 #[derive(Args, Debug)]
 pub struct BenchArgs {
     /// Output directory for bench.md, bench.csv, bench.json and the plots (replaced whole).
@@ -18,7 +25,7 @@ pub struct BenchArgs {
     /// Sphere image side for the error figures [16..=4096].
     #[arg(long, value_name = "N", default_value_t = 512, value_parser = super::parse::count::<u32>())]
     pub size: u32,
-    /// Seconds spent timing each throughput figure.
+    /// Seconds spent timing each throughput figure (0, 60].
     #[arg(long, value_name = "S", default_value_t = 0.3, value_parser = super::parse::positive())]
     pub seconds: f64,
     /// Skip the iCE40 place and route (Yosys, nextpnr-ice40) even when they are installed.
@@ -30,14 +37,15 @@ pub struct BenchArgs {
 }
 
 pub fn run(a: &BenchArgs) -> Result<()> {
+    let max_size = crate::render::MAX_SIZE;
     anyhow::ensure!(
-        (16..=4096).contains(&a.size),
-        "size {} is out of range; allowed 16..=4096",
+        (MIN_SIZE..=max_size).contains(&a.size),
+        "size {} is out of range; allowed {MIN_SIZE}..={max_size}",
         a.size
     );
     anyhow::ensure!(
-        a.seconds > 0.0 && a.seconds <= 60.0,
-        "seconds {} is out of range; allowed (0, 60]",
+        a.seconds > 0.0 && a.seconds <= MAX_SECONDS,
+        "seconds {} is out of range; allowed (0, {MAX_SECONDS}]",
         a.seconds
     );
     let out = StagedDir::new(&a.out, &a.force.policy(&[]))?;

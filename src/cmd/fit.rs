@@ -14,6 +14,15 @@ use std::path::PathBuf;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
+/// Smallest sphere image side `fit` measures on (`--size`): below it too few pixels fall in
+/// each map cell for the error to mean much. The largest is [`crate::render::MAX_SIZE`].
+pub const MIN_SIZE: u32 = 16;
+/// Largest `--runners-up`: each is a passing candidate measured on the whole image, and 100
+/// already lists more than anyone reads.
+pub const MAX_RUNNERS_UP: usize = 100;
+/// Largest `--synth-limit`: each synthesis takes Yosys seconds to a minute.
+pub const MAX_SYNTH_LIMIT: usize = 64;
+
 #[derive(Args, Debug)]
 #[command(group(clap::ArgGroup::new("target").required(true).multiple(true).args(["max_error", "rmse"])))]
 pub struct FitArgs {
@@ -56,7 +65,7 @@ pub struct FitArgs {
     /// Side of the sphere test image [16..=4096].
     #[arg(long, value_name = "N", default_value_t = 512, value_parser = parse::count::<u32>())]
     pub size: u32,
-    /// Passing configurations listed after the choice.
+    /// Passing configurations listed after the choice [0..=100].
     #[arg(long, value_name = "K", default_value_t = 3, value_parser = parse::count::<usize>())]
     pub runners_up: usize,
     /// With --cost cells: how many passing configurations to synthesise, shared equally by
@@ -64,7 +73,8 @@ pub struct FitArgs {
     /// bits of each) [1..=64].
     #[arg(long, value_name = "S", default_value_t = 8, value_parser = parse::count::<usize>())]
     pub synth_limit: usize,
-    /// Seeded random vectors per stage in the written design (as generate --vectors).
+    /// Seeded random vectors per stage in the written design (as generate --vectors)
+    /// [0..=1000000].
     #[arg(long, value_name = "N", default_value_t = 2000, value_parser = parse::count::<usize>())]
     pub vectors: usize,
     /// Seed of the random vectors.
@@ -73,6 +83,7 @@ pub struct FitArgs {
 }
 
 pub fn run(a: &FitArgs) -> Result<()> {
+    crate::vectors::check_stage_vectors(a.vectors, "--vectors")?;
     let scene = Scene::from_toml_file(&a.scene)?;
     let base = Config {
         grad_bits: a.grad_bits,
@@ -83,15 +94,21 @@ pub fn run(a: &FitArgs) -> Result<()> {
         ..Config::default()
     };
     base.validate()?;
+    let max_size = crate::render::MAX_SIZE;
     anyhow::ensure!(
-        (16..=4096).contains(&a.size),
-        "size {} is out of range; allowed 16..=4096",
+        (MIN_SIZE..=max_size).contains(&a.size),
+        "size {} is out of range; allowed {MIN_SIZE}..={max_size}",
         a.size
     );
     anyhow::ensure!(
-        (1..=64).contains(&a.synth_limit),
-        "synth-limit {} is out of range; allowed 1..=64",
+        (1..=MAX_SYNTH_LIMIT).contains(&a.synth_limit),
+        "synth-limit {} is out of range; allowed 1..={MAX_SYNTH_LIMIT}",
         a.synth_limit
+    );
+    anyhow::ensure!(
+        a.runners_up <= MAX_RUNNERS_UP,
+        "runners-up {} is out of range; allowed 0..={MAX_RUNNERS_UP}",
+        a.runners_up
     );
     let opts = Options {
         base,

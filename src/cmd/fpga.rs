@@ -23,7 +23,7 @@ pub struct FpgaArgs {
     /// Package: ct256, tq144, cm81, cb132, bg121, sg48, ...
     #[arg(long, default_value = "ct256")]
     pub package: String,
-    /// Target clock the placer aims at, MHz.
+    /// Target clock the placer aims at, MHz (0, 1000].
     #[arg(long, value_name = "MHZ", default_value_t = 125.0, value_parser = super::parse::positive())]
     pub freq: f64,
     /// Placer seed.
@@ -41,7 +41,16 @@ pub struct FpgaArgs {
     pub require_timing: bool,
 }
 
+/// Highest `--freq` target, MHz: iCE40 fabric tops out at a few hundred MHz, so a placer
+/// target beyond 1 GHz means a typo.
+pub const MAX_FREQ_MHZ: f64 = 1000.0;
+
 pub fn run(a: &FpgaArgs) -> Result<()> {
+    anyhow::ensure!(
+        a.freq > 0.0 && a.freq <= MAX_FREQ_MHZ,
+        "freq {} is out of range; allowed (0, {MAX_FREQ_MHZ}] MHz",
+        a.freq
+    );
     let logs = StagedDir::new(
         &a.logs,
         &a.force.policy(&[a.dir.as_deref(), a.cfg.config.as_deref()]),

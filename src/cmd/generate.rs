@@ -25,7 +25,7 @@ pub struct GenerateArgs {
     pub out: PathBuf,
     #[command(flatten)]
     pub force: super::force::ForceArg,
-    /// Seeded random vectors per stage, after the hand-picked corner cases.
+    /// Seeded random vectors per stage, after the hand-picked corner cases [0..=1000000].
     #[arg(long, value_name = "N", default_value_t = 2000, value_parser = super::parse::count::<usize>())]
     pub vectors: usize,
     /// Seed of the random vectors.
@@ -34,6 +34,7 @@ pub struct GenerateArgs {
 }
 
 pub fn run(a: &GenerateArgs) -> Result<()> {
+    vectors::check_stage_vectors(a.vectors, "--vectors")?;
     let cfg = a.cfg.resolve()?;
     let scene = match &a.scene {
         Some(p) => Scene::from_toml_file(p)?,

@@ -24,7 +24,8 @@ pub struct StressArgs {
     /// Every gradient (2^(3 grad-bits) inputs; grad-bits <= 12).
     #[arg(long, conflicts_with = "samples")]
     pub exhaustive: bool,
-    /// Gradients of a sampled run; the largest magnitude sweeps 1..=2^(grad-bits - 1).
+    /// Gradients of a sampled run; the largest magnitude sweeps 1..=2^(grad-bits - 1)
+    /// [1..=137438953472, 2^37].
     #[arg(long, value_name = "N", default_value_t = 10_000_000)]
     pub samples: u64,
     /// Seed of a sampled run.
@@ -38,6 +39,9 @@ pub struct StressArgs {
 }
 
 pub fn run(a: &StressArgs) -> Result<()> {
+    if !a.exhaustive {
+        stress::check_samples(a.samples)?;
+    }
     let cfg = a.cfg.resolve()?;
     let mut scene = match &a.scene {
         Some(p) => Scene::from_toml_file(p)?,
@@ -70,7 +74,17 @@ pub fn run(a: &StressArgs) -> Result<()> {
         bar.finish_and_clear();
         r?
     } else {
-        stress::sampled(&setup, a.samples, a.seed)
+        let bar = ProgressBar::new(a.samples);
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{elapsed_precise} [{bar:40}] {percent}% {human_pos}/{human_len} samples, eta {eta}",
+            )
+            .expect("valid template")
+            .progress_chars("=> "),
+        );
+        let r = stress::sampled_with_progress(&setup, a.samples, a.seed, &|n| bar.inc(n));
+        bar.finish_and_clear();
+        r
     };
     print!("{}", summary(&report));
     if let Some(out) = json {

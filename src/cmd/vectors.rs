@@ -7,14 +7,16 @@ use crate::scene::Scene;
 use crate::vectors::{self, MapSet};
 use anyhow::Result;
 use clap::Args;
-use std::path::PathBuf;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
 pub struct VectorsArgs {
     #[command(flatten)]
     pub cfg: ConfigArgs,
     /// Random vectors after the corner cases: the first half shaded with map 0, the rest with
-    /// map 1 (the corner cases come again before the map-1 part).
+    /// map 1 (the corner cases come again before the map-1 part) [0..=10000000000; the file
+    /// must also fit the free space of its filesystem].
     #[arg(long, value_name = "N", default_value_t = 1_000_000)]
     pub count: usize,
     /// Seed of the random vectors.
@@ -36,6 +38,7 @@ pub struct VectorsArgs {
 
 pub fn run(a: &VectorsArgs) -> Result<()> {
     let cfg = a.cfg.resolve()?;
+    vectors::check_stream_vectors(a.count as u64)?;
     let maps = match (&a.maps, &a.scene) {
         (Some(dir), _) => MapSet::from_dir(&cfg, dir)?,
         (None, Some(p)) => {
@@ -49,7 +52,28 @@ pub fn run(a: &VectorsArgs) -> Result<()> {
         a.maps.as_deref(),
     ]);
     let out = StagedFile::new(&a.out, &policy, vectors::is_vector_stream)?;
-    let n = vectors::write_top_stream(&cfg, &maps, out.path(), a.count, a.seed)?;
+    // The whole file must fit before the first byte is written (its size is exact: every
+    // line has the same length).
+    let need = vectors::top_stream_bytes(&cfg, a.count as u64);
+    crate::disk::check_space(
+        out.path().parent().unwrap_or(Path::new(".")),
+        need,
+        &format!("--count {}: {}", a.count, a.out.display()),
+    )?;
+    let bar = ProgressBar::new(vectors::top_stream_lines(&cfg, a.count as u64));
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{elapsed_precise} [{bar:40}] {percent}% {human_pos}/{human_len} vectors, eta {eta}",
+        )
+        .expect("valid template")
+        .progress_chars("=> "),
+    );
+    let written =
+        vectors::write_top_stream_with_progress(&cfg, &maps, out.path(), a.count, a.seed, &|k| {
+            bar.inc(k)
+        });
+    bar.finish_and_clear();
+    let n = written?;
     out.commit()?;
     eprintln!(
         "rmapgen: wrote {n} top vectors ({}) to {}",

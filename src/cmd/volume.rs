@@ -80,7 +80,7 @@ pub struct VolumeArgs {
     /// unless the RTL image equals the model image pixel for pixel.
     #[arg(long)]
     pub rtl: bool,
-    /// Timed runs per measurement with --timing (the median is reported).
+    /// Timed runs per measurement with --timing (the median is reported) [1..=100].
     #[arg(long, value_name = "N", default_value_t = 5, value_parser = super::parse::count::<u32>())]
     pub repeat: u32,
     /// Output directory for reference.png, model.png, error50.png and metrics.json (replaced
@@ -90,6 +90,9 @@ pub struct VolumeArgs {
     #[command(flatten)]
     pub force: super::force::ForceArg,
 }
+
+/// Largest `--repeat`: each timed run renders a frame (up to seconds with skipping off).
+pub const MAX_REPEAT: u32 = 100;
 
 /// Parses `X,Y,Z` into three numbers.
 fn triple<T: std::str::FromStr>(flag: &str, s: &str) -> Result<[T; 3]> {
@@ -152,6 +155,9 @@ fn volume(a: &VolumeArgs) -> Result<Volume> {
         .input
         .as_ref()
         .expect("clap requires FILE without --synthetic");
+    if path.is_dir() {
+        bail!("{} is a directory, not a volume file", path.display());
+    }
     if load::is_nrrd(path) {
         if a.dims.is_some() || a.bits.is_some() || a.signed {
             bail!("--dims, --bits and --signed are for raw files; the NRRD header {} gives the layout", path.display());
@@ -303,6 +309,12 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
     if a.timing && a.repeat == 0 {
         bail!("--repeat must be at least 1");
     }
+    if a.repeat > MAX_REPEAT {
+        bail!(
+            "--repeat {} is more than the limit of {MAX_REPEAT}",
+            a.repeat
+        );
+    }
     let t = Instant::now();
     let vol = volume(a)?;
     let load_ms = t.elapsed().as_secs_f64() * 1e3;
@@ -314,7 +326,7 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
     ]);
     let out = StagedDir::new(&a.out, &policy)?;
     let t = Instant::now();
-    let p = Prepared::new(&vol, cfg.grad_bits, opts.brick);
+    let p = Prepared::try_new(&vol, cfg.grad_bits, opts.brick)?;
     let prepare_ms = t.elapsed().as_secs_f64() * 1e3;
     let rtl = if a.rtl {
         Some(crate::rtl::verilated::VerilatedTop::build(&cfg, &scene)?)

@@ -26,6 +26,55 @@ use rng::SplitMix64;
 use std::io::Write;
 use std::path::Path;
 
+/// Largest number of random vectors per stage file (`generate --vectors`, `fit --vectors`):
+/// 1 000 000. Each stage file is built in memory before it is written (about 100 bytes a
+/// vector at the peak, so at most about 100 MB a stage), and the testbenches stream it at
+/// about 6 000 vectors/s in Icarus, so a million already takes about 3 minutes a stage.
+/// Longer runs of the top are what `rmapgen vectors` is for: it streams to disk.
+pub const MAX_STAGE_VECTORS: usize = 1_000_000;
+
+/// Largest number of random vectors of a top stream (`vectors --count`): 10^10, about 190 GB
+/// at the default widths, about 3 hours to write at the measured 1 million vectors/s and
+/// 1.4 hours through the Verilator C++ harness at 2 million vectors/s. The free space of the
+/// target's filesystem is checked too, before anything is written.
+pub const MAX_STREAM_VECTORS: u64 = 10_000_000_000;
+
+/// Refuses a per-stage vector count above [`MAX_STAGE_VECTORS`], naming `flag`.
+pub fn check_stage_vectors(n: usize, flag: &str) -> Result<()> {
+    if n > MAX_STAGE_VECTORS {
+        bail!(
+            "{flag} {n} is more than the limit of {MAX_STAGE_VECTORS} random vectors per stage file; for a longer stream of the top use `rmapgen vectors --count N`"
+        );
+    }
+    Ok(())
+}
+
+/// Refuses a top stream count above [`MAX_STREAM_VECTORS`].
+pub fn check_stream_vectors(n: u64) -> Result<()> {
+    if n > MAX_STREAM_VECTORS {
+        bail!("--count {n} is more than the limit of {MAX_STREAM_VECTORS} vectors");
+    }
+    Ok(())
+}
+
+/// Lines of a top stream of `random` random vectors: both parts' corner cases, the random
+/// vectors and the repeated swap witness (see [`top_inputs`]).
+pub fn top_stream_lines(cfg: &Config, random: u64) -> u64 {
+    (inputs::top_corners(cfg, 0).len() + inputs::top_corners(cfg, 1).len()) as u64 + 1 + random
+}
+
+/// Bytes of one top vector line (every line has the same length: fields are zero-padded).
+pub fn top_line_bytes(cfg: &Config) -> u64 {
+    let fields = Stage::Top.fields(cfg);
+    let digits: u64 = fields.iter().map(|f| hexfile::digits(f.bits) as u64).sum();
+    digits + fields.len() as u64
+}
+
+/// The exact size of a top stream file of `random` random vectors (saturating).
+pub fn top_stream_bytes(cfg: &Config, random: u64) -> u64 {
+    top_stream_lines(cfg, random).saturating_mul(top_line_bytes(cfg))
+}
+
 /// Whether a field drives the module or is checked at its output.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Dir {
@@ -245,11 +294,27 @@ impl MapSet {
     }
 }
 
+/// Largest map file `vectors --maps` reads (16 MiB): the widest configuration's map has
+/// 32 768 entries of a few bytes each; a file far beyond that is not a map.
+pub const MAX_MAP_FILE_BYTES: u64 = 16 << 20;
+
 /// Reads the three `$readmemh` files `<prefix>_{x,y,z}.hex` (logical address order).
 pub fn read_maps(cfg: &Config, dir: &Path, prefix: &str) -> Result<Maps> {
     let mut data = Vec::with_capacity(3 * cfg.map_entries() as usize);
     for axis in ["x", "y", "z"] {
         let p = dir.join(format!("{prefix}_{axis}.hex"));
+        if p.is_dir() {
+            bail!("map {} is a directory, not a map file", p.display());
+        }
+        if let Ok(m) = std::fs::metadata(&p) {
+            if m.len() > MAX_MAP_FILE_BYTES {
+                bail!(
+                    "map {} is {} bytes, more than the limit of {MAX_MAP_FILE_BYTES} for a map file",
+                    p.display(),
+                    m.len()
+                );
+            }
+        }
         let text = std::fs::read_to_string(&p)
             .with_context(|| format!("cannot read map {}", p.display()))?;
         let before = data.len();
@@ -496,6 +561,7 @@ pub fn write_all_with_maps(
     maps: &MapSet,
 ) -> Result<()> {
     cfg.validate()?;
+    check_stage_vectors(random, "--vectors")?;
     let model = Model::new(cfg);
     for stage in stages(cfg) {
         out.write_text(
@@ -516,7 +582,20 @@ pub fn write_top_stream(
     random: usize,
     seed: u64,
 ) -> Result<usize> {
+    write_top_stream_with_progress(cfg, maps, path, random, seed, &|_| {})
+}
+
+/// [`write_top_stream`], calling `progress(n)` after every `n` more lines written.
+pub fn write_top_stream_with_progress(
+    cfg: &Config,
+    maps: &MapSet,
+    path: &Path,
+    random: usize,
+    seed: u64,
+    progress: &dyn Fn(u64),
+) -> Result<usize> {
     cfg.validate()?;
+    check_stream_vectors(random as u64)?;
     let model = Model::new(cfg);
     let fields = Stage::Top.fields(cfg);
     if let Some(d) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
@@ -533,11 +612,15 @@ pub fn write_top_stream(
         line.clear();
         format_line(&fields, &row, &mut line);
         n += 1;
+        if n % (1 << 16) == 0 {
+            progress(1 << 16);
+        }
         w.write_all(line.as_bytes())
             .with_context(|| format!("cannot write {}", path.display()))
     })?;
     w.flush()
         .with_context(|| format!("cannot write {}", path.display()))?;
+    progress(n as u64 % (1 << 16));
     Ok(n)
 }
 

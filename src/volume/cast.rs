@@ -60,6 +60,13 @@ pub const DEFAULT_ERT: f64 = 0.99;
 pub const DEFAULT_STEP: f64 = 0.5;
 /// Default brick size (cells per side) for empty-space skipping.
 pub const DEFAULT_BRICK: usize = 8;
+/// Smallest sample step in voxels (`--step`): the samples on a ray, hence the work of a
+/// frame, grow as 1 / step.
+pub const MIN_STEP: f64 = 0.05;
+/// Largest sample step in voxels: beyond it samples skip whole cells.
+pub const MAX_STEP: f64 = 4.0;
+/// Largest brick side in cells (`--brick`): larger bricks are rarely empty.
+pub const MAX_BRICK: usize = 64;
 
 /// One sample's shading: a G-bit gradient in, an M-bit intensity out.
 pub trait Shader: Sync {
@@ -134,8 +141,8 @@ impl CastOptions {
             crate::render::MAX_SIZE
         );
         ensure!(
-            self.step.is_finite() && self.step >= 0.05 && self.step <= 4.0,
-            "step {} is out of range; allowed 0.05..=4 (voxels)",
+            self.step.is_finite() && self.step >= MIN_STEP && self.step <= MAX_STEP,
+            "step {} is out of range; allowed {MIN_STEP}..={MAX_STEP} (voxels)",
             self.step
         );
         ensure!(
@@ -144,8 +151,8 @@ impl CastOptions {
             self.ert
         );
         ensure!(
-            (2..=64).contains(&self.brick) && self.brick.is_power_of_two(),
-            "brick {} is not allowed; give a power of two in 2..=64",
+            (2..=MAX_BRICK).contains(&self.brick) && self.brick.is_power_of_two(),
+            "brick {} is not allowed; give a power of two in 2..={MAX_BRICK}",
             self.brick
         );
         Ok(())
@@ -167,6 +174,16 @@ impl<'a> Prepared<'a> {
             grads: super::gradient::gradients(vol, grad_bits),
             bricks: Bricks::new(vol, brick),
         }
+    }
+
+    /// [`Prepared::new`], refusing with an error a volume whose gradients the machine has no
+    /// memory for.
+    pub fn try_new(vol: &'a Volume, grad_bits: u32, brick: usize) -> anyhow::Result<Prepared<'a>> {
+        Ok(Prepared {
+            vol,
+            grads: super::gradient::try_gradients(vol, grad_bits)?,
+            bricks: Bricks::new(vol, brick),
+        })
     }
 }
 

@@ -97,6 +97,12 @@ const HALF_BELOW_F64: f64 = 0.499_999_999_999_999_94;
 /// the largest component is found from the largest |difference| per axis, which gives the
 /// same maximum as comparing every gradient.
 pub fn gradients(vol: &Volume, grad_bits: u32) -> Gradients {
+    try_gradients(vol, grad_bits).expect("memory for the gradients")
+}
+
+/// [`gradients`], with the gradient buffer reserved by `try_reserve_exact`: a volume the
+/// machine has no memory for is an error, not an abort.
+pub fn try_gradients(vol: &Volume, grad_bits: u32) -> anyhow::Result<Gradients> {
     assert!((2..=16).contains(&grad_bits), "grad_bits {grad_bits}");
     let [nx, ny, _] = vol.dims;
     let inv = vol.spacing.map(|s| [1.0 / (2.0 * s), 1.0 / s]);
@@ -130,7 +136,16 @@ pub fn gradients(vol: &Volume, grad_bits: u32) -> Gradients {
     let f = inv.map(|i| [-i[0] * scale, -i[1] * scale]);
     let l = limit(grad_bits) as f64;
     let q = |d: f32, k: f64| round_half_away((d as f64 * k).clamp(-l, l)) as i16;
-    let mut data = vec![[0i16; 3]; vol.data.len()];
+    let mut data: Vec<[i16; 3]> = Vec::new();
+    data.try_reserve_exact(vol.data.len()).map_err(|_| {
+        anyhow::anyhow!(
+            "{}: cannot allocate {} for the gradients of {} voxels",
+            vol.info.source,
+            super::human_bytes(6 * vol.data.len() as u64),
+            vol.data.len()
+        )
+    })?;
+    data.resize(vol.data.len(), [0; 3]);
     data.par_chunks_mut(nx * ny)
         .enumerate()
         .for_each(|(z, out)| {
@@ -158,12 +173,12 @@ pub fn gradients(vol: &Volume, grad_bits: u32) -> Gradients {
                 }
             }
         });
-    Gradients {
+    Ok(Gradients {
         grad_bits,
         data,
         scale,
         max_component,
-    }
+    })
 }
 
 #[cfg(test)]

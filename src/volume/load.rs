@@ -7,11 +7,30 @@
 //! `double`, all converted to f32 (exact for integers up to 2^24). The voxel spacing comes
 //! from `spacings` or from the lengths of `space directions` (orientation is ignored: the
 //! volume is rendered in its index frame). Anything else is refused with an error naming it.
+//!
+//! Bounds: the volume must fit [`super::MEMORY_BUDGET`] (checked from the header, before any
+//! data is read, with the size it needs); the data is streamed in chunks, never held whole,
+//! and everything read from it (line skips, byte skip, voxel data, after decompression)
+//! counts against [`MAX_READ_BYTES`]; a header is at most [`MAX_HEADER_BYTES`].
 
-use super::{check_dims, check_spacing, Volume, VolumeInfo};
+use super::{check_dims, check_spacing, human_bytes, Volume, VolumeInfo};
 use anyhow::{bail, Context, Result};
-use std::io::Read;
+use std::io::{BufRead, BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
+
+/// Largest NRRD header read, in bytes (1 MiB): the text before the blank line of an attached
+/// file, or a whole detached `.nhdr`. Real headers are a few hundred bytes.
+pub const MAX_HEADER_BYTES: usize = 1 << 20;
+
+/// Largest number of bytes read from a volume's data stream, in bytes (4 GiB): skipped lines,
+/// `byte skip` and the voxel data together, after decompression for gzip. It bounds the work
+/// a small file can ask for (a gzip stream of zeros decompresses 1000 to 1); the largest
+/// volume of doubles inside [`super::MAX_VOXELS`] is 1.6 GiB of voxel data.
+pub const MAX_READ_BYTES: u64 = 4 << 30;
+
+/// Bytes decoded at a time: the loaders never hold the file's voxel bytes, only this chunk
+/// and the f32 values.
+const CHUNK: usize = 1 << 20;
 
 /// Voxel types the loaders convert.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -84,34 +103,180 @@ impl VoxelType {
         Ok(t)
     }
 
-    /// Converts packed voxels to f32.
-    pub fn decode(self, bytes: &[u8], big_endian: bool) -> Vec<f32> {
+    /// Appends packed voxels (a whole number of them) to `out` as f32, without any
+    /// temporary. A finite value too large for f32 (a double beyond 3.4e38) is an error
+    /// naming it and its voxel, counted from `first` (the index of the first voxel in
+    /// `bytes`).
+    pub fn decode_into(
+        self,
+        bytes: &[u8],
+        big_endian: bool,
+        first: usize,
+        out: &mut Vec<f32>,
+    ) -> std::result::Result<(), Overflow> {
         macro_rules! conv {
             ($t:ty, $n:expr) => {
-                bytes
-                    .chunks_exact($n)
-                    .map(|c| {
-                        let a: [u8; $n] = c.try_into().unwrap();
-                        (if big_endian {
-                            <$t>::from_be_bytes(a)
-                        } else {
-                            <$t>::from_le_bytes(a)
-                        }) as f32
-                    })
-                    .collect()
+                out.extend(bytes.chunks_exact($n).map(|c| {
+                    let a: [u8; $n] = c.try_into().expect("whole voxels");
+                    (if big_endian {
+                        <$t>::from_be_bytes(a)
+                    } else {
+                        <$t>::from_le_bytes(a)
+                    }) as f32
+                }))
             };
         }
         match self {
-            VoxelType::I8 => bytes.iter().map(|&b| b as i8 as f32).collect(),
-            VoxelType::U8 => bytes.iter().map(|&b| b as f32).collect(),
+            VoxelType::I8 => out.extend(bytes.iter().map(|&b| b as i8 as f32)),
+            VoxelType::U8 => out.extend(bytes.iter().map(|&b| b as f32)),
             VoxelType::I16 => conv!(i16, 2),
             VoxelType::U16 => conv!(u16, 2),
             VoxelType::I32 => conv!(i32, 4),
             VoxelType::U32 => conv!(u32, 4),
             VoxelType::F32 => conv!(f32, 4),
-            VoxelType::F64 => conv!(f64, 8),
+            VoxelType::F64 => {
+                for (i, c) in bytes.chunks_exact(8).enumerate() {
+                    let a: [u8; 8] = c.try_into().expect("8 bytes");
+                    let v = if big_endian {
+                        f64::from_be_bytes(a)
+                    } else {
+                        f64::from_le_bytes(a)
+                    };
+                    let f = v as f32;
+                    if v.is_finite() && !f.is_finite() {
+                        return Err(Overflow {
+                            index: first + i,
+                            value: v,
+                        });
+                    }
+                    out.push(f);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Converts packed voxels to f32 (a double too large for f32 becomes infinite; the
+    /// loaders use [`VoxelType::decode_into`], which refuses it).
+    pub fn decode(self, bytes: &[u8], big_endian: bool) -> Vec<f32> {
+        let mut out = Vec::with_capacity(bytes.len() / self.bytes());
+        if let Err(o) = self.decode_into(bytes, big_endian, 0, &mut out) {
+            out.push(f32::INFINITY.copysign(o.value as f32));
+            let rest = &bytes[(o.index + 1) * 8..];
+            out.extend(self.decode(rest, big_endian));
+        }
+        out
+    }
+}
+
+/// A finite voxel value that does not fit in f32.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Overflow {
+    /// Index of the voxel, x fastest.
+    pub index: usize,
+    pub value: f64,
+}
+
+impl Overflow {
+    /// The message: the value, the voxel position and why.
+    pub fn message(&self, what: &str, dims: [usize; 3]) -> String {
+        let (x, y, z) = (
+            self.index % dims[0],
+            self.index / dims[0] % dims[1],
+            self.index / (dims[0] * dims[1]),
+        );
+        format!(
+            "{what}: voxel ({x}, {y}, {z}) value {:e} overflows f32 (largest {:e}); rescale the data",
+            self.value,
+            f32::MAX
+        )
+    }
+}
+
+/// Opens a volume or data file, refusing a directory by name.
+fn open_file(path: &Path, what: &str) -> Result<(std::fs::File, u64)> {
+    if path.is_dir() {
+        bail!("{} is a directory, not a {what}", path.display());
+    }
+    let f = std::fs::File::open(path)
+        .with_context(|| format!("cannot read {what} {}", path.display()))?;
+    let len = f
+        .metadata()
+        .with_context(|| format!("cannot read {what} {}", path.display()))?
+        .len();
+    Ok((f, len))
+}
+
+/// Reads exactly the voxel data of `dims` voxels of type `t` from `r` and decodes it in
+/// chunks into f32 values, reserved with `try_reserve_exact` (an allocation failure is an
+/// error, not an abort). `check_end` marks a stream of unknown length (gzip): its values
+/// are reserved as they arrive and it must end after the data. `size_error(have)` builds the error for a stream that ends early (have <
+/// want) or goes on (have = want + 1, when `check_end`).
+#[allow(clippy::too_many_arguments)]
+fn read_voxels(
+    r: &mut dyn Read,
+    t: VoxelType,
+    big_endian: bool,
+    dims: [usize; 3],
+    what: &str,
+    check_end: bool,
+    read_error: &dyn Fn(std::io::Error) -> anyhow::Error,
+    size_error: &dyn Fn(u64) -> anyhow::Error,
+) -> Result<Vec<f32>> {
+    let n = dims[0] * dims[1] * dims[2];
+    let mut values: Vec<f32> = Vec::new();
+    let reserve = |values: &mut Vec<f32>, cap: usize| -> Result<()> {
+        values.try_reserve_exact(cap - values.len()).map_err(|_| {
+            anyhow::anyhow!(
+                "{what}: cannot allocate {} for {n} voxel values",
+                human_bytes(4 * n as u64)
+            )
+        })
+    };
+    // A stream of known length gets all its values at once; a gzip stream only as its data
+    // arrives (doubling, never beyond n), so a small file that claims many voxels allocates
+    // no more than it holds.
+    if check_end {
+        reserve(&mut values, n.min(CHUNK))?;
+    } else {
+        reserve(&mut values, n)?;
+    }
+    let want = (n * t.bytes()) as u64;
+    let chunk = (CHUNK / t.bytes()) * t.bytes();
+    let mut buf = vec![0u8; chunk.min(want as usize)];
+    let mut have = 0u64;
+    while have < want {
+        let len = (want - have).min(buf.len() as u64) as usize;
+        let mut got = 0;
+        while got < len {
+            match r.read(&mut buf[got..len]) {
+                Ok(0) => return Err(size_error(have + got as u64)),
+                Ok(k) => got += k,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(read_error(e)),
+            }
+        }
+        let count = len / t.bytes();
+        if values.capacity() - values.len() < count {
+            let cap = n.min((2 * values.capacity()).max(values.len() + count));
+            reserve(&mut values, cap)?;
+        }
+        t.decode_into(&buf[..len], big_endian, values.len(), &mut values)
+            .map_err(|o| anyhow::anyhow!(o.message(what, dims)))?;
+        have += len as u64;
+    }
+    if check_end {
+        let mut one = [0u8; 1];
+        loop {
+            match r.read(&mut one) {
+                Ok(0) => break,
+                Ok(_) => return Err(size_error(want + 1)),
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(read_error(e)),
+            }
         }
     }
+    Ok(values)
 }
 
 const SUPPORTED_TYPES: &str = "signed char, uchar, short, ushort, int, uint, float, double";
@@ -149,9 +314,7 @@ pub fn load_raw(
     let dims = check_dims(dims, "--dims")?;
     let spacing = check_spacing(spacing, "--spacing")?;
     let want = dims[0] * dims[1] * dims[2] * t.bytes();
-    let len = std::fs::metadata(path)
-        .with_context(|| format!("cannot read {what}"))?
-        .len();
+    let (mut file, len) = open_file(path, "volume file")?;
     if len != want as u64 {
         bail!(
             "{what} is {len} bytes but --dims {},{},{} with {}-bit voxels need {want} bytes",
@@ -161,15 +324,21 @@ pub fn load_raw(
             format.bits
         );
     }
-    let bytes = std::fs::read(path).with_context(|| format!("cannot read {what}"))?;
-    if bytes.len() != want {
-        bail!("{what} changed size while being read");
-    }
+    let data = read_voxels(
+        &mut file,
+        t,
+        false,
+        dims,
+        &what,
+        false,
+        &|e| anyhow::anyhow!("cannot read {what}: {e}"),
+        &|_| anyhow::anyhow!("{what} changed size while being read"),
+    )?;
     let info = VolumeInfo {
         source: path.display().to_string(),
         voxel_type: t.name().to_string(),
     };
-    Volume::new(dims, spacing, t.decode(&bytes, false), info)
+    Volume::new(dims, spacing, data, info)
 }
 
 /// Whether a path names an NRRD file by its extension (`.nrrd` or `.nhdr`, any case).
@@ -284,8 +453,25 @@ fn direction_lengths(v: &str, what: &str) -> Result<Vec<f64>> {
 /// Loads an NRRD volume (`.nrrd` with attached data or `.nhdr` with a detached data file).
 pub fn load_nrrd(path: &Path) -> Result<Volume> {
     let what = format!("NRRD file {}", path.display());
-    let bytes = std::fs::read(path).with_context(|| format!("cannot read {what}"))?;
-    let (h, attached) = parse_header(&bytes, &what)?;
+    let (mut file, len) = open_file(path, "volume file")?;
+    // The header only: at most MAX_HEADER_BYTES, cut at a line end.
+    let mut head = Vec::new();
+    (&mut file)
+        .take(MAX_HEADER_BYTES as u64)
+        .read_to_end(&mut head)
+        .with_context(|| format!("cannot read {what}"))?;
+    let truncated = (head.len() as u64) < len;
+    if truncated {
+        let end = head.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+        head.truncate(end);
+    }
+    let (h, attached) = parse_header(&head, &what)?;
+    if truncated && attached.is_none() {
+        bail!(
+            "{what}: the header is longer than the limit of {} (no blank line ends it)",
+            human_bytes(MAX_HEADER_BYTES as u64)
+        );
+    }
     let need = |f: &Option<String>, name: &str| -> Result<String> {
         f.clone()
             .with_context(|| format!("{what}: header has no '{name}' field"))
@@ -367,32 +553,26 @@ pub fn load_nrrd(path: &Path) -> Result<Volume> {
         bail!("{what}: byte skip -1 is only allowed with raw encoding");
     }
 
-    // The data: attached after the header, or in the data file named by the header.
-    let data_file;
-    let (raw, source): (&[u8], String) = match &h.data_file {
+    // The data: attached after the header, or in the data file named by the header. It is
+    // read as a stream, never whole: line skips, byte skip and voxel data count against
+    // MAX_READ_BYTES, and only the f32 values are kept.
+    let (data, data_len, start, source) = match &h.data_file {
         Some(f) => {
             if f.starts_with("LIST") || (f.contains('%') && f.split_whitespace().count() > 1) {
                 bail!("{what}: data file '{f}' is a list or pattern of files, which is not supported; give one data file");
             }
             let p = path.parent().unwrap_or(Path::new(".")).join(f);
-            data_file = std::fs::read(&p)
-                .with_context(|| format!("{what}: cannot read data file {}", p.display()))?;
-            (&data_file, format!("data file {}", p.display()))
+            let (df, dlen) = open_file(&p, "data file").with_context(|| what.clone())?;
+            (df, dlen, 0u64, format!("data file {}", p.display()))
         }
         None => match attached {
-            Some(off) => (&bytes[off..], what.clone()),
+            Some(off) => (file, len, off as u64, what.clone()),
             None => bail!("{what}: header has no 'data file' field and no data follows it"),
         },
     };
-    let mut raw = raw;
-    for _ in 0..line_skip {
-        match raw.iter().position(|&b| b == b'\n') {
-            Some(i) => raw = &raw[i + 1..],
-            None => bail!("{what}: line skip {line_skip} passes the end of the {source}"),
-        }
-    }
-    let want = dims[0] * dims[1] * dims[2] * t.bytes();
-    let size_error = |have: usize| {
+    let want = (dims[0] * dims[1] * dims[2] * t.bytes()) as u64;
+    let skip = byte_skip.max(0) as u64;
+    let size_error = |have: u64| {
         anyhow::anyhow!(
             "{what}: the {source} holds {have} bytes of voxel data but sizes {} {} {} of {} need {want} bytes",
             dims[0],
@@ -401,41 +581,92 @@ pub fn load_nrrd(path: &Path) -> Result<Volume> {
             t.name()
         )
     };
-    let decoded;
-    let body: &[u8] = if gzip {
-        let skip = byte_skip as usize;
-        let mut out = Vec::new();
-        flate2::read::MultiGzDecoder::new(raw)
-            .take((skip + want + 1) as u64)
-            .read_to_end(&mut out)
-            .map_err(|e| {
-                anyhow::anyhow!("{what}: cannot decompress the gzip data of the {source}: {e}")
-            })?;
-        if out.len() < skip {
-            return Err(size_error(0));
-        }
-        decoded = out;
-        &decoded[skip..]
-    } else if byte_skip == -1 {
-        if raw.len() < want {
-            return Err(size_error(raw.len()));
-        }
-        &raw[raw.len() - want..]
-    } else {
-        let skip = byte_skip as usize;
-        if raw.len() < skip {
-            return Err(size_error(0));
-        }
-        &raw[skip..]
+    let limit_error = |n: u128| {
+        anyhow::anyhow!(
+            "{what}: reading it means {n} bytes (line skip, byte skip {byte_skip} and {want} bytes of voxel data{}), more than the read limit of {}",
+            if gzip { ", decompressed" } else { "" },
+            human_bytes(MAX_READ_BYTES)
+        )
     };
-    if body.len() != want {
-        return Err(size_error(body.len()));
+    if skip as u128 + want as u128 > MAX_READ_BYTES as u128 {
+        return Err(limit_error(skip as u128 + want as u128));
     }
+    let read_error = |e: std::io::Error| anyhow::anyhow!("{what}: cannot read the {source}: {e}");
+    let mut r = BufReader::with_capacity(1 << 16, data);
+    r.seek(SeekFrom::Start(start)).map_err(read_error)?;
+    let mut pos = start;
+    for _ in 0..line_skip {
+        loop {
+            let buf = r.fill_buf().map_err(read_error)?;
+            if buf.is_empty() {
+                bail!("{what}: line skip {line_skip} passes the end of the {source}");
+            }
+            let n = buf.iter().position(|&b| b == b'\n').map(|i| i + 1);
+            let k = n.unwrap_or(buf.len());
+            r.consume(k);
+            pos += k as u64;
+            if n.is_some() {
+                break;
+            }
+        }
+    }
+    let read = (pos - start) as u128 + skip as u128 + want as u128;
+    if read > MAX_READ_BYTES as u128 {
+        return Err(limit_error(read));
+    }
+    let values = if gzip {
+        let gz_error = |e: std::io::Error| {
+            anyhow::anyhow!("{what}: cannot decompress the gzip data of the {source}: {e}")
+        };
+        let mut dec = flate2::bufread::MultiGzDecoder::new(r);
+        let skipped =
+            std::io::copy(&mut (&mut dec).take(skip), &mut std::io::sink()).map_err(gz_error)?;
+        if skipped < skip {
+            return Err(size_error(0));
+        }
+        read_voxels(
+            &mut dec,
+            t,
+            big_endian,
+            dims,
+            &what,
+            true,
+            &gz_error,
+            &size_error,
+        )?
+    } else {
+        let remaining = data_len.saturating_sub(pos);
+        if byte_skip == -1 {
+            if remaining < want {
+                return Err(size_error(remaining));
+            }
+            r.seek(SeekFrom::Start(data_len - want))
+                .map_err(read_error)?;
+        } else {
+            if remaining < skip {
+                return Err(size_error(0));
+            }
+            if remaining - skip != want {
+                return Err(size_error(remaining - skip));
+            }
+            r.seek_relative(skip as i64).map_err(read_error)?;
+        }
+        read_voxels(
+            &mut r,
+            t,
+            big_endian,
+            dims,
+            &what,
+            false,
+            &read_error,
+            &size_error,
+        )?
+    };
     let info = VolumeInfo {
         source: path.display().to_string(),
         voxel_type: t.name().to_string(),
     };
-    Volume::new(dims, spacing, t.decode(body, big_endian), info)
+    Volume::new(dims, spacing, values, info)
 }
 
 /// An attached NRRD file (raw or gzip encoding) of a volume, little-endian: what

@@ -32,8 +32,33 @@ use serde::Serialize;
 /// above, one light, the standard material and a transfer function for its values.
 pub const ENGINE_SCENE_TOML: &str = include_str!("../../scenes/engine.toml");
 
-/// Largest number of voxels accepted (2^28: 1 GiB of values plus 1.5 GiB of gradients).
-pub const MAX_VOXELS: usize = 1 << 28;
+/// Memory a volume may take once loaded and prepared for rendering, in bytes (2 GiB): the
+/// budget every loader and `--dims` is checked against before anything is allocated.
+pub const MEMORY_BUDGET: u64 = 2 << 30;
+
+/// Bytes per voxel of a volume ready to render: its f32 value (4) and its three i16
+/// gradient components (6). Loaders decode in chunks, so the file's own voxel type (a
+/// double is 8 bytes) adds nothing.
+pub const BYTES_PER_VOXEL: u64 = 4 + 6;
+
+/// Largest number of voxels accepted: what fits [`MEMORY_BUDGET`] (214 748 364, e.g.
+/// 512 x 512 x 819).
+pub const MAX_VOXELS: usize = (MEMORY_BUDGET / BYTES_PER_VOXEL) as usize;
+
+/// A byte count for messages: "2.5 GiB", "300.0 MiB", "12 bytes".
+pub fn human_bytes(n: u64) -> String {
+    const K: f64 = 1024.0;
+    let x = n as f64;
+    if x >= K * K * K {
+        format!("{:.1} GiB", x / (K * K * K))
+    } else if x >= K * K {
+        format!("{:.1} MiB", x / (K * K))
+    } else if x >= K {
+        format!("{:.1} KiB", x / K)
+    } else {
+        format!("{n} bytes")
+    }
+}
 
 /// A scalar volume on a regular grid. Voxel (x, y, z) sits at world position
 /// (x * spacing[0], y * spacing[1], z * spacing[2]); x varies fastest in `data`.
@@ -65,16 +90,21 @@ pub fn check_dims(dims: [i64; 3], what: &str) -> Result<[usize; 3]> {
             bail!("{what}: size {n} along {name} is too small; every size must be at least 2");
         }
     }
-    let total = dims.iter().try_fold(1i64, |acc, &n| acc.checked_mul(n));
-    match total {
-        Some(t) if t as u128 <= MAX_VOXELS as u128 => Ok(dims.map(|n| n as usize)),
-        _ => bail!(
-            "{what}: {} x {} x {} voxels is more than the limit of {MAX_VOXELS}",
+    let total = dims
+        .iter()
+        .fold(1u128, |acc, &n| acc.saturating_mul(n as u128));
+    if total > MAX_VOXELS as u128 {
+        let need = total.saturating_mul(BYTES_PER_VOXEL as u128);
+        bail!(
+            "{what}: {} x {} x {} voxels need {} ({BYTES_PER_VOXEL} bytes a voxel for values and gradients), more than the limit of {} ({MAX_VOXELS} voxels)",
             dims[0],
             dims[1],
-            dims[2]
-        ),
+            dims[2],
+            human_bytes(u64::try_from(need).unwrap_or(u64::MAX)),
+            human_bytes(MEMORY_BUDGET)
+        );
     }
+    Ok(dims.map(|n| n as usize))
 }
 
 /// Checks a voxel spacing: three finite positive numbers.

@@ -1,5 +1,6 @@
 //! One integration-test binary; modules mirror the source tree.
 
+mod alloc;
 mod bench;
 mod cmd_render;
 mod errors;
@@ -9,6 +10,7 @@ mod grid;
 mod hdl;
 mod helpers;
 mod hexfile;
+mod limits;
 mod map_fit;
 mod model_stages;
 mod output_safety;
@@ -22,3 +24,8 @@ mod stress;
 mod symmetry;
 mod vectors;
 mod volume;
+
+/// Counts every allocation of the test binary per thread (tests/it/alloc.rs), so tests can
+/// bound the memory a call takes.
+#[global_allocator]
+static ALLOC: alloc::Counting = alloc::Counting;
