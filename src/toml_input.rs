@@ -171,13 +171,31 @@ pub fn invalid(text: &str, what: &str, e: &Invalid) -> anyhow::Error {
     anyhow::anyhow!("{}: {}", place(what, text, span), one_line(&e.message))
 }
 
-/// Reads a TOML input file: refuses a directory or an unreadable file in one line.
-/// `kind` is what the file holds ("scene", "config").
+/// The largest TOML input read: a scene with 10,000 lights is about 1 MB, and parsing holds
+/// several times the text in memory, so this keeps a wrong file (a volume, a log) from being
+/// read whole.
+pub const MAX_BYTES: u64 = 16 << 20;
+
+/// Reads a TOML input file: refuses a directory, a file over [`MAX_BYTES`] or an unreadable
+/// file in one line. `kind` is what the file holds ("scene", "config").
 pub fn read(path: &Path, kind: &str) -> Result<String> {
+    use std::io::Read;
     if path.is_dir() {
         bail!("{kind} {} is a directory, not a TOML file", path.display());
     }
-    match std::fs::read(path) {
+    // Read one byte past the limit, so a file that grows while read is caught too.
+    let read = std::fs::File::open(path).and_then(|f| {
+        let mut bytes = Vec::new();
+        f.take(MAX_BYTES + 1).read_to_end(&mut bytes).map(|_| bytes)
+    });
+    if read.as_ref().is_ok_and(|b| b.len() as u64 > MAX_BYTES) {
+        bail!(
+            "{kind} {} is larger than {} MiB, the limit for a TOML input",
+            path.display(),
+            MAX_BYTES >> 20
+        );
+    }
+    match read {
         Ok(bytes) => match String::from_utf8(bytes) {
             Ok(s) => Ok(s),
             Err(e) => {

@@ -599,16 +599,49 @@ fn apply(text: &str, m: &Mutation) -> String {
 }
 
 /// Loads `text` as a scene and as a configuration; errors must be one line.
+/// Memory a load may take beyond its text: parsing holds a few copies of it, and nothing it
+/// builds may grow with the values it reads (a count or size in a file is no allocation).
+const LOAD_BUDGET: usize = 4 << 20;
+
 fn load_both(text: &str) -> Result<(), TestCaseError> {
-    if let Err(e) = Scene::from_toml_named(text, "scene s.toml") {
+    let budget = LOAD_BUDGET + 64 * text.len();
+    let (scene, peak) = crate::alloc::peak_during(|| Scene::from_toml_named(text, "scene s.toml"));
+    prop_assert!(peak < budget, "scene load peaked at {peak} bytes");
+    if let Err(e) = scene {
         let m = format!("{e:#}");
         prop_assert!(!m.contains('\n') && m.starts_with("scene s.toml"), "{m:?}");
     }
-    if let Err(e) = Config::from_toml_named(text, "config c.toml") {
+    let (config, peak) =
+        crate::alloc::peak_during(|| Config::from_toml_named(text, "config c.toml"));
+    prop_assert!(peak < budget, "config load peaked at {peak} bytes");
+    if let Err(e) = config {
         let m = format!("{e:#}");
         prop_assert!(!m.contains('\n') && m.starts_with("config c.toml"), "{m:?}");
     }
     Ok(())
+}
+
+#[test]
+fn a_toml_input_over_its_size_limit_is_refused_unread() {
+    let t = tempdir();
+    let big = t.path().join("big.toml");
+    let mut text = String::from("[material]\nambient = 0.1\n");
+    while (text.len() as u64) <= rmapgen::toml_input::MAX_BYTES {
+        text.push_str("# padding padding padding padding padding padding padding padding\n");
+    }
+    std::fs::write(&big, text).unwrap();
+    let out = t.path().join("o");
+    for flag in ["--scene", "--config"] {
+        let o = run(&[
+            "render",
+            flag,
+            big.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_error(&o, "is larger than 16 MiB, the limit for a TOML input");
+    }
+    assert!(!out.exists());
 }
 
 proptest! {
