@@ -4,13 +4,12 @@
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 use rmapgen::config::Config;
-use rmapgen::hexfile;
 use rmapgen::model::fast::FastShader;
 use rmapgen::model::map_fit::LsqFit;
 use rmapgen::model::{reflectance_map, Model};
 use rmapgen::reference::Reference;
+use rmapgen::rng::SplitMix64;
 use rmapgen::scene::Scene;
-use rmapgen::vectors::rng::SplitMix64;
 use std::hint::black_box;
 
 /// Uniform random gradients over the whole `grad_bits` cube (the hardest case for branch
@@ -34,7 +33,7 @@ fn throughput(c: &mut Criterion) {
     let cfg = Config::default();
     let model = Model::new(&cfg);
     let four = scene("four_lights.toml");
-    let maps = hexfile::scene_maps(&cfg, &four);
+    let maps = four.maps(&cfg);
     let fast = FastShader::new(&model, &maps);
     let reference = Reference::new(&cfg, &four);
     // 1M gradients: 12 MB in, 2 MB out, larger than L2, so the input streams as in a render.

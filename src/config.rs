@@ -331,11 +331,6 @@ impl Config {
     pub fn bank_total_bits(&self) -> u64 {
         self.bank_count() as u64 * self.bank_entries() as u64 * self.map_bits as u64
     }
-    /// Width of the colour multiplier's product numerator * K: the quotient (at most 255)
-    /// sits above the shift S, so nothing wider is ever non-zero.
-    pub fn color_product_bits(&self) -> u32 {
-        crate::model::color_mul::constants(self).1 + COLOR_BITS
-    }
     pub fn frac_max(&self) -> u32 {
         (1 << self.frac_bits) - 1
     }

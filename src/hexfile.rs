@@ -2,7 +2,7 @@
 //! configuration (Icarus, Verilator and Yosys all accept them), then one entry per line.
 
 use crate::config::Config;
-use crate::model::{atan_rom, map_fit, recip_rom, Maps};
+use crate::model::{atan_rom, recip_rom};
 use crate::scene::Scene;
 
 /// Hex digits of a `bits`-wide value.
@@ -23,12 +23,6 @@ pub fn format(cfg: &Config, what: &str, bits: u32, entries: &[u32]) -> String {
         s.push_str(&format!("{e:0w$x}\n"));
     }
     s
-}
-
-/// The maps of a scene for a configuration, filled as the scene's `map_fit` says.
-pub fn scene_maps(cfg: &Config, scene: &Scene) -> Maps {
-    let p = scene.prepared();
-    map_fit::contents(cfg, scene.map_fit, |n| p.shade(n))
 }
 
 /// The fixed ROMs and the scene's maps, as (file name, contents).
@@ -53,7 +47,7 @@ pub fn all(cfg: &Config, scene: &Scene) -> Vec<(String, String)> {
             ),
         ));
     }
-    let maps = scene_maps(cfg, scene);
+    let maps = scene.maps(cfg);
     for (axis, name) in ["x", "y", "z"].iter().enumerate() {
         v.push((
             format!("map_{name}.hex"),

@@ -40,7 +40,7 @@ impl Reference {
     /// gradient.
     #[inline]
     pub fn exact(&self, g: [i32; 3]) -> Option<f64> {
-        let n = crate::scene::unit_direction(DVec3::new(g[0] as f64, g[1] as f64, g[2] as f64))?;
+        let n = crate::geometry::unit_direction(DVec3::new(g[0] as f64, g[1] as f64, g[2] as f64))?;
         Some(self.scene.shade(n))
     }
 

@@ -20,9 +20,9 @@ use crate::model::Model;
 use crate::output::StagedDir;
 use crate::reference::Reference;
 use crate::render::{self, metrics, sphere_gradients};
+use crate::rng::SplitMix64;
 use crate::rtl::fpga::{self, FpgaReport};
 use crate::scene::Scene;
-use crate::vectors::rng::SplitMix64;
 use anyhow::Result;
 use octahedral::Octahedral;
 use rayon::prelude::*;
@@ -271,10 +271,7 @@ pub fn run(opts: &Options, progress: &dyn Fn(&str)) -> Result<Vec<Row>> {
             _ => None,
         };
         let model = Model::new(&cfg);
-        let fast = FastShader::new(
-            &model,
-            &crate::hexfile::scene_maps(&cfg, &Scene::standard()),
-        );
+        let fast = FastShader::new(&model, &Scene::standard().maps(&cfg));
         let one = grads.len() as f64 / time(opts.seconds, || fast.shade_batch(&grads, &mut out16));
         let all =
             grads.len() as f64 / time(opts.seconds, || fast.shade_batch_par(&grads, &mut out16));

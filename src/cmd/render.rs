@@ -58,7 +58,8 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         &cfg,
         &scene,
         options,
-        rtl.as_ref().map(|t| t as &dyn render::IntensitySource),
+        rtl.as_ref()
+            .map(|t| t as &dyn crate::model::IntensitySource),
     )?;
     if let Some(n) = r.rtl_mismatches() {
         if n > 0 {

@@ -2,7 +2,6 @@
 //! sweeps every magnitude, against the true direction and the float reference.
 
 use super::config_args::ConfigArgs;
-use crate::hexfile;
 use crate::output::StagedFile;
 use crate::scene::Scene;
 use crate::stress::{self, exhaustive, Report, Setup};
@@ -60,7 +59,7 @@ pub fn run(a: &StressArgs) -> Result<()> {
         )?),
         None => None,
     };
-    let setup = Setup::new(&cfg, &scene, hexfile::scene_maps(&cfg, &scene));
+    let setup = Setup::new(&cfg, &scene, scene.maps(&cfg));
     let report = if a.exhaustive {
         let bar = ProgressBar::new(1u64 << (3 * cfg.grad_bits.min(exhaustive::MAX_GRAD_BITS)));
         bar.set_style(

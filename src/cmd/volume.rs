@@ -7,11 +7,11 @@ use super::config_args::ConfigArgs;
 use crate::config::Config;
 use crate::output::StagedDir;
 use crate::reference::Reference;
+use crate::scene::transfer::Transfer;
 use crate::scene::Scene;
 use crate::volume::cast::{self, CastOptions, Caster, ModelShader, Prepared, Stats};
 use crate::volume::load::{self, RawFormat};
 use crate::volume::report::{self, VolumeRender};
-use crate::volume::transfer::Transfer;
 use crate::volume::{synthetic, Volume, ENGINE_SCENE_TOML};
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -339,7 +339,7 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
         &scene,
         opts,
         rtl.as_ref()
-            .map(|t| t as &dyn crate::render::IntensitySource),
+            .map(|t| t as &dyn crate::model::IntensitySource),
     )?;
     report::check_covered(&r, &vol)?;
     if let Some(n) = r.rtl_mismatches() {

@@ -17,8 +17,8 @@ use crate::model::fast::FastShader;
 use crate::model::{color_mul, Maps, Model};
 use crate::reference::Reference;
 use crate::render::sphere_gradients;
+use crate::rng::SplitMix64;
 use crate::scene::Scene;
-use crate::vectors::rng::SplitMix64;
 use serde::Serialize;
 
 /// The scene's test image, in the shuffled order measurements visit it.
@@ -210,7 +210,7 @@ pub fn measure(
     let mut start = 0;
     while start < img.pixels() {
         // Checks after 256, 512, 1024, ... pixels, then every CHUNK.
-        let len = start.max(FIRST_CHUNK).min(CHUNK).min(img.pixels() - start);
+        let len = start.clamp(FIRST_CHUNK, CHUNK).min(img.pixels() - start);
         fast.shade_batch(&img.gradients[start..start + len], &mut out[..len]);
         for (j, &i) in out[..len].iter().enumerate() {
             acc.add(img, cfg, start + j, i as u32);
@@ -244,7 +244,7 @@ mod tests {
             ),
         ] {
             let img = TestImage::new(&cfg, &scene, 96);
-            let maps = crate::hexfile::scene_maps(&cfg, &scene);
+            let maps = scene.maps(&cfg);
             let (e, _) = measure(&cfg, &maps, &img, Limits::default(), &[]);
             let r = render::render(
                 &cfg,
@@ -277,7 +277,7 @@ mod tests {
         };
         let scene = Scene::standard();
         let img = TestImage::new(&cfg, &scene, 128);
-        let maps = crate::hexfile::scene_maps(&cfg, &scene);
+        let maps = scene.maps(&cfg);
         let (full, worst) = measure(&cfg, &maps, &img, Limits::default(), &[]);
         let lim = Limits {
             max: Some(full.max_abs_error - 1),
@@ -305,7 +305,7 @@ mod tests {
             ..Config::default()
         };
         let img = TestImage::new(&cfg, &scene, 64);
-        let maps = crate::hexfile::scene_maps(&cfg, &scene);
+        let maps = scene.maps(&cfg);
         let (e, _) = measure(&cfg, &maps, &img, Limits::default(), &[]);
         let ch = e.color_max_abs_error.unwrap();
         // The channel scales the intensity by at most 255/255, plus rounding.

@@ -614,12 +614,7 @@ mod tests {
         let scene = Scene::alternate();
         let cache = MapCache::new(&scene, MapFit::Sample);
         for c in space::candidates(&Config::default()).iter().step_by(977) {
-            assert_eq!(
-                *cache.get(c),
-                crate::hexfile::scene_maps(c, &scene),
-                "{}",
-                c.summary()
-            );
+            assert_eq!(*cache.get(c), scene.maps(c), "{}", c.summary());
         }
     }
 

@@ -16,6 +16,12 @@ pub fn constants(cfg: &Config) -> (u64, u32) {
     (k, s)
 }
 
+/// Width of the product numerator * K: the quotient (at most 255) sits above the shift S, so
+/// nothing wider is ever non-zero.
+pub fn product_bits(cfg: &Config) -> u32 {
+    constants(cfg).1 + COLOR_BITS
+}
+
 /// Width of the numerator 2 c i + d.
 pub fn numerator_bits(cfg: &Config) -> u32 {
     COLOR_BITS + cfg.map_bits + 1

@@ -244,7 +244,7 @@ impl LsqFit {
         for (ju, &tu) in self.tangent.iter().enumerate() {
             for (jv, &tv) in self.tangent.iter().enumerate() {
                 let [x, y, z] = place(axis, sg(s_max, 1.0), sg(s_u, tu), sg(s_v, tv));
-                let i = shade(crate::scene::sym_normalize(DVec3::new(x, y, z)));
+                let i = shade(crate::geometry::sym_normalize(DVec3::new(x, y, z)));
                 f[ju * k + jv] = if i.is_nan() {
                     0.0
                 } else {

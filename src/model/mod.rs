@@ -19,6 +19,13 @@ pub mod zero_detect;
 use crate::config::Config;
 pub use reflectance_map::Maps;
 
+/// Another implementation of the shader, asked for the intensities of many gradients in one
+/// batch (an RTL simulation streams them through the design); renders compare it with the
+/// model pixel for pixel.
+pub trait IntensitySource {
+    fn intensities(&self, gradients: &[[i32; 3]]) -> anyhow::Result<Vec<u32>>;
+}
+
 /// The fixed ROMs of one configuration, built once.
 #[derive(Clone, Debug)]
 pub struct Model {

@@ -60,7 +60,7 @@ pub fn entry_direction(
         1 => DVec3::new(u, mx, v),
         _ => DVec3::new(u, v, mx),
     };
-    crate::scene::sym_normalize(d)
+    crate::geometry::sym_normalize(d)
 }
 
 /// Quantises a light-model intensity (clamped to 0..=1) to `map_bits`, half up.

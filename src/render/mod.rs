@@ -11,8 +11,7 @@ pub mod metrics;
 pub mod sphere;
 
 use crate::config::Config;
-use crate::hexfile;
-use crate::model::{Maps, Model};
+use crate::model::{IntensitySource, Maps, Model};
 use crate::output::StagedDir;
 use crate::reference::Reference;
 use crate::scene::Scene;
@@ -61,12 +60,6 @@ impl Options {
         );
         Ok(())
     }
-}
-
-/// Another implementation of the shader, asked for the intensities of the render's gradients
-/// in one batch (an RTL simulation streams them through the design).
-pub trait IntensitySource {
-    fn intensities(&self, gradients: &[[i32; 3]]) -> Result<Vec<u32>>;
 }
 
 /// The model's intensities of many gradients, in order, in parallel.
@@ -132,11 +125,7 @@ pub fn render(
     options.validate(cfg)?;
     let pixels = sphere_gradients(cfg, options.size, options.shrink);
     let gradients: Vec<[i32; 3]> = pixels.iter().map(|p| p.2).collect();
-    let model = model_intensities(
-        &Model::new(cfg),
-        &hexfile::scene_maps(cfg, scene),
-        &gradients,
-    );
+    let model = model_intensities(&Model::new(cfg), &scene.maps(cfg), &gradients);
     let reference = Reference::new(cfg, scene).intensities(&gradients);
     let rtl = match rtl {
         None => None,

@@ -10,6 +10,7 @@ pub mod manifest;
 pub mod package;
 pub mod pipe;
 pub mod ports;
+pub mod tb;
 pub mod templates;
 pub mod verilated;
 
@@ -226,7 +227,7 @@ pub fn modules(cfg: &Config) -> Vec<Module> {
 /// and `roms` both write exactly these.
 pub fn hex_files(cfg: &Config, scene: &Scene) -> Vec<(String, String)> {
     let mut v = hexfile::all(cfg, scene);
-    let alt = hexfile::scene_maps(cfg, &Scene::alternate());
+    let alt = Scene::alternate().maps(cfg);
     for (axis, name) in ["x", "y", "z"].iter().enumerate() {
         let what = format!(
             "second reflectance map (scene two_lights), max axis {name}, address {{s_max, s_u, i_u, s_v, i_v}}"
@@ -236,7 +237,7 @@ pub fn hex_files(cfg: &Config, scene: &Scene) -> Vec<(String, String)> {
             hexfile::format(cfg, &what, cfg.map_bits, alt.axis(axis as u32)),
         ));
     }
-    v.extend(banks::bank_files(cfg, &hexfile::scene_maps(cfg, scene)));
+    v.extend(banks::bank_files(cfg, &scene.maps(cfg)));
     v
 }
 

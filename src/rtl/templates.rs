@@ -362,7 +362,7 @@ pub fn render(cfg: &Config, m: Module) -> Result<String> {
         Module::ColorMul => {
             let (k, s) = color_mul::constants(cfg);
             let p = pipe::color_mul(cfg);
-            let pw = cfg.color_product_bits();
+            let pw = crate::model::color_mul::product_bits(cfg);
             ColorMul {
                 h,
                 depth: cfg.pipeline_depth,

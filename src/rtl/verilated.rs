@@ -3,8 +3,8 @@
 //! and volume renders use it (`--rtl`) to show the hardware's own image next to the model's.
 
 use crate::config::Config;
+use crate::model::IntensitySource;
 use crate::output::StagedDir;
-use crate::render::IntensitySource;
 use crate::scene::Scene;
 use crate::vectors::inputs::enc_grad;
 use anyhow::{bail, Context, Result};
@@ -52,7 +52,7 @@ impl VerilatedTop {
         let design = dir.path().join("design");
         let staged = StagedDir::new(&design, &Default::default())?;
         super::write_design(cfg, scene, &staged)?;
-        crate::tb::write_all(cfg, &staged)?;
+        crate::rtl::tb::write_all(cfg, &staged)?;
         staged.commit()?;
         let harness = dir.path().join("top_apply.cpp");
         std::fs::write(&harness, HARNESS)?;

@@ -199,7 +199,7 @@ mod tests {
         let mut two = Scene::standard();
         two.view.two_sided = true;
         scenes.push(two);
-        let mut rng = crate::vectors::rng::SplitMix64::new(5);
+        let mut rng = crate::rng::SplitMix64::new(5);
         let mut unit = || rng.below(1 << 30) as f64 / (1u64 << 30) as f64;
         for scene in &scenes {
             let p = scene.prepared();

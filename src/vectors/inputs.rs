@@ -4,10 +4,10 @@
 //!
 //! Each input vector is a list of field values in the order of `Stage::fields`, inputs only.
 
-use super::rng::SplitMix64;
 use super::Stage;
 use crate::config::{Config, COLOR_BITS};
 use crate::model::{Maps, Model};
+use crate::rng::SplitMix64;
 
 /// A gradient component as G-bit two's complement.
 pub fn enc_grad(cfg: &Config, v: i32) -> u64 {

@@ -12,7 +12,6 @@
 //! [`Model::trace`] calls, and `Model::trace` itself for the top.
 
 pub mod inputs;
-pub mod rng;
 
 use crate::config::{Config, COLOR_BITS};
 use crate::hexfile;
@@ -20,9 +19,9 @@ use crate::model::{
     color_mul, interpolate, map_lookup, normalise, sort_shift, zero_detect, Maps, Model,
 };
 use crate::output::StagedDir;
+use crate::rng::SplitMix64;
 use crate::scene::Scene;
 use anyhow::{bail, Context, Result};
-use rng::SplitMix64;
 use std::io::Write;
 use std::path::Path;
 
@@ -270,8 +269,8 @@ impl MapSet {
 
     pub fn from_scenes(cfg: &Config, scene: &Scene, second: &Scene) -> MapSet {
         MapSet {
-            scene: hexfile::scene_maps(cfg, scene),
-            second: hexfile::scene_maps(cfg, second),
+            scene: scene.maps(cfg),
+            second: second.maps(cfg),
         }
     }
 

@@ -13,8 +13,8 @@
 //! range up to the rounding of the caster's nested `a + (b - a) * t` (a few f32 ulps); the
 //! range is widened by 2^-18 of its largest magnitude (32 ulps) to cover that.
 
-use super::transfer::Tf;
 use super::Volume;
+use crate::scene::transfer::Tf;
 use rayon::prelude::*;
 
 /// Relative widening of a brick's range.
@@ -90,7 +90,7 @@ impl Bricks {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::volume::transfer::Transfer;
+    use crate::scene::transfer::Transfer;
     use crate::volume::VolumeInfo;
 
     #[test]

@@ -31,7 +31,7 @@ pub struct Camera {
 impl Camera {
     /// A camera framing the world box `lo..=hi`, looking along `-view`.
     pub fn new(lo: [f64; 3], hi: [f64; 3], view: [f64; 3], size: u32) -> Result<Camera> {
-        let Some(view) = crate::scene::unit_direction(DVec3::from_array(view)) else {
+        let Some(view) = crate::geometry::unit_direction(DVec3::from_array(view)) else {
             bail!("view direction {view:?} must be a finite, non-zero vector");
         };
         if size == 0 {

@@ -27,7 +27,7 @@
 //!
 //! **Shaders.** The fused path ([`Caster::render`]) shades each contributing sample as it
 //! is composited, with any [`Shader`] (the float reference, the bit-accurate model). A
-//! batch shader (the Verilated RTL, through [`crate::render::IntensitySource`]) uses the
+//! batch shader (the Verilated RTL, through [`crate::model::IntensitySource`]) uses the
 //! two-pass path: [`Caster::collect`] lists every contributing sample's gradient and weight,
 //! the batch shader shades the list, and [`Samples::composite`] sums in the same order, so
 //! it gives the fused image exactly when the intensities agree.
@@ -35,13 +35,12 @@
 use super::bricks::Bricks;
 use super::camera::Camera;
 use super::gradient::Gradients;
-use super::transfer::{Tf, Transfer};
 use super::Volume;
 use crate::config::Config;
-use crate::hexfile;
 use crate::model::fast::FastShader;
 use crate::model::{Maps, Model};
 use crate::reference::Reference;
+use crate::scene::transfer::{Tf, Transfer};
 use crate::scene::Scene;
 use anyhow::{bail, ensure, Result};
 use rayon::prelude::*;
@@ -92,7 +91,7 @@ pub struct ModelShader {
 impl ModelShader {
     pub fn new(cfg: &Config, scene: &Scene) -> ModelShader {
         let model = Model::new(cfg);
-        let maps = hexfile::scene_maps(cfg, scene);
+        let maps = scene.maps(cfg);
         let fast = FastShader::new(&model, &maps);
         ModelShader { model, maps, fast }
     }

@@ -18,7 +18,7 @@
 //! on real data. A gradient that rounds to (0, 0, 0) reaches the shader as the zero case.
 //!
 //! The ray caster interpolates these integer gradients trilinearly at each sample and rounds
-//! again (see [`super::cast`]), so a sample's gradient is also a G-bit integer vector; the
+//! again (see `volume::cast`), so a sample's gradient is also a G-bit integer vector; the
 //! float reference and the bit-accurate model shade that same vector.
 
 use super::Volume;

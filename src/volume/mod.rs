@@ -12,7 +12,7 @@
 //!   compositing, empty-space skipping and early ray termination; each sample is shaded by a
 //!   [`cast::Shader`] (the float reference or the bit-accurate model), or its gradients are
 //!   collected for a batch shader (an RTL simulation, through
-//!   [`crate::render::IntensitySource`]).
+//!   [`crate::model::IntensitySource`]).
 //! - [`report`]: one render with every shader, the images, the error statistics and
 //!   `metrics.json`.
 
@@ -23,7 +23,6 @@ pub mod gradient;
 pub mod load;
 pub mod report;
 pub mod synthetic;
-pub mod transfer;
 
 use anyhow::{bail, Result};
 use serde::Serialize;

@@ -1,18 +1,19 @@
 //! One volume render with every shader: the float reference and the bit-accurate model
 //! (fused path), and optionally a batch shader such as the Verilated RTL (two-pass path,
-//! through [`crate::render::IntensitySource`], the same hook as the sphere render). The
+//! through [`crate::model::IntensitySource`], the same hook as the sphere render). The
 //! images, the error statistics and `metrics.json` reuse the sphere render's
 //! [`crate::render::metrics`] and [`crate::render::images`]; the statistics are taken over
 //! the pixels the volume covers (accumulated opacity > 0), as the sphere's over its disc.
 
 use super::cast::{CastOptions, Caster, Frame, ModelShader, Prepared, Stats};
-use super::transfer::Transfer;
 use super::VolumeInfo;
 use crate::config::Config;
+use crate::model::IntensitySource;
 use crate::output::StagedDir;
 use crate::reference::Reference;
 use crate::render::images::{display8, error50, png};
-use crate::render::{metrics, IntensitySource, Metrics};
+use crate::render::{metrics, Metrics};
+use crate::scene::transfer::Transfer;
 use crate::scene::Scene;
 use anyhow::{bail, Result};
 use image::GrayImage;

@@ -98,7 +98,7 @@ fn huge_light_directions_give_the_image_of_the_unit_direction() {
 #[test]
 fn unit_direction_is_exact_and_refuses_what_has_no_direction() {
     use glam::DVec3;
-    use rmapgen::scene::{sym_normalize, unit_direction};
+    use rmapgen::geometry::{sym_normalize, unit_direction};
     // Ordinary vectors: bit-identical to plain normalisation.
     for v in [
         [1.0, 1.0, 2.0],

@@ -9,8 +9,8 @@ use rayon::prelude::*;
 use rmapgen::config::Config;
 use rmapgen::model::fast::{intensity_at, ordered_signs, FastShader};
 use rmapgen::model::{reflectance_map, Maps, Model};
+use rmapgen::rng::SplitMix64;
 use rmapgen::scene::Scene;
-use rmapgen::vectors::rng::SplitMix64;
 
 /// Maps with pseudo-random entries over the whole output range, so every entry matters.
 fn random_maps(cfg: &Config, seed: u64) -> Maps {

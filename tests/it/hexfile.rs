@@ -38,7 +38,7 @@ fn hex_files_equal_model_tables() {
         if cfg.compensation {
             assert_eq!(get("atan_rom.hex").unwrap(), atan_rom::contents(&cfg));
         }
-        let maps = hexfile::scene_maps(&cfg, &scene);
+        let maps = scene.maps(&cfg);
         for (axis, n) in ["x", "y", "z"].iter().enumerate() {
             assert_eq!(
                 get(&format!("map_{n}.hex")).unwrap(),

@@ -127,7 +127,7 @@ fn scenes_select_the_fit_and_the_hex_writer_follows() {
     );
     // The hex files carry the fitted map: the same RTL loads it unchanged.
     let cfg = Config::default();
-    let maps = hexfile::scene_maps(&cfg, &scene);
+    let maps = scene.maps(&cfg);
     let p = scene.prepared();
     assert_eq!(maps, map_fit::contents(&cfg, MapFit::Lsq, |n| p.shade(n)));
     let files = hexfile::all(&cfg, &scene);

@@ -5,7 +5,6 @@
 //! the measured values sit next to each bound. Errors are in output LSBs (map_bits = 8).
 
 use rmapgen::config::Config;
-use rmapgen::hexfile;
 use rmapgen::model::Model;
 use rmapgen::reference::Reference;
 use rmapgen::render::{self, sphere, Metrics, Options};
@@ -151,7 +150,7 @@ fn model_and_reference_are_invariant_to_power_of_two_scaling() {
     ] {
         let s = scene("two_lights.toml");
         let model = Model::new(&cfg);
-        let maps = hexfile::scene_maps(&cfg, &s);
+        let maps = s.maps(&cfg);
         let reference = Reference::new(&cfg, &s);
         let full = (1i32 << (cfg.grad_bits - 1)) - 1;
         for k in 1..=sphere::max_shrink(&cfg) {
@@ -191,7 +190,7 @@ fn metrics_agree_with_a_direct_count() {
     )
     .unwrap();
     let model = Model::new(&cfg);
-    let maps = hexfile::scene_maps(&cfg, &s);
+    let maps = s.maps(&cfg);
     let reference = Reference::new(&cfg, &s);
     let mut sq = 0.0;
     for (i, &(_, _, g)) in r.pixels.iter().enumerate() {

@@ -11,12 +11,11 @@
 
 use rayon::prelude::*;
 use rmapgen::config::Config;
-use rmapgen::hexfile;
 use rmapgen::model::{sort_shift, Model};
 use rmapgen::reference::Reference;
+use rmapgen::rng::SplitMix64;
 use rmapgen::scene::Scene;
 use rmapgen::stress::{exhaustive, Setup};
-use rmapgen::vectors::rng::SplitMix64;
 
 /// g * 2^k when every component stays in range.
 fn scaled(cfg: &Config, g: [i32; 3], k: u32) -> Option<[i32; 3]> {
@@ -28,7 +27,7 @@ fn scaled(cfg: &Config, g: [i32; 3], k: u32) -> Option<[i32; 3]> {
 
 fn check_scaling(cfg: &Config, scene: &Scene, grads: &[[i32; 3]]) -> usize {
     let model = Model::new(cfg);
-    let maps = hexfile::scene_maps(cfg, scene);
+    let maps = scene.maps(cfg);
     let reference = Reference::new(cfg, scene);
     grads
         .par_iter()
@@ -112,7 +111,7 @@ fn worst_errors_never_grow_as_magnitude_shrinks() {
         ..Config::default()
     };
     for scene in [Scene::standard(), Scene::alternate()] {
-        let setup = Setup::new(&cfg, &scene, hexfile::scene_maps(&cfg, &scene));
+        let setup = Setup::new(&cfg, &scene, scene.maps(&cfg));
         let r = exhaustive::run(&setup, &|_| {}).unwrap();
         assert_eq!(r.mismatches, 0);
         let err: Vec<u64> = r

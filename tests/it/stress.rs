@@ -3,10 +3,9 @@
 
 use rayon::prelude::*;
 use rmapgen::config::Config;
-use rmapgen::hexfile;
+use rmapgen::rng::SplitMix64;
 use rmapgen::scene::Scene;
 use rmapgen::stress::{self, exhaustive, Setup};
-use rmapgen::vectors::rng::SplitMix64;
 
 /// The exact worst |model - reference| per shift amount (0..=11) of the default configuration
 /// on the standard scene with the sampled map, from `rmapgen stress --exhaustive` over all
@@ -24,7 +23,7 @@ const EXHAUSTIVE_MAX_ANGLE: [f64; 12] = [
 fn sampled_run_stays_within_the_exhaustive_bounds() {
     let cfg = Config::default();
     let scene = Scene::standard();
-    let setup = Setup::new(&cfg, &scene, hexfile::scene_maps(&cfg, &scene));
+    let setup = Setup::new(&cfg, &scene, scene.maps(&cfg));
     let r = stress::sampled(&setup, 10_000_000, 1);
     assert_eq!(r.inputs, 10_000_000);
     assert_eq!(
@@ -135,7 +134,7 @@ fn exhaustive_equals_brute_force_on_8_bit_gradients() {
         ),
     ];
     for (cfg, scene) in cases {
-        let setup = Setup::new(&cfg, &scene, hexfile::scene_maps(&cfg, &scene));
+        let setup = Setup::new(&cfg, &scene, scene.maps(&cfg));
         let r = exhaustive::run(&setup, &|_| {}).unwrap();
         assert_eq!(r.inputs, 1 << 24);
         assert_eq!(r.mismatches, 0);
@@ -165,7 +164,7 @@ fn exhaustive_refuses_wide_gradients() {
         ..Config::default()
     };
     let scene = Scene::standard();
-    let setup = Setup::new(&cfg, &scene, hexfile::scene_maps(&cfg, &scene));
+    let setup = Setup::new(&cfg, &scene, scene.maps(&cfg));
     let e = exhaustive::run(&setup, &|_| {}).unwrap_err().to_string();
     assert!(
         e.contains("grad_bits = 13") && e.contains("--samples"),
@@ -180,7 +179,7 @@ fn sampled_run_is_reproducible() {
         ..Config::default()
     };
     let scene = Scene::alternate();
-    let setup = Setup::new(&cfg, &scene, hexfile::scene_maps(&cfg, &scene));
+    let setup = Setup::new(&cfg, &scene, scene.maps(&cfg));
     let mut a = stress::sampled(&setup, 200_000, 7);
     let mut b = stress::sampled(&setup, 200_000, 7);
     a.seconds = 0.0;

@@ -12,17 +12,16 @@
 //!
 //! Exactness is a float question: `DVec3::dot` and `normalize` sum x, y, z in a fixed order,
 //! and tan(FRAC_PI_4) is 1 - 2^-53. Map building and the reference therefore use
-//! `scene::sym_dot`/`sym_normalize` (products summed in ascending order) and the outer entry's
+//! `geometry::sym_dot`/`sym_normalize` (products summed in ascending order) and the outer entry's
 //! tangent is exactly 1, so transformed maps are bit-identical. The "boundary" scene below is
 //! the regression witness: before that change its entry sat at 118.49999999999999 on one side
 //! and 118.50000000000001 on the other, and [456, 224, 2047] shaded 118 against 119 for the
 //! x-z swapped scene at [2047, 224, 456].
 
 use rmapgen::config::Config;
-use rmapgen::hexfile;
 use rmapgen::model::Model;
+use rmapgen::rng::SplitMix64;
 use rmapgen::scene::{Light, Material, Scene, View};
-use rmapgen::vectors::rng::SplitMix64;
 
 /// A transform of the cube: output component i is sign[i] * input component perm[i].
 #[derive(Clone, Copy, Debug)]
@@ -160,10 +159,10 @@ fn check(cfg: &Config, n: usize) {
     let model = Model::new(cfg);
     let gs = gradients(cfg, n);
     for (si, s) in scenes().iter().enumerate() {
-        let maps = hexfile::scene_maps(cfg, s);
+        let maps = s.maps(cfg);
         let want: Vec<u32> = gs.iter().map(|&g| model.intensity(&maps, g)).collect();
         for t in Transform::all() {
-            let tmaps = hexfile::scene_maps(cfg, &t.scene(s));
+            let tmaps = t.scene(s).maps(cfg);
             for (&g, &w) in gs.iter().zip(&want) {
                 let got = model.intensity(&tmaps, t.gradient(g));
                 assert_eq!(
@@ -241,7 +240,7 @@ fn ties_read_the_border_entry_exactly() {
         },
     ] {
         let model = Model::new(&cfg);
-        let maps = hexfile::scene_maps(&cfg, &Scene::standard());
+        let maps = Scene::standard().maps(&cfg);
         for g in [
             [700, -700, 5],
             [3, 900, 900],
@@ -264,11 +263,8 @@ fn boundary_witness_agrees_after_an_x_z_swap() {
         sign: [1, 1, 1],
     };
     let model = Model::new(&cfg);
-    let a = model.intensity(&hexfile::scene_maps(&cfg, &scene), [456, 224, 2047]);
-    let b = model.intensity(
-        &hexfile::scene_maps(&cfg, &swap.scene(&scene)),
-        [2047, 224, 456],
-    );
+    let a = model.intensity(&scene.maps(&cfg), [456, 224, 2047]);
+    let b = model.intensity(&swap.scene(&scene).maps(&cfg), [2047, 224, 456]);
     assert_eq!(a, b);
 }
 
@@ -301,10 +297,10 @@ fn most_negative_value_shades_as_its_mirrored_half() {
     // Halving: the magnitude >> 1 with the sign kept.
     let half = |g: [i32; 3]| g.map(|c| c.signum() * (c.abs() >> 1));
     for s in scenes() {
-        let maps = hexfile::scene_maps(&cfg, &s);
+        let maps = s.maps(&cfg);
         let transformed: Vec<_> = Transform::all()
             .into_iter()
-            .map(|t| (t, hexfile::scene_maps(&cfg, &t.scene(&s))))
+            .map(|t| (t, t.scene(&s).maps(&cfg)))
             .collect();
         for &g in &grads {
             let want = model.intensity(&maps, g);
@@ -354,12 +350,12 @@ fn saturated_outputs_and_fractions_are_symmetric() {
         gs.push([a, b, c]);
         gs.push([c, a, b]);
     }
-    let near = model.trace(&hexfile::scene_maps(&cfg, &s), [2040, 2032, 700], [0; 3]);
+    let near = model.trace(&s.maps(&cfg), [2040, 2032, 700], [0; 3]);
     assert_eq!(
         (near.sort.m, near.sort.a, near.norm.u),
         (255, 254, cfg.frac_max())
     );
-    let maps = hexfile::scene_maps(&cfg, &s);
+    let maps = s.maps(&cfg);
     let want: Vec<u32> = gs.iter().map(|&g| model.intensity(&maps, g)).collect();
     assert!(
         want.iter().filter(|&&w| w == cfg.map_max()).count() > 50,
@@ -367,7 +363,7 @@ fn saturated_outputs_and_fractions_are_symmetric() {
     );
     assert!(want.iter().filter(|&&w| w == 0).count() > 50, "clamps at 0");
     for t in Transform::all() {
-        let tmaps = hexfile::scene_maps(&cfg, &t.scene(&s));
+        let tmaps = t.scene(&s).maps(&cfg);
         for (&g, &w) in gs.iter().zip(&want) {
             assert_eq!(model.intensity(&tmaps, t.gradient(g)), w, "{t:?}: {g:?}");
         }

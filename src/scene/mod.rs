@@ -7,6 +7,9 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+pub mod transfer;
+
+use crate::geometry::{sym_dot, unit_direction};
 use crate::toml_input::{self, Invalid};
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -20,7 +23,7 @@ pub struct Scene {
     /// Opacity transfer function for volume rendering (`rmapgen volume`); not used by the
     /// shading itself, so sphere scenes leave it out.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub transfer: Option<crate::volume::transfer::Transfer>,
+    pub transfer: Option<transfer::Transfer>,
     /// How the host fills the maps from the light model: `"sample"` (the light model at each
     /// entry's direction, the paper) or `"lsq"` (least squares over a dense grid of
     /// directions, `model::map_fit`). A top-level key; commands' `--map-fit` overrides it.
@@ -81,70 +84,11 @@ fn one() -> f64 {
 }
 
 /// The standard scene of the README and the tests, as shipped in `scenes/standard.toml`.
-pub const STANDARD_TOML: &str = include_str!("../scenes/standard.toml");
+pub const STANDARD_TOML: &str = include_str!("../../scenes/standard.toml");
 
 /// A second scene (`scenes/two_lights.toml`): the map the double-buffer tests load through the
 /// host port and swap in mid-stream.
-pub const ALTERNATE_TOML: &str = include_str!("../scenes/two_lights.toml");
-
-/// A dot product whose three products are added in ascending order, so that permuting the
-/// axes of both vectors gives the identical float result. Map entries and the reference use it
-/// so that an axis-swapped gradient under an axis-swapped scene shades bit-identically.
-#[inline]
-pub fn sym_dot(a: DVec3, b: DVec3) -> f64 {
-    let (mut p, mut q, mut r) = (a.x * b.x, a.y * b.y, a.z * b.z);
-    if p > q {
-        std::mem::swap(&mut p, &mut q);
-    }
-    if q > r {
-        std::mem::swap(&mut q, &mut r);
-    }
-    if p > q {
-        std::mem::swap(&mut p, &mut q);
-    }
-    (p + q) + r
-}
-
-/// Normalisation with [`sym_dot`]: axis permutations commute with it exactly. Overflows
-/// (to a zero vector) for components beyond about 1e154; directions from input go through
-/// [`unit_direction`].
-#[inline]
-pub fn sym_normalize(v: DVec3) -> DVec3 {
-    v / sym_dot(v, v).sqrt()
-}
-
-/// The unit vector along `v` for any finite non-zero `v`, however large or small its
-/// components (`[1e308, 1e308, 1e308]`, `[1e-320, 0, 0]`); `None` for a zero, NaN or
-/// infinite vector. `v` is first scaled by the power of two that brings its largest
-/// |component| into 1..2, so the squared length can neither overflow nor underflow; the
-/// scaling is exact, so the result is bit-identical to [`sym_normalize`] wherever that one
-/// is finite, and directions that differ by a power of two give the same unit vector. Axis
-/// permutations commute with it exactly. Every direction normalised from input (scene lights
-/// and view, the volume camera, the reference's gradients) goes through it.
-#[inline]
-pub fn unit_direction(v: DVec3) -> Option<DVec3> {
-    if !v.is_finite() {
-        return None;
-    }
-    let m = v.abs().max_element();
-    if m == 0.0 {
-        return None;
-    }
-    // m = 2^e * 1.f (e from the exponent bits; subnormals have e = -1023 and stay below 2).
-    let e = ((m.to_bits() >> 52) & 0x7ff) as i32 - 1023;
-    let u = sym_normalize(v * pow2(-e));
-    debug_assert!(u.is_finite() && u != DVec3::ZERO, "{v} -> {u}");
-    Some(u)
-}
-
-/// 2^k exactly, for k in -1074..=1023.
-fn pow2(k: i32) -> f64 {
-    if k >= -1022 {
-        f64::from_bits(((k + 1023) as u64) << 52)
-    } else {
-        f64::from_bits(1u64 << (k + 1074))
-    }
-}
+pub const ALTERNATE_TOML: &str = include_str!("../../scenes/two_lights.toml");
 
 /// A direction from input, checked: `key` is where it sits in the scene file
 /// (`light[2].direction`), and the error names it.
@@ -175,6 +119,12 @@ fn check_coef(key: &str, x: f64) -> Result<(), Invalid> {
 }
 
 impl Scene {
+    /// The maps of this scene for a configuration, filled as its `map_fit` says.
+    pub fn maps(&self, cfg: &crate::config::Config) -> crate::model::Maps {
+        let p = self.prepared();
+        crate::model::map_fit::contents(cfg, self.map_fit, |n| p.shade(n))
+    }
+
     pub fn standard() -> Scene {
         Scene::from_toml_str(STANDARD_TOML).expect("the standard scene is valid")
     }
@@ -365,6 +315,7 @@ impl PreparedScene {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::sym_normalize;
 
     #[test]
     fn standard_scene_loads() {
@@ -417,7 +368,7 @@ mod tests {
         assert_eq!(p.lights.len(), 1, "{:?}", p.lights);
         assert_eq!(p.lights[0].1, 0.75);
         // The same light model as the full sum, and the same one as the one-light scene.
-        let mut rng = crate::vectors::rng::SplitMix64::new(3);
+        let mut rng = crate::rng::SplitMix64::new(3);
         for _ in 0..500 {
             let mut c = || rng.below(2001) as f64 / 1000.0 - 1.0;
             let n = DVec3::new(c(), c(), c());
