@@ -1,7 +1,9 @@
 //! Direction arithmetic shared by the scene, the float reference, the map builders and the
 //! volume camera: a dot product and a normalisation that commute exactly with axis
 //! permutations (so mirrored and axis-swapped inputs shade bit-identically), and a
-//! normalisation that takes any finite non-zero direction from input.
+//! normalisation that takes any finite non-zero direction from input; and the two facts of the
+//! map's geometry: where the (max, u, v) components of a face sit on the axes, and which
+//! tangent a position along a face stands for.
 
 use glam::DVec3;
 
@@ -61,5 +63,32 @@ fn pow2(k: i32) -> f64 {
         f64::from_bits(((k + 1023) as u64) << 52)
     } else {
         f64::from_bits(1u64 << (k + 1074))
+    }
+}
+
+/// Places (max, u, v) components on the axes: the max component on `axis` (0 x, 1 y, 2 z) and
+/// the other two in axis order, so max x gives (max, u, v), max y (u, max, v), max z
+/// (u, v, max). The sort & shift stage sorts a gradient this way; the map entries, the map
+/// fit and the stress tests place their directions back with it.
+pub fn place<T>(axis: u32, max: T, u: T, v: T) -> [T; 3] {
+    match axis {
+        0 => [max, u, v],
+        1 => [u, max, v],
+        _ => [u, v, max],
+    }
+}
+
+/// The tangent (u / max) that a point at fraction `r` (0..=1) of a face's width stands for:
+/// `tan(r pi/4)` with distortion compensation (positions are angles), `r` without (positions
+/// are tangents). The border (`r` = 1) is exactly 1, since tan(pi/4) rounds below 1, so the
+/// border entries of two faces are the same direction. Map entries sit at `r = i / (E - 1)`,
+/// pipeline positions at `r = p / pos_max`.
+pub fn face_tangent(compensation: bool, r: f64) -> f64 {
+    if r >= 1.0 {
+        1.0
+    } else if compensation {
+        (r * std::f64::consts::FRAC_PI_4).tan()
+    } else {
+        r
     }
 }

@@ -35,11 +35,7 @@ pub fn contents(cfg: &Config) -> Vec<u32> {
 /// The tangent of a map entry's angle from the axis. The outer entry is exactly 1 (tan of
 /// FRAC_PI_4 rounds to 1 - 2^-53), so the border entries of two faces are the same direction.
 pub fn entry_tangent(cfg: &Config, index: u32) -> f64 {
-    if index == cfg.entries() - 1 {
-        1.0
-    } else {
-        (index as f64 / (cfg.entries() - 1) as f64 * FRAC_PI_4).tan()
-    }
+    crate::geometry::face_tangent(true, index as f64 / (cfg.entries() - 1) as f64)
 }
 
 #[cfg(test)]

@@ -16,7 +16,7 @@ pub fn eval(cfg: &Config, u: u32) -> u32 {
 
 /// The tangent at a map entry's position.
 pub fn entry_tangent(cfg: &Config, index: u32) -> f64 {
-    index as f64 / (cfg.entries() - 1) as f64
+    crate::geometry::face_tangent(false, index as f64 / (cfg.entries() - 1) as f64)
 }
 
 #[cfg(test)]

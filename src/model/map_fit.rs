@@ -30,12 +30,11 @@
 //!    its RMS residual (with few entries it can trade badly). It is off without interpolation,
 //!    where it was measured to raise the maximum. [`MapFit::LsqPlain`] leaves it out.
 
-use super::{map_lookup, reflectance_map, Maps};
+use super::{reflectance_map, Maps};
 use crate::config::Config;
 use glam::DVec3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use std::f64::consts::FRAC_PI_4;
 
 /// How the host fills the maps.
 #[derive(
@@ -219,7 +218,8 @@ impl LsqFit {
             let (axis, s_max, s_u, s_v) = (q >> 3, (q >> 2) & 1, (q >> 1) & 1, q & 1);
             for i_u in 0..n {
                 for i_v in 0..n {
-                    let a = map_lookup::addr(cfg, s_max, s_u, i_u as u32, s_v, i_v as u32);
+                    let a =
+                        crate::model::map_addr::addr(cfg, s_max, s_u, i_u as u32, s_v, i_v as u32);
                     let v = e[i_u * n + i_v];
                     data[(axis * cfg.map_entries() + a) as usize] = if v.is_nan() {
                         0
@@ -243,7 +243,8 @@ impl LsqFit {
         let mut f = vec![0.0; k * k];
         for (ju, &tu) in self.tangent.iter().enumerate() {
             for (jv, &tv) in self.tangent.iter().enumerate() {
-                let [x, y, z] = place(axis, sg(s_max, 1.0), sg(s_u, tu), sg(s_v, tv));
+                let [x, y, z] =
+                    crate::geometry::place(axis, sg(s_max, 1.0), sg(s_u, tu), sg(s_v, tv));
                 let i = shade(crate::geometry::sym_normalize(DVec3::new(x, y, z)));
                 f[ju * k + jv] = if i.is_nan() {
                     0.0
@@ -369,22 +370,7 @@ impl LsqFit {
 /// The tangent at a position of x entry spacings (0..=entries-1): the tangent the pipeline's
 /// positions stand for, exactly 1 on the border.
 fn tangent_at(cfg: &Config, x: f64) -> f64 {
-    let r = x / (cfg.entries() - 1) as f64;
-    if r >= 1.0 {
-        1.0
-    } else if cfg.compensation {
-        (r * FRAC_PI_4).tan()
-    } else {
-        r
-    }
-}
-
-fn place(axis: u32, m: f64, u: f64, v: f64) -> [f64; 3] {
-    match axis {
-        0 => [m, u, v],
-        1 => [u, m, v],
-        _ => [u, v, m],
-    }
+    crate::geometry::face_tangent(cfg.compensation, x / (cfg.entries() - 1) as f64)
 }
 
 /// c = a b for n x n row-major matrices.
@@ -470,6 +456,7 @@ fn invert_spd(a: &[f64], n: usize) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::FRAC_PI_4;
 
     #[test]
     fn inverse_is_an_inverse() {

@@ -1,11 +1,12 @@
 //! Table look-up: split each position into a base entry and an interpolation weight, and
 //! read the base entry and its three higher neighbours from the map of the max axis.
 //!
-//! Map address (per axis map, `3 + 2 * index_bits` bits): {s_max, s_u, i_u, s_v, i_v}.
+//! Map address: [`super::map_addr`].
 //! With interpolation the base index is min(position >> interp_bits, entries - 2), so the
 //! outer entry is never a base, and the weight is position - base * step, in 0..=step.
 //! Without interpolation the position is the entry index and one entry is read.
 
+use super::map_addr::addr;
 use super::reflectance_map::Maps;
 use crate::config::Config;
 
@@ -17,13 +18,6 @@ pub struct Lookup {
     pub w_v: u32,
     /// e[du + 2 * dv]: base, u + 1, v + 1, both + 1. Without interpolation only e[0].
     pub e: [u32; 4],
-}
-
-/// Address of entry (i_u, i_v) in the map of one axis.
-#[inline]
-pub fn addr(cfg: &Config, s_max: u32, s_u: u32, i_u: u32, s_v: u32, i_v: u32) -> u32 {
-    let i = cfg.index_bits;
-    (s_max << (2 * i + 2)) | (s_u << (2 * i + 1)) | (i_u << (i + 1)) | (s_v << i) | i_v
 }
 
 /// Base index and weight of one position.

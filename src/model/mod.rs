@@ -8,6 +8,7 @@ pub mod color_mul;
 pub mod fast;
 pub mod interpolate;
 pub mod linear_index;
+pub mod map_addr;
 pub mod map_fit;
 pub mod map_lookup;
 pub mod normalise;

@@ -2,7 +2,7 @@
 //! (s_u, i_u, s_v, i_v), the light model evaluated at the entry's direction and quantised to
 //! `map_bits`. The host rebuilds them every frame; the RTL holds them in RAM.
 
-use super::{atan_rom, linear_index, map_lookup};
+use super::map_addr;
 use crate::config::Config;
 use glam::DVec3;
 
@@ -34,11 +34,7 @@ impl Maps {
 
 /// The tangent at which entry `index` sits along one component.
 pub fn entry_tangent(cfg: &Config, index: u32) -> f64 {
-    if cfg.compensation {
-        atan_rom::entry_tangent(cfg, index)
-    } else {
-        linear_index::entry_tangent(cfg, index)
-    }
+    crate::geometry::face_tangent(cfg.compensation, index as f64 / (cfg.entries() - 1) as f64)
 }
 
 /// Unit direction of one map entry, given by its axis and address fields.
@@ -55,12 +51,7 @@ pub fn entry_direction(
     let mx = sgn(s_max);
     let u = sgn(s_u) * entry_tangent(cfg, i_u);
     let v = sgn(s_v) * entry_tangent(cfg, i_v);
-    let d = match axis {
-        0 => DVec3::new(mx, u, v),
-        1 => DVec3::new(u, mx, v),
-        _ => DVec3::new(u, v, mx),
-    };
-    crate::geometry::sym_normalize(d)
+    crate::geometry::sym_normalize(DVec3::from_array(crate::geometry::place(axis, mx, u, v)))
 }
 
 /// Quantises a light-model intensity (clamped to 0..=1) to `map_bits`, half up.
@@ -84,7 +75,7 @@ pub fn contents(cfg: &Config, shade: impl Fn(DVec3) -> f64) -> Maps {
                 for s_v in 0..2 {
                     for i_u in 0..n {
                         for i_v in 0..n {
-                            let a = map_lookup::addr(cfg, s_max, s_u, i_u, s_v, i_v);
+                            let a = map_addr::addr(cfg, s_max, s_u, i_u, s_v, i_v);
                             let d = entry_direction(cfg, axis, s_max, s_u, i_u, s_v, i_v);
                             data[(axis * cfg.map_entries() + a) as usize] = quantise(cfg, shade(d));
                         }

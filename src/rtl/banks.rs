@@ -8,6 +8,7 @@
 
 use crate::config::Config;
 use crate::hexfile;
+use crate::model::map_addr::MapAddr;
 use crate::model::Maps;
 
 /// Where one logical map entry lives: which bank (index into [`bank_names`]) and where in it.
@@ -15,31 +16,6 @@ use crate::model::Maps;
 pub struct BankSlot {
     pub bank: usize,
     pub addr: u32,
-}
-
-/// Fields of a logical map address {s_max, s_u, i_u, s_v, i_v}.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct MapAddr {
-    pub s_max: u32,
-    pub s_u: u32,
-    pub i_u: u32,
-    pub s_v: u32,
-    pub i_v: u32,
-}
-
-impl MapAddr {
-    /// Splits a logical address (the inverse of `model::map_lookup::addr`).
-    pub fn decode(cfg: &Config, addr: u32) -> MapAddr {
-        let i = cfg.index_bits;
-        let idx = cfg.entries() - 1;
-        MapAddr {
-            s_max: (addr >> (2 * i + 2)) & 1,
-            s_u: (addr >> (2 * i + 1)) & 1,
-            i_u: (addr >> (i + 1)) & idx,
-            s_v: (addr >> i) & 1,
-            i_v: addr & idx,
-        }
-    }
 }
 
 /// Concatenates (value, width) fields, first field most significant, like Verilog's {a, b}.
@@ -141,7 +117,7 @@ pub fn bank_files(cfg: &Config, maps: &Maps) -> Vec<(String, String)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::map_lookup;
+    use crate::model::map_addr;
 
     fn configs() -> Vec<Config> {
         let d = Config::default();
@@ -194,13 +170,7 @@ mod tests {
                 let mut banks: Vec<usize> = [(0, 0), (1, 0), (0, 1), (1, 1)]
                     .iter()
                     .map(|&(du, dv)| {
-                        bank_slot(
-                            &cfg,
-                            0,
-                            1,
-                            map_lookup::addr(&cfg, 1, 0, bu + du, 1, bv + dv),
-                        )
-                        .bank
+                        bank_slot(&cfg, 0, 1, map_addr::addr(&cfg, 1, 0, bu + du, 1, bv + dv)).bank
                     })
                     .collect();
                 banks.sort();
@@ -215,7 +185,7 @@ mod tests {
         for addr in 0..cfg.map_entries() {
             let a = MapAddr::decode(&cfg, addr);
             assert_eq!(
-                map_lookup::addr(&cfg, a.s_max, a.s_u, a.i_u, a.s_v, a.i_v),
+                map_addr::addr(&cfg, a.s_max, a.s_u, a.i_u, a.s_v, a.i_v),
                 addr
             );
         }

@@ -23,8 +23,9 @@
 use super::interval::{shade_bounds, DirBox};
 use super::{angle_deg, WorstError};
 use super::{
-    class_of, class_range, classes, encoded_direction, encoded_tangent, place, Acc, Report, Setup,
+    class_of, class_range, classes, encoded_direction, encoded_tangent, Acc, Report, Setup,
 };
+use crate::geometry::place;
 use crate::model::fast::ordered_signs;
 use crate::model::reflectance_map::quantise;
 use crate::model::sort_shift::{self, SortShift};

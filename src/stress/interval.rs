@@ -94,11 +94,7 @@ impl DirBox {
         let m = sgn(signs.0, (1.0, 1.0));
         let u = sgn(signs.1, tu);
         let v = sgn(signs.2, tv);
-        let c = match axis {
-            0 => [m, u, v],
-            1 => [u, m, v],
-            _ => [u, v, m],
-        };
+        let c = crate::geometry::place(axis, m, u, v);
         DirBox { c }
     }
 
@@ -214,11 +210,7 @@ mod tests {
                     let (tu, tv) = (u0 + unit() * w, v0 + unit() * w);
                     let sg = |s: u32, t: f64| if s == 1 { -t } else { t };
                     let (m, u, v) = (sg(signs.0, 1.0), sg(signs.1, tu), sg(signs.2, tv));
-                    let d = match axis {
-                        0 => DVec3::new(m, u, v),
-                        1 => DVec3::new(u, m, v),
-                        _ => DVec3::new(u, v, m),
-                    };
+                    let d = DVec3::from_array(crate::geometry::place(axis, m, u, v));
                     let i = p.shade(d.normalize());
                     assert!(bound.lo <= i && i <= bound.hi, "{i} outside {bound:?}");
                 }

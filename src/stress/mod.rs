@@ -28,7 +28,6 @@ use crate::scene::Scene;
 use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
-use std::f64::consts::FRAC_PI_4;
 
 /// Everything a stress run shades with.
 pub struct Setup {
@@ -78,25 +77,7 @@ pub fn class_range(cfg: &Config, class: u32) -> (u32, u32) {
 
 /// The tangent a map position stands for (see the module documentation).
 pub fn encoded_tangent(cfg: &Config, p: u32) -> f64 {
-    let x = p as f64 / cfg.pos_max() as f64;
-    if p == cfg.pos_max() {
-        // The border, exactly (tan of FRAC_PI_4 rounds below 1), as for the outer entries.
-        1.0
-    } else if cfg.compensation {
-        (x * FRAC_PI_4).tan()
-    } else {
-        x
-    }
-}
-
-/// Places (max, u, v) components on the axes: max x gives (max, u, v), max y (u, max, v),
-/// max z (u, v, max).
-pub fn place<T>(axis: u32, max: T, u: T, v: T) -> [T; 3] {
-    match axis {
-        0 => [max, u, v],
-        1 => [u, max, v],
-        _ => [u, v, max],
-    }
+    crate::geometry::face_tangent(cfg.compensation, p as f64 / cfg.pos_max() as f64)
 }
 
 /// The encoded direction (unit) of a sample with these sort results and positions.
@@ -108,7 +89,7 @@ pub fn encoded_direction(
     p_v: u32,
 ) -> DVec3 {
     let sg = |s: u32, t: f64| if s == 1 { -t } else { t };
-    let [x, y, z] = place(
+    let [x, y, z] = crate::geometry::place(
         axis,
         sg(signs.0, 1.0),
         sg(signs.1, encoded_tangent(cfg, p_u)),

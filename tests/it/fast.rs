@@ -182,7 +182,7 @@ fn default_tables_are_exact_over_their_domains() {
                     if (axis >= 1 && a == m) || (axis == 2 && b == m) {
                         continue;
                     }
-                    let mut g = rmapgen::stress::place(axis, mx, mu, mv).map(|c| c as i32);
+                    let mut g = rmapgen::geometry::place(axis, mx, mu, mv).map(|c| c as i32);
                     for (j, c) in g.iter_mut().enumerate() {
                         if (code >> j) & 1 == 1 {
                             *c = -*c;
@@ -226,7 +226,7 @@ fn default_tables_are_exact_over_their_domains() {
                         continue;
                     }
                     let [mx, mu, mv] = mags(m, a, b).map(|c| c as i32);
-                    let mut g = rmapgen::stress::place(axis, mx, mu, mv);
+                    let mut g = rmapgen::geometry::place(axis, mx, mu, mv);
                     for (j, c) in g.iter_mut().enumerate() {
                         if (code >> j) & 1 == 1 {
                             *c = -*c;

@@ -10,6 +10,7 @@ mod grid;
 mod hdl;
 mod helpers;
 mod hexfile;
+mod layout;
 mod limits;
 mod map_fit;
 mod model_stages;
