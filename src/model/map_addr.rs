@@ -78,6 +78,8 @@ mod tests {
     }
 
     #[test]
+    // The binary literals are grouped by field, not by nibble.
+    #[allow(clippy::unusual_byte_groupings)]
     fn fields_sit_where_the_layout_says() {
         let cfg = Config::default(); // index_bits 3: {s_max, s_u, i_u[2:0], s_v, i_v[2:0]}
         assert_eq!(addr(&cfg, 1, 0, 0, 0, 0), 0b1_0_000_0_000);
