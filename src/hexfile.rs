@@ -2,8 +2,7 @@
 //! configuration (Icarus, Verilator and Yosys all accept them), then one entry per line.
 
 use crate::config::Config;
-use crate::model::{atan_rom, recip_rom};
-use crate::scene::Scene;
+use crate::model::{atan_rom, recip_rom, Maps};
 
 /// Hex digits of a `bits`-wide value.
 pub fn digits(bits: u32) -> usize {
@@ -25,8 +24,8 @@ pub fn format(cfg: &Config, what: &str, bits: u32, entries: &[u32]) -> String {
     s
 }
 
-/// The fixed ROMs and the scene's maps, as (file name, contents).
-pub fn all(cfg: &Config, scene: &Scene) -> Vec<(String, String)> {
+/// The fixed ROMs and a scene's maps, as (file name, contents).
+pub fn all(cfg: &Config, maps: &Maps) -> Vec<(String, String)> {
     let mut v = vec![(
         "recip_rom.hex".to_string(),
         format(
@@ -47,7 +46,6 @@ pub fn all(cfg: &Config, scene: &Scene) -> Vec<(String, String)> {
             ),
         ));
     }
-    let maps = scene.maps(cfg);
     for (axis, name) in ["x", "y", "z"].iter().enumerate() {
         v.push((
             format!("map_{name}.hex"),

@@ -70,10 +70,10 @@ pub fn write_dir(
     extra: &[(String, String)],
 ) -> Result<(PathBuf, Manifest)> {
     let out = StagedDir::new(out, policy)?;
-    let manifest = rtl::write_design(cfg, scene, &out)?;
-    // The vectors see the same maps as the design: this scene's, and the alternate scene's
-    // that testbenches load through the host port.
+    // Built once: the design's init files and the vectors see the same maps, this scene's
+    // and the alternate scene's that testbenches load through the host port.
     let maps = MapSet::from_scenes(cfg, scene, &Scene::alternate());
+    let manifest = rtl::write_design(cfg, &maps, &out)?;
     vectors::write_all_with_maps(cfg, &out, vectors, seed, &maps)?;
     tb::write_all(cfg, &out)?;
     for (name, text) in extra {

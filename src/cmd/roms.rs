@@ -3,6 +3,7 @@
 use super::config_args::ConfigArgs;
 use crate::output::StagedDir;
 use crate::scene::Scene;
+use crate::vectors::MapSet;
 use anyhow::Context;
 use anyhow::Result;
 use clap::Args;
@@ -59,7 +60,10 @@ pub fn run(a: &RomsArgs) -> Result<()> {
         );
     }
     let out = StagedDir::new(target, &policy)?;
-    for (name, text) in crate::rtl::hex_files(&cfg, &scene) {
+    for (name, text) in crate::rtl::hex_files(
+        &cfg,
+        &MapSet::from_scenes(&cfg, &scene, &Scene::alternate()),
+    ) {
         out.write_text(&name, &text)?;
     }
     if a.update.is_some() {

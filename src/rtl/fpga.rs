@@ -16,7 +16,6 @@
 use super::manifest;
 use crate::config::Config;
 use crate::output::StagedDir;
-use crate::scene::Scene;
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -162,7 +161,7 @@ pub fn ice40_report(cfg: &Config, opts: &Options) -> Result<FpgaReport> {
     cfg.validate()?;
     let tmp = crate::output::Scratch::new()?;
     let out = StagedDir::new(&tmp.path().join("rtl"), &Default::default())?;
-    super::write_design(cfg, &Scene::standard(), &out)?;
+    super::write_design(cfg, &crate::vectors::MapSet::standard(cfg), &out)?;
     let dir = out.commit()?;
     run_dir(&dir, opts)
 }

@@ -17,7 +17,7 @@ pub mod verilated;
 use crate::config::Config;
 use crate::hexfile;
 use crate::output::StagedDir;
-use crate::scene::Scene;
+use crate::vectors::MapSet;
 use anyhow::Result;
 pub use manifest::Manifest;
 pub use ports::{Dir, Port, Width};
@@ -222,12 +222,12 @@ pub fn modules(cfg: &Config) -> Vec<Module> {
 }
 
 /// Every `$readmemh` file of a design: recip_rom.hex, atan_rom.hex (with compensation), the
-/// scene's logical maps map_<axis>.hex, the second map map2_<axis>.hex ([`Scene::alternate`],
+/// scene's logical maps map_<axis>.hex, the second map map2_<axis>.hex (the alternate scene's,
 /// which testbenches load through the host port) and the map banks' init files. `generate`
 /// and `roms` both write exactly these.
-pub fn hex_files(cfg: &Config, scene: &Scene) -> Vec<(String, String)> {
-    let mut v = hexfile::all(cfg, scene);
-    let alt = Scene::alternate().maps(cfg);
+pub fn hex_files(cfg: &Config, maps: &MapSet) -> Vec<(String, String)> {
+    let mut v = hexfile::all(cfg, &maps.scene);
+    let alt = &maps.second;
     for (axis, name) in ["x", "y", "z"].iter().enumerate() {
         let what = format!(
             "second reflectance map (scene two_lights), max axis {name}, address {{s_max, s_u, i_u, s_v, i_v}}"
@@ -237,15 +237,16 @@ pub fn hex_files(cfg: &Config, scene: &Scene) -> Vec<(String, String)> {
             hexfile::format(cfg, &what, cfg.map_bits, alt.axis(axis as u32)),
         ));
     }
-    v.extend(banks::bank_files(cfg, &scene.maps(cfg)));
+    v.extend(banks::bank_files(cfg, &maps.scene));
     v
 }
 
 /// Writes every module's `.v`, the ROM and map init files, the logical maps of the scene
-/// (`map_<axis>.hex`) and of [`Scene::alternate`] (`map2_<axis>.hex`, which testbenches load
+/// (`map_<axis>.hex`) and of the alternate scene (`map2_<axis>.hex`, which testbenches load
 /// through the host port), the FuseSoC core and README of [`package`], and `manifest.json`.
-/// Returns the manifest.
-pub fn write_design(cfg: &Config, scene: &Scene, out: &StagedDir) -> Result<Manifest> {
+/// Returns the manifest. `maps` are built once by the caller, which hands the same value to
+/// the vectors.
+pub fn write_design(cfg: &Config, maps: &MapSet, out: &StagedDir) -> Result<Manifest> {
     cfg.validate()?;
     let mut files = Vec::new();
     let mut write = |name: String, text: &str| -> Result<()> {
@@ -257,7 +258,7 @@ pub fn write_design(cfg: &Config, scene: &Scene, out: &StagedDir) -> Result<Mani
         write(m.file(), &templates::render(cfg, m)?)?;
     }
     let mut hex = Vec::new();
-    for (name, text) in hex_files(cfg, scene) {
+    for (name, text) in hex_files(cfg, maps) {
         hex.push(name.clone());
         write(name, &text)?;
     }

@@ -51,7 +51,11 @@ impl VerilatedTop {
         let dir = crate::output::Scratch::new()?;
         let design = dir.path().join("design");
         let staged = StagedDir::new(&design, &Default::default())?;
-        super::write_design(cfg, scene, &staged)?;
+        super::write_design(
+            cfg,
+            &crate::vectors::MapSet::from_scenes(cfg, scene, &Scene::alternate()),
+            &staged,
+        )?;
         crate::rtl::tb::write_all(cfg, &staged)?;
         staged.commit()?;
         let harness = dir.path().join("top_apply.cpp");
