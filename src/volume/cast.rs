@@ -66,6 +66,14 @@ pub const MIN_STEP: f64 = 0.05;
 pub const MAX_STEP: f64 = 4.0;
 /// Largest brick side in cells (`--brick`): larger bricks are rarely empty.
 pub const MAX_BRICK: usize = 64;
+/// Bytes a batch (`--rtl`) render holds per contributing sample: its weight (4) and gradient
+/// (12) here, its intensity (4) back from the batch shader, and its line in the simulator's
+/// input and output files (about 16).
+pub const BATCH_BYTES_PER_SAMPLE: u64 = 36;
+/// The most contributing samples a batch render gathers: what fits the volume memory budget.
+/// A transparent transfer function at a small step can reach billions, so the render stops
+/// with an error once it passes this, instead of running out of memory.
+pub const MAX_BATCH_SAMPLES: usize = (super::MEMORY_BUDGET / BATCH_BYTES_PER_SAMPLE) as usize;
 
 /// One sample's shading: a G-bit gradient in, an M-bit intensity out.
 pub trait Shader: Sync {
@@ -547,12 +555,22 @@ impl<'a> Caster<'a> {
         }
     }
 
-    /// Every sample the fused path would shade, for a batch shader.
-    pub fn collect(&self) -> Samples {
+    /// Every sample the fused path would shade, for a batch shader; refused once more than
+    /// [`MAX_BATCH_SAMPLES`] samples contribute.
+    pub fn collect(&self) -> Result<Samples> {
+        self.collect_at_most(MAX_BATCH_SAMPLES)
+    }
+
+    /// [`Caster::collect`] with the sample limit given.
+    fn collect_at_most(&self, limit: usize) -> Result<Samples> {
+        use std::sync::atomic::{AtomicUsize, Ordering};
         let n = self.opts.size as usize;
+        // Samples gathered so far over all rows: the image's sample count is only known
+        // once every ray is marched, so the limit is checked as rows fill.
+        let gathered = AtomicUsize::new(0);
         // Per row: opacities, sample counts per pixel, weights, gradients, work.
         type Row = (Vec<f32>, Vec<usize>, Vec<f32>, Vec<[i32; 3]>, Stats);
-        let rows: Vec<Row> = (0..n)
+        let rows: Result<Vec<Row>> = (0..n)
             .into_par_iter()
             .map(|y| {
                 let mut st = Stats::default();
@@ -566,11 +584,20 @@ impl<'a> Caster<'a> {
                             g.push(gi);
                         });
                         counts[x] = w.len() - before;
+                        if gathered.fetch_add(counts[x], Ordering::Relaxed) + counts[x] > limit {
+                            bail!(
+                                "the batch (--rtl) render gathers more than {limit} contributing \
+                                 samples, the limit for {} of memory; use a smaller --size or a \
+                                 larger --step",
+                                super::human_bytes(super::MEMORY_BUDGET)
+                            );
+                        }
                     }
                 }
-                (alpha, counts, w, g, st)
+                Ok((alpha, counts, w, g, st))
             })
             .collect();
+        let rows = rows?;
         let mut s = Samples {
             size: self.opts.size,
             alpha: Vec::with_capacity(n * n),
@@ -590,7 +617,7 @@ impl<'a> Caster<'a> {
             s.gradients.extend(g);
             s.stats = s.stats.add(st);
         }
-        s
+        Ok(s)
     }
 }
 
@@ -680,7 +707,7 @@ mod tests {
             let c = Caster::new(&p, &transfer(), [-0.4, -0.8, 0.45], opts(40, true)).unwrap();
             let model = ModelShader::new(&cfg, &Scene::standard());
             let fused = c.render(&model);
-            let samples = c.collect();
+            let samples = c.collect().unwrap();
             assert_eq!(samples.stats, fused.stats);
             assert!(samples.gradients.len() > 1000);
             let shaded: Vec<u32> = samples
@@ -695,6 +722,15 @@ mod tests {
                 cfg.summary()
             );
             assert!(samples.composite(&shaded[1..]).is_err());
+            // A limit below the image's sample count stops the gathering with an error.
+            let e = c.collect_at_most(samples.gradients.len() - 1).unwrap_err();
+            assert!(e.to_string().contains("more than"), "{e}");
+            assert_eq!(
+                c.collect_at_most(samples.gradients.len())
+                    .unwrap()
+                    .gradients,
+                samples.gradients
+            );
             // A batch that differs in one sample changes the image.
             let mut off = shaded.clone();
             let i = samples.weights.iter().position(|&w| w > 0.2).unwrap();
@@ -737,7 +773,7 @@ mod tests {
             },
         )
         .unwrap();
-        let s = c.collect();
+        let s = c.collect().unwrap();
         assert!(s.alpha.iter().all(|&a| a == 1.0), "{:?}", s.alpha);
         for g in &s.gradients {
             assert!(g[2] > 0 && g[0] == 0 && g[1] == 0, "{g:?}");

@@ -215,7 +215,7 @@ pub fn render(
 /// A batch shader's image: the contributing samples' gradients shaded in one batch, then
 /// composited.
 pub fn batch(caster: &Caster, src: &dyn IntensitySource, cfg: &Config) -> Result<Vec<u32>> {
-    let samples = caster.collect();
+    let samples = caster.collect()?;
     let v = src.intensities(&samples.gradients)?;
     if v.len() != samples.gradients.len() {
         bail!(
