@@ -7,16 +7,6 @@ use std::path::Path;
 const MATERIAL: &str =
     "[material]\nambient = 0.1\ndiffuse = 0.6\nspecular = 0.3\nshininess = 20.0\n";
 
-fn entries(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = dir
-        .read_dir()
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
-}
-
 #[test]
 fn writes_images_and_metrics() {
     let tmp = tempdir();
@@ -38,7 +28,7 @@ fn writes_images_and_metrics() {
         "{stdout}"
     );
     assert_eq!(
-        entries(&out),
+        crate::helpers::entries(&out),
         [
             ".rmapgen-files",
             "error50.png",
@@ -47,7 +37,11 @@ fn writes_images_and_metrics() {
             "reference.png"
         ]
     );
-    assert_eq!(entries(tmp.path()), ["sphere"], "no staging directory left");
+    assert_eq!(
+        crate::helpers::entries(tmp.path()),
+        ["sphere"],
+        "no staging directory left"
+    );
     for name in ["error50.png", "model.png", "reference.png"] {
         let img = image::open(out.join(name)).unwrap();
         assert_eq!((img.width(), img.height()), (96, 96), "{name}");
@@ -115,9 +109,9 @@ fn fails(scene_text: Option<&str>, extra: &[&str], needle: &str) {
     let o = run(&args.iter().map(|s| s.as_str()).collect::<Vec<_>>());
     assert_error(&o, needle);
     assert!(
-        entries(outs.path()).is_empty(),
+        crate::helpers::entries(outs.path()).is_empty(),
         "left behind: {:?}",
-        entries(outs.path())
+        crate::helpers::entries(outs.path())
     );
 }
 
@@ -209,5 +203,5 @@ fn failure_keeps_an_existing_output() {
         "red_bits = 12 exceeds grad_bits = 10",
     );
     assert_eq!(std::fs::read(out.join("metrics.json")).unwrap(), before);
-    assert_eq!(entries(tmp.path()), ["o"]);
+    assert_eq!(crate::helpers::entries(tmp.path()), ["o"]);
 }

@@ -74,19 +74,10 @@ fn rendered(cfg: &Config, scene: &Scene) -> (u32, f64) {
     (m.max_abs_error, m.rmse)
 }
 
-fn files(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
-}
-
 /// Every Verilog file in `dir`, concatenated, comments left out (a comment may say what a
 /// module stands in for).
 fn verilog(dir: &Path) -> String {
-    files(dir)
+    crate::helpers::entries(dir)
         .iter()
         .filter(|f| f.ends_with(".v"))
         .flat_map(|f| {
@@ -194,7 +185,7 @@ fn a_diffuse_scene_gets_fewer_map_bits_and_no_compensation_rom() {
     assert!(rendered(&c, &sc).0 <= 7);
     assert!(!c.compensation, "{stdout}");
     assert!(space::bits(&c) < space::bits(&paper), "{stdout}");
-    let f = files(&out);
+    let f = crate::helpers::entries(&out);
     assert!(!f.iter().any(|n| n.starts_with("atan_rom")), "{f:?}");
     assert!(
         !verilog(&out).contains("atan"),
@@ -231,7 +222,7 @@ fn the_colour_multiplier_is_there_exactly_when_the_scene_has_a_colour() {
     let plain = tmp.path().join("plain");
     let (d, _) = fit("standard.toml", &plain, &["--max-error", "20"]);
     assert!(!config(&d["chosen"]).color);
-    assert!(!files(&plain).contains(&"color_mul.v".to_string()));
+    assert!(!crate::helpers::entries(&plain).contains(&"color_mul.v".to_string()));
     let v = verilog(&plain);
     assert!(
         !v.contains("color_mul") && !v.contains("r_o"),
@@ -242,7 +233,7 @@ fn the_colour_multiplier_is_there_exactly_when_the_scene_has_a_colour() {
     let (d, stdout) = fit("color.toml", &colored, &["--max-error", "20"]);
     let c = config(&d["chosen"]);
     assert!(c.color);
-    assert!(files(&colored).contains(&"color_mul.v".to_string()));
+    assert!(crate::helpers::entries(&colored).contains(&"color_mul.v".to_string()));
     // The target covers the colour channels too.
     let e = &d["chosen"]["errors"];
     assert!(e["color_max_abs_error"].as_u64().unwrap() <= 20, "{stdout}");
@@ -281,7 +272,7 @@ fn cost_in_cells_leaves_out_the_interpolator_for_a_diffuse_scene() {
             assert!(rc >= cells, "{stdout}");
         }
     }
-    assert!(!files(&tmp.path().join("f")).contains(&"interpolate.v".to_string()));
+    assert!(!crate::helpers::entries(&tmp.path().join("f")).contains(&"interpolate.v".to_string()));
 }
 
 #[test]
@@ -359,6 +350,10 @@ fn bad_input_is_one_line_exit_2_and_leaves_the_output_alone() {
         a.extend(args);
         let o = helpers::run(&a);
         helpers::assert_error(&o, needle);
-        assert_eq!(files(&out), vec!["keep.txt".to_string()], "{a:?}");
+        assert_eq!(
+            crate::helpers::entries(&out),
+            vec!["keep.txt".to_string()],
+            "{a:?}"
+        );
     }
 }

@@ -35,6 +35,22 @@ pub fn assert_error(out: &Output, needle: &str) {
     );
 }
 
+/// The names in a directory, sorted; hidden ones too (stamps, staging directories, partial
+/// files).
+pub fn entries(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("cannot read {}: {e}", dir.display()))
+        .map(|e| {
+            e.expect("dir entry")
+                .file_name()
+                .to_string_lossy()
+                .into_owned()
+        })
+        .collect();
+    v.sort();
+    v
+}
+
 /// Whether a directory exists and has entries.
 pub fn nonempty(p: &Path) -> bool {
     p.read_dir()

@@ -13,22 +13,16 @@ use std::io::Write;
 use std::path::Path;
 use std::process::Output;
 
-/// The names in a directory (hidden ones too: staging directories and partial files).
-fn entries(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
-}
-
 /// Runs a command that must be refused: exit 2, one line naming the problem, and `dir`
 /// holding exactly `before` afterwards (no output, no staging directory, no partial file).
 fn refused(args: &[&str], needle: &str, dir: &Path, before: &[&str]) -> Output {
     let out = helpers::run(args);
     assert_error(&out, needle);
-    assert_eq!(entries(dir), before, "left behind by {args:?}");
+    assert_eq!(
+        crate::helpers::entries(dir),
+        before,
+        "left behind by {args:?}"
+    );
     out
 }
 
@@ -362,7 +356,7 @@ fn a_directory_is_not_a_volume_file() {
     std::fs::write(&nhdr, header("uchar", "2 2 2", "raw", "data file: data\n")).unwrap();
     let o = helpers::run(&["volume", s(&nhdr), "--out", s(&out)]);
     assert_error(&o, "is a directory, not a data file");
-    assert_eq!(entries(d.path()), ["in"]);
+    assert_eq!(crate::helpers::entries(d.path()), ["in"]);
 }
 
 #[test]

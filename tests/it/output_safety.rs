@@ -35,11 +35,7 @@ fn notes(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
 
 /// Nothing but `names` in `dir` (no staging directories or partial files beside an output).
 fn only(dir: &Path, names: &[&str]) {
-    let mut got: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    got.sort();
+    let got = helpers::entries(dir);
     let mut want: Vec<String> = names.iter().map(|s| s.to_string()).collect();
     want.sort();
     assert_eq!(got, want, "entries of {}", dir.display());

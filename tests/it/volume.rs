@@ -10,16 +10,6 @@ use std::path::Path;
 
 const SMALL: &str = "64,64,32";
 
-fn entries(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = dir
-        .read_dir()
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
-}
-
 /// Runs `rmapgen volume` with `args` plus `--size 64 --out <dir>`, expecting success.
 fn render(args: &[&str], out: &Path) -> String {
     let mut a = vec!["volume"];
@@ -49,7 +39,7 @@ fn synthetic_writes_images_and_metrics() {
         "{stdout}"
     );
     assert_eq!(
-        entries(&out),
+        crate::helpers::entries(&out),
         [
             ".rmapgen-files",
             "error50.png",
@@ -58,7 +48,11 @@ fn synthetic_writes_images_and_metrics() {
             "reference.png"
         ]
     );
-    assert_eq!(entries(tmp.path()), ["v"], "no staging directory left");
+    assert_eq!(
+        crate::helpers::entries(tmp.path()),
+        ["v"],
+        "no staging directory left"
+    );
     for name in ["error50.png", "model.png", "reference.png"] {
         let img = image::open(out.join(name)).unwrap();
         assert_eq!(
@@ -212,13 +206,21 @@ fn fails(args: &[&str], needle: &str) {
     let out = tmp.path().join("out");
     std::fs::create_dir(&out).unwrap();
     std::fs::write(out.join("keep.txt"), "old").unwrap();
-    let before = entries(tmp.path());
+    let before = crate::helpers::entries(tmp.path());
     let mut a = vec!["volume"];
     a.extend_from_slice(args);
     a.extend_from_slice(&["--size", "32", "--out", out.to_str().unwrap()]);
     assert_error(&run(&a), needle);
-    assert_eq!(entries(tmp.path()), before, "no staging directory");
-    assert_eq!(entries(&out), ["keep.txt"], "output untouched");
+    assert_eq!(
+        crate::helpers::entries(tmp.path()),
+        before,
+        "no staging directory"
+    );
+    assert_eq!(
+        crate::helpers::entries(&out),
+        ["keep.txt"],
+        "output untouched"
+    );
     assert_eq!(
         std::fs::read_to_string(out.join("keep.txt")).unwrap(),
         "old"
