@@ -3,6 +3,7 @@
 
 use crate::config::Config;
 use crate::model::{atan_rom, recip_rom, Maps};
+use crate::stages;
 
 /// Hex digits of a `bits`-wide value.
 pub fn digits(bits: u32) -> usize {
@@ -27,7 +28,7 @@ pub fn format(cfg: &Config, what: &str, bits: u32, entries: &[u32]) -> String {
 /// The fixed ROMs and a scene's maps, as (file name, contents).
 pub fn all(cfg: &Config, maps: &Maps) -> Vec<(String, String)> {
     let mut v = vec![(
-        "recip_rom.hex".to_string(),
+        stages::recip_rom::INIT_FILE.to_string(),
         format(
             cfg,
             "reciprocal ROM",
@@ -37,7 +38,7 @@ pub fn all(cfg: &Config, maps: &Maps) -> Vec<(String, String)> {
     )];
     if cfg.compensation {
         v.push((
-            "atan_rom.hex".to_string(),
+            stages::atan_rom::INIT_FILE.to_string(),
             format(
                 cfg,
                 "distortion compensation (atan) ROM",

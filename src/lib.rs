@@ -15,6 +15,7 @@ pub mod render;
 pub mod rng;
 pub mod rtl;
 pub mod scene;
+pub mod stages;
 pub mod stress;
 pub mod toml_input;
 pub mod vectors;

@@ -3,21 +3,26 @@
 //! intermediate value (the per-stage test vectors are written from it); [`Model::shade`] is
 //! the same computation returning only the output.
 
-pub mod atan_rom;
-pub mod color_mul;
 pub mod fast;
-pub mod interpolate;
-pub mod linear_index;
 pub mod map_addr;
 pub mod map_fit;
-pub mod map_lookup;
-pub mod normalise;
-pub mod recip_rom;
+pub mod map_set;
 pub mod reflectance_map;
-pub mod sort_shift;
-pub mod zero_detect;
+
+// Each stage's bit-accurate model lives in its stage folder, beside its Verilog template and
+// its vectors (src/stages/<stage>/model.rs); these names make it read as one pipeline here.
+pub use crate::stages::atan_rom::model as atan_rom;
+pub use crate::stages::color_mul::model as color_mul;
+pub use crate::stages::interpolate::model as interpolate;
+pub use crate::stages::linear_index::model as linear_index;
+pub use crate::stages::map_lookup::model as map_lookup;
+pub use crate::stages::normalise::model as normalise;
+pub use crate::stages::recip_rom::model as recip_rom;
+pub use crate::stages::sort_shift::model as sort_shift;
+pub use crate::stages::zero_detect::model as zero_detect;
 
 use crate::config::Config;
+pub use map_set::MapSet;
 pub use reflectance_map::Maps;
 
 /// Another implementation of the shader, asked for the intensities of many gradients in one

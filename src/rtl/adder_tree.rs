@@ -312,6 +312,17 @@ impl Sum {
     pub fn width(&self) -> u32 {
         self.sig.width + self.shift
     }
+
+    /// The sum used as a signal: its value must start at bit 0.
+    pub fn plain(&self) -> Sig {
+        assert_eq!(self.shift, 0, "{} is shifted", self.sig.name);
+        self.sig.clone()
+    }
+}
+
+/// Registered adder levels among `steps`: the clocks the trees add to a stage's latency.
+pub fn registered(steps: &[Step]) -> u32 {
+    steps.iter().filter(|s| s.registered).count() as u32
 }
 
 /// The result of [`build`]: the steps, each tree's sum, and the riders after the last step.

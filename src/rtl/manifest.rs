@@ -2,8 +2,11 @@
 //! the configuration, the modules in instantiation order with their ports and latencies, the
 //! top's latency, the memories and every file written.
 
-use super::{banks, latency, modules, ports, sideband_delays, Module, SidebandDelays};
+use super::ports;
 use crate::config::Config;
+use crate::stages::rmap_top::{self, SidebandDelays};
+pub use crate::stages::unit::Memory;
+use crate::stages::{self, TOP};
 use serde::Serialize;
 
 pub const FILE: &str = "manifest.json";
@@ -36,88 +39,25 @@ pub struct ModuleInfo {
     pub ports: Vec<ports::Port>,
 }
 
-/// One memory array of the design.
-#[derive(Clone, Debug, Serialize)]
-pub struct Memory {
-    /// Hierarchical name below rmap_top.
-    pub instance: String,
-    pub module: &'static str,
-    pub init_file: String,
-    pub entries: u32,
-    pub width: u32,
-    pub bits: u64,
-    pub writable: bool,
-}
-
-fn memory(
-    instance: &str,
-    module: Module,
-    init_file: String,
-    entries: u32,
-    width: u32,
-    writable: bool,
-) -> Memory {
-    Memory {
-        instance: instance.to_string(),
-        module: module.name(),
-        init_file,
-        entries,
-        width,
-        bits: entries as u64 * width as u64,
-        writable,
-    }
-}
-
-/// The memory arrays of a configuration.
+/// The memory arrays of a configuration, named below rmap_top.
 pub fn memories(cfg: &Config) -> Vec<Memory> {
-    let mut v = vec![memory(
-        "u_normalise.u_recip_rom.rom",
-        Module::RecipRom,
-        "recip_rom.hex".into(),
-        cfg.recip_entries(),
-        cfg.recip_bits,
-        false,
-    )];
-    if cfg.compensation {
-        for rom in ["rom_u", "rom_v"] {
-            v.push(memory(
-                &format!("u_atan_rom.{rom}"),
-                Module::AtanRom,
-                "atan_rom.hex".into(),
-                cfg.atan_entries(),
-                cfg.pos_bits(),
-                false,
-            ));
-        }
-    }
-    for (k, name) in banks::bank_names(cfg).iter().enumerate() {
-        let inst = if name.is_empty() {
-            "u_bank".to_string()
-        } else {
-            format!("u_bank_{name}")
-        };
-        v.push(memory(
-            &format!("u_map_lookup.{inst}.mem"),
-            Module::MapBank,
-            banks::bank_file(cfg, k),
-            cfg.bank_entries(),
-            cfg.map_bits,
-            true,
-        ));
-    }
-    v
+    TOP.memories(cfg)
 }
 
 impl Manifest {
     pub fn new(cfg: &Config, files: Vec<String>) -> Manifest {
-        let modules = modules(cfg)
+        let parents = stages::parents(cfg);
+        let modules = stages::modules(cfg)
             .into_iter()
             .map(|m| ModuleInfo {
                 name: m.name(),
                 file: m.file(),
-                parent: m.parent().map(Module::name),
-                latency: latency(cfg, m),
-                ports: ports::ports(cfg, m),
+                parent: parents
+                    .iter()
+                    .find(|(n, _)| *n == m.name())
+                    .and_then(|(_, p)| *p),
+                latency: m.latency(cfg),
+                ports: m.ports(cfg),
             })
             .collect();
         let memories = memories(cfg);
@@ -125,9 +65,9 @@ impl Manifest {
             rmapgen_version: env!("CARGO_PKG_VERSION"),
             config: cfg.clone(),
             config_summary: cfg.summary(),
-            top: Module::RmapTop.name(),
-            latency: super::top_latency(cfg),
-            sideband_delays: sideband_delays(cfg),
+            top: TOP.name(),
+            latency: rmap_top::top_latency(cfg),
+            sideband_delays: rmap_top::sideband_delays(cfg),
             modules,
             memory_bits: memories.iter().map(|m| m.bits).sum(),
             memories,

@@ -3,8 +3,10 @@
 //! a `README.md` with the port table and the timing notes (latency, flow control, reset,
 //! buffer swap and write rules), both from the same tables as the Verilog.
 
-use super::{latency, manifest, modules, pipeline, ports, top_latency, Dir, Module, Width};
+use super::{manifest, Dir, Width};
 use crate::config::Config;
+use crate::stages::rmap_top::{latency_list, top_latency};
+use crate::stages::{self, TOP};
 use anyhow::{Context, Result};
 use askama::Template;
 
@@ -51,7 +53,7 @@ pub fn core(cfg: &Config, hex: &[String]) -> Result<String> {
         summary: cfg.summary(),
         vlnv: vlnv(),
         latency: top_latency(cfg),
-        rtl_files: modules(cfg).iter().map(|m| m.file()).collect(),
+        rtl_files: stages::modules(cfg).iter().map(|m| m.file()).collect(),
         // The logical maps map_<axis>.hex are for people and tools, not the design.
         mem_files: mem
             .into_iter()
@@ -72,7 +74,8 @@ pub fn readme(cfg: &Config) -> Result<String> {
         .filter_map(|l| l.split_once(" = "))
         .map(|(k, v)| (k.to_string(), v.to_string()))
         .collect();
-    let ports = ports::ports(cfg, Module::RmapTop)
+    let ports = TOP
+        .ports(cfg)
         .into_iter()
         .map(|p| {
             (
@@ -89,11 +92,7 @@ pub fn readme(cfg: &Config) -> Result<String> {
             )
         })
         .collect();
-    let latency_list = pipeline(cfg)
-        .iter()
-        .map(|&m| format!("{} {}", m.name(), latency(cfg, m).unwrap_or(0)))
-        .collect::<Vec<_>>()
-        .join(", ");
+    let latency_list = latency_list(cfg);
     let memories = manifest::memories(cfg)
         .into_iter()
         .map(|m| {

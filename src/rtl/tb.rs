@@ -1,11 +1,12 @@
 //! Self-checking Verilog testbenches, one per stage module present in a configuration and one
-//! for `rmap_top`, rendered from `templates/tb/<module>_tb.v` (which extend
-//! `templates/tb/base_tb.v`) into `<out>/tb/<module>_tb.v`.
+//! for `rmap_top`, rendered from each stage's `src/stages/<module>/<module>_tb.v` (which
+//! extend `templates/tb/base_tb.v`) into `<out>/tb/<module>_tb.v`.
 //!
-//! Everything a testbench knows comes from one place: the vector fields from
-//! [`Stage::fields`], the ports from [`rtl::ports::ports`], the latency from
-//! [`rtl::latency`], the ROM and map files from [`rtl::manifest::memories`]. A field whose port
-//! is missing or has another width is an error here, not a silent mismatch in simulation.
+//! Everything a testbench knows comes from its stage's unit: the vector fields
+//! ([`Vectors::fields`]) and the ports they drive ([`Vectors::port`]), the ports
+//! ([`Unit::ports`]), the latency ([`Unit::latency`]), the ROM and map files
+//! ([`Unit::memories`]). A field whose port is missing or has another width is an error here,
+//! not a silent mismatch in simulation.
 //!
 //! Beside the testbenches this writes `tb/config.toml` (the configuration, for
 //! `rmapgen vectors --config`) and `tb/rmap_top_config.h` (the widths the Verilator C++
@@ -13,101 +14,15 @@
 
 use crate::config::Config;
 use crate::output::StagedDir;
-use crate::rtl::{self, manifest, Module, Width};
-use crate::vectors::{self, Dir, Stage};
+use crate::rtl::ports::{self, Width};
+use crate::stages::rmap_top::top_latency;
+use crate::stages::testbench::{FieldView, Sig, TbData};
+use crate::stages::{self, Unit, Vectors, TOP};
+use crate::vectors::Dir;
 use anyhow::{bail, Context, Result};
-use askama::Template;
-
-/// A signal of the testbench: a design port.
-pub struct Sig {
-    pub name: &'static str,
-    /// `[n-1:0]`, or empty for one bit.
-    /// `[n-1:0]`, or blanks for one bit, padded so the names line up.
-    pub range: String,
-    pub init: String,
-    /// The instance connection, `.name (name)`, names padded.
-    pub pin: String,
-}
-
-/// A vector field as the testbench stores and drives or checks it.
-pub struct FieldView {
-    pub name: &'static str,
-    pub bits: u32,
-    /// Always a range, `[0:0]` for one bit, so every ring is declared alike.
-    pub range: String,
-    /// The design port the field drives or is compared with; empty for `map` of the top,
-    /// which steers the testbench itself.
-    pub port: String,
-}
-
-/// Everything the testbench templates read.
-pub struct TbData {
-    pub header: String,
-    pub module: &'static str,
-    pub summary: String,
-    pub vector_file: String,
-    pub field_list: String,
-    pub latency: u32,
-    pub depth: u32,
-    pub depth_bits: u32,
-    pub full_speed: u32,
-    pub reset_at: u32,
-    pub timeout: u32,
-    pub seed: u32,
-    pub has_en: bool,
-    /// The top with valid/ready flow control: ready_i random, acceptance by ready_o.
-    pub handshake: bool,
-    /// `{zero_o, i_o, ...}`: every checked output, and its width (the hold check).
-    pub outs_concat: String,
-    pub outs_bits: u32,
-    pub inputs: Vec<Sig>,
-    pub outputs: Vec<Sig>,
-    pub ports: Vec<Sig>,
-    pub fields: Vec<FieldView>,
-    /// Input fields with a port.
-    pub in_fields: Vec<FieldView>,
-    pub out_fields: Vec<FieldView>,
-    pub scan_format: String,
-    pub scan_args: String,
-    pub in_format: String,
-    pub in_args: String,
-    pub out_format: String,
-    pub exp_args: String,
-    pub got_args: String,
-    /// Files the design reads with `$readmemh` (and the testbench itself, for `map2_*`).
-    pub hex_files: Vec<String>,
-    /// The second map, loaded through the host port (map_lookup and the top).
-    pub map2_files: Vec<String>,
-    pub map_entries: u32,
-    pub map_addr_bits: u32,
-    pub map_bits: u32,
-    pub nwrites: u32,
-}
-
-macro_rules! tb_template {
-    ($name:ident, $path:literal) => {
-        #[derive(Template)]
-        #[template(path = $path, syntax = "verilog")]
-        struct $name<'a> {
-            t: &'a TbData,
-        }
-    };
-}
-
-tb_template!(ZeroDetectTb, "tb/zero_detect_tb.v");
-tb_template!(SortShiftTb, "tb/sort_shift_tb.v");
-tb_template!(NormaliseTb, "tb/normalise_tb.v");
-tb_template!(AtanRomTb, "tb/atan_rom_tb.v");
-tb_template!(LinearIndexTb, "tb/linear_index_tb.v");
-tb_template!(MapLookupTb, "tb/map_lookup_tb.v");
-tb_template!(InterpolateTb, "tb/interpolate_tb.v");
-tb_template!(ColorMulTb, "tb/color_mul_tb.v");
-tb_template!(RmapTopTb, "tb/rmap_top_tb.v");
 
 /// Accepted vectors before the first bubble or stall: the pipeline runs full first.
 const FULL_SPEED: u32 = 64;
-/// Accepted vectors before the mid-stream reset (at most half the top's map-0 corners).
-const RESET_AT: u32 = 37;
 
 fn range(bits: u32) -> String {
     if bits == 1 {
@@ -117,23 +32,11 @@ fn range(bits: u32) -> String {
     }
 }
 
-/// The design port a vector field drives or is checked against.
-fn port_name(stage: Stage, name: &str, dir: Dir) -> Option<String> {
-    match (stage, name) {
-        (Stage::Top, "map") => None,
-        (Stage::MapLookup, "buf") => Some("rd_buf_i".into()),
-        (_, n) if n.ends_with("_o") => Some(n.into()),
-        (_, n) => Some(format!("{n}{}", if dir == Dir::In { "_i" } else { "_o" })),
-    }
-}
-
-/// The `$readmemh` files the design under `m` reads, from the manifest's memory list (the
-/// instances below `rmap_top` are named `u_<module>`).
-fn memory_files(cfg: &Config, m: Module) -> Vec<String> {
-    let prefix = format!("u_{}.", m.name());
-    let mut v: Vec<String> = manifest::memories(cfg)
+/// The `$readmemh` files the design under `m` reads.
+fn memory_files(cfg: &Config, m: &dyn Unit) -> Vec<String> {
+    let mut v: Vec<String> = m
+        .memories(cfg)
         .into_iter()
-        .filter(|mem| m == Module::RmapTop || mem.instance.starts_with(&prefix))
         .map(|mem| mem.init_file)
         .collect();
     v.dedup();
@@ -141,13 +44,12 @@ fn memory_files(cfg: &Config, m: Module) -> Vec<String> {
 }
 
 /// The testbench data of one stage.
-pub fn data(cfg: &Config, stage: Stage) -> Result<TbData> {
-    let module = Module::from_name(stage.name())
-        .with_context(|| format!("no RTL module named {}", stage.name()))?;
-    let latency = rtl::latency(cfg, module)
+pub fn data(cfg: &Config, stage: &dyn Vectors) -> Result<TbData> {
+    let latency = stage
+        .latency(cfg)
         .with_context(|| format!("{} has no fixed latency", stage.name()))?;
-    let ports = rtl::ports::ports(cfg, module);
-    let bits_of = |p: &rtl::Port| match p.width {
+    let ports = stage.ports(cfg);
+    let bits_of = |p: &ports::Port| match p.width {
         Width::Bits(b) => Ok(b),
         Width::Param(w) => bail!(
             "port {} of {} has a parameter width {w}",
@@ -172,8 +74,8 @@ pub fn data(cfg: &Config, stage: Stage) -> Result<TbData> {
             pin: format!(".{:nw$} ({})", p.name, p.name),
         };
         match p.dir {
-            rtl::Dir::Input => inputs.push(s()),
-            rtl::Dir::Output => outputs.push(s()),
+            ports::Dir::Input => inputs.push(s()),
+            ports::Dir::Output => outputs.push(s()),
         }
         sigs.push(s());
     }
@@ -193,7 +95,7 @@ pub fn data(cfg: &Config, stage: Stage) -> Result<TbData> {
 
     let mut fields = Vec::new();
     for f in stage.fields(cfg) {
-        let port = match port_name(stage, f.name, f.dir) {
+        let port = match stage.port(&f) {
             None => String::new(),
             Some(pn) => {
                 let p = ports.iter().find(|p| p.name == pn).with_context(|| {
@@ -204,9 +106,9 @@ pub fn data(cfg: &Config, stage: Stage) -> Result<TbData> {
                     )
                 })?;
                 let want = if f.dir == Dir::In {
-                    rtl::Dir::Input
+                    ports::Dir::Input
                 } else {
-                    rtl::Dir::Output
+                    ports::Dir::Output
                 };
                 if p.dir != want || bits_of(p)? != f.bits {
                     bail!(
@@ -260,7 +162,9 @@ pub fn data(cfg: &Config, stage: Stage) -> Result<TbData> {
         )
     };
 
-    let map2 = matches!(stage, Stage::MapLookup | Stage::Top);
+    // A design with writable memories (the map banks) gets the second map through its host
+    // port.
+    let map2 = stage.memories(cfg).iter().any(|m| m.writable);
     let map2_files: Vec<String> = if map2 {
         ["x", "y", "z"]
             .iter()
@@ -269,16 +173,12 @@ pub fn data(cfg: &Config, stage: Stage) -> Result<TbData> {
     } else {
         Vec::new()
     };
-    let mut hex_files = memory_files(cfg, module);
+    let mut hex_files = memory_files(cfg, stage);
     hex_files.extend(map2_files.iter().cloned());
 
     // The ring must hold every sample in flight plus the one being read.
     let depth = (latency + 4).next_power_of_two().max(16);
-    let reset_at = if stage == Stage::Top {
-        RESET_AT.min(vectors::inputs::top_corners(cfg, 0).len() as u32 / 2)
-    } else {
-        RESET_AT
-    };
+    let reset_at = stage.reset_at(cfg);
     Ok(TbData {
         header: format!(
             "// {}_tb.v: generated by rmapgen {}. Do not edit; regenerate with `rmapgen generate`.\n// Configuration: {}",
@@ -331,25 +231,16 @@ pub fn data(cfg: &Config, stage: Stage) -> Result<TbData> {
 }
 
 /// The Verilog text of one stage's testbench.
-pub fn render(cfg: &Config, stage: Stage) -> Result<String> {
+pub fn render(cfg: &Config, stage: &dyn Vectors) -> Result<String> {
     let t = &data(cfg, stage)?;
-    let text = match stage {
-        Stage::ZeroDetect => ZeroDetectTb { t }.render(),
-        Stage::SortShift => SortShiftTb { t }.render(),
-        Stage::Normalise => NormaliseTb { t }.render(),
-        Stage::AtanRom => AtanRomTb { t }.render(),
-        Stage::LinearIndex => LinearIndexTb { t }.render(),
-        Stage::MapLookup => MapLookupTb { t }.render(),
-        Stage::Interpolate => InterpolateTb { t }.render(),
-        Stage::ColorMul => ColorMulTb { t }.render(),
-        Stage::Top => RmapTopTb { t }.render(),
-    };
-    text.with_context(|| format!("cannot render templates/tb/{}_tb.v", stage.name()))
+    stage
+        .testbench(t)
+        .with_context(|| format!("cannot render src/stages/{0}/{0}_tb.v", stage.name()))
 }
 
 /// `tb/rmap_top_config.h`: the widths and flags the Verilator C++ harness compiles against.
 pub fn harness_header(cfg: &Config) -> String {
-    let fields = Stage::Top.fields(cfg);
+    let fields = TOP.vectors().expect("the top has vectors").fields(cfg);
     format!(
         "// rmap_top_config.h: generated by rmapgen {}. Do not edit.\n\
          // Configuration: {}\n\
@@ -369,7 +260,7 @@ pub fn harness_header(cfg: &Config) -> String {
         cfg.map_bits,
         cfg.map_addr_bits(),
         cfg.color as u32,
-        rtl::top_latency(cfg),
+        top_latency(cfg),
         fields.len(),
         cfg.handshake as u32,
     )
@@ -379,7 +270,7 @@ pub fn harness_header(cfg: &Config) -> String {
 /// `tb/config.toml` and `tb/rmap_top_config.h`.
 pub fn write_all(cfg: &Config, out: &StagedDir) -> Result<()> {
     cfg.validate()?;
-    for stage in vectors::stages(cfg) {
+    for stage in stages::checked(cfg) {
         out.write_text(&format!("tb/{}_tb.v", stage.name()), &render(cfg, stage)?)?;
     }
     let toml = toml::to_string(cfg).context("cannot serialise the configuration")?;
@@ -407,7 +298,7 @@ mod tests {
                 ..Config::default()
             },
         ] {
-            for stage in vectors::stages(&cfg) {
+            for stage in stages::checked(&cfg) {
                 let d = data(&cfg, stage).unwrap_or_else(|e| panic!("{}: {e:#}", stage.name()));
                 assert!(!d.out_fields.is_empty());
                 assert!(d.depth > d.latency + 2);
@@ -418,7 +309,14 @@ mod tests {
     #[test]
     fn files_the_design_reads_are_checked() {
         let cfg = Config::default();
-        let top = data(&cfg, Stage::Top).unwrap();
+        let of = |name: &str| {
+            let stage = stages::checked(&cfg)
+                .into_iter()
+                .find(|s| s.name() == name)
+                .unwrap();
+            data(&cfg, stage).unwrap()
+        };
+        let top = of("rmap_top");
         for f in [
             "recip_rom.hex",
             "atan_rom.hex",
@@ -432,10 +330,7 @@ mod tests {
                 top.hex_files
             );
         }
-        assert_eq!(
-            data(&cfg, Stage::Normalise).unwrap().hex_files,
-            vec!["recip_rom.hex"]
-        );
-        assert!(data(&cfg, Stage::SortShift).unwrap().hex_files.is_empty());
+        assert_eq!(of("normalise").hex_files, vec!["recip_rom.hex"]);
+        assert!(of("sort_shift").hex_files.is_empty());
     }
 }

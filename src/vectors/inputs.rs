@@ -1,12 +1,12 @@
 //! The inputs of every stage's vectors: hand-picked corner cases first (FloPoCo's standard
 //! test cases: never remove one, add new ones at the end), then seeded random draws from the
-//! stage's input domain. Expected outputs are added by the model in `super::eval`.
+//! stage's input domain. Expected outputs come from the model (`Vectors::expected`).
 //!
-//! Each input vector is a list of field values in the order of `Stage::fields`, inputs only.
+//! These are the generators the stages share (gradients, positions, colours); each stage's
+//! own corners and random draws are in its folder (`Vectors::corners`, `Vectors::random`).
 
-use super::Stage;
 use crate::config::{Config, COLOR_BITS};
-use crate::model::{Maps, Model};
+use crate::model::{Maps, Model, Trace};
 use crate::rng::SplitMix64;
 
 /// A gradient component as G-bit two's complement.
@@ -191,7 +191,8 @@ pub fn random_top_gradient(cfg: &Config, rng: &mut SplitMix64) -> [i32; 3] {
     }
 }
 
-fn grads(cfg: &Config, g: [i32; 3]) -> Vec<u64> {
+/// A gradient as its three vector fields.
+pub fn grads(cfg: &Config, g: [i32; 3]) -> Vec<u64> {
     g.iter().map(|&c| enc_grad(cfg, c)).collect()
 }
 
@@ -208,287 +209,20 @@ pub fn position_corners(cfg: &Config) -> Vec<u32> {
     p
 }
 
-/// The hand-picked inputs of a stage. `model` and `maps` supply the trace-derived cases (the
-/// intermediate values of the gradient corners as they reach this stage).
-pub fn corners(stage: Stage, model: &Model, maps: &Maps) -> Vec<Vec<u64>> {
-    let cfg = &model.cfg;
-    let traces = || {
-        gradient_corners(cfg)
-            .into_iter()
-            .map(move |g| model.trace(maps, g, [0; 3]))
-    };
-    let mut out: Vec<Vec<u64>> = Vec::new();
-    match stage {
-        Stage::ZeroDetect => {
-            let h = 1i32 << (cfg.grad_bits - 1);
-            out.push(grads(cfg, [0, 0, 0]));
-            for p in 0..3 {
-                for c in [1, -1, -h, h - 1] {
-                    let mut g = [0; 3];
-                    g[p] = c;
-                    out.push(grads(cfg, g));
-                }
-            }
-            for g in gradient_corners(cfg) {
-                out.push(grads(cfg, g));
-            }
-        }
-        Stage::SortShift => {
-            for g in gradient_corners(cfg) {
-                out.push(grads(cfg, g));
-            }
-        }
-        Stage::Normalise => {
-            let r = cfg.red_bits;
-            let (lo, hi) = (1u64 << (r - 1), (1u64 << r) - 1);
-            // The zero vector reaches normalise as m = a = b = 0.
-            out.push(vec![0, 0, 0]);
-            // Both ends of the reciprocal ROM, with a and b at 0, 1, half, max - 1 and max.
-            for m in [lo, lo + 1, hi - 1, hi] {
-                let cs = [0, 1, m / 2, m - 1, m];
-                for (i, &a) in cs.iter().enumerate() {
-                    for &b in &cs[i..] {
-                        out.push(vec![m, a, b]);
-                        if a != b {
-                            out.push(vec![m, b, a]);
-                        }
-                    }
-                }
-            }
-            // Every reciprocal-ROM entry once, with a = m - 1 (rounds nearest to 1.0).
-            for m in lo..=hi {
-                out.push(vec![m, m - 1, m * 3 / 4]);
-            }
-            for t in traces() {
-                out.push(vec![t.sort.m as u64, t.sort.a as u64, t.sort.b as u64]);
-            }
-        }
-        Stage::AtanRom | Stage::LinearIndex => {
-            // Exhaustive: every fraction code in both lanes, which covers 0, all ones and
-            // every point where the position steps.
-            let fmax = cfg.frac_max() as u64;
-            for u in 0..=fmax {
-                out.push(vec![u, fmax - u]);
-            }
-        }
-        Stage::MapLookup => {
-            let p = position_corners(cfg);
-            let pmax = cfg.pos_max() as u64;
-            let n = p.len();
-            // Every position corner in each lane, axes, signs and buffers cycling.
-            for (j, &pc) in p.iter().enumerate() {
-                let other = p[(j * 7 + 3) % n] as u64;
-                let k = j as u64;
-                out.push(vec![
-                    k % 3,
-                    k & 1,
-                    (k >> 1) & 1,
-                    (k >> 2) & 1,
-                    pc as u64,
-                    other,
-                    (k >> 3) & 1,
-                ]);
-                out.push(vec![
-                    (k + 1) % 3,
-                    (k >> 2) & 1,
-                    k & 1,
-                    (k >> 1) & 1,
-                    other,
-                    pc as u64,
-                    !(k >> 3) & 1,
-                ]);
-            }
-            // Every axis, sign combination and buffer at the two extreme corners.
-            for buf in 0..2 {
-                for axis in 0..3 {
-                    for signs in 0..8u64 {
-                        for (pu, pv) in [(0, 0), (pmax, pmax), (0, pmax)] {
-                            out.push(vec![
-                                axis,
-                                signs & 1,
-                                (signs >> 1) & 1,
-                                signs >> 2,
-                                pu,
-                                pv,
-                                buf,
-                            ]);
-                        }
-                    }
-                }
-            }
-            for (i, t) in traces().enumerate() {
-                let s = t.sort;
-                out.push(vec![
-                    s.axis as u64,
-                    s.s_max as u64,
-                    s.s_u as u64,
-                    s.s_v as u64,
-                    t.p_u as u64,
-                    t.p_v as u64,
-                    (i & 1) as u64,
-                ]);
-            }
-        }
-        Stage::Interpolate => {
-            let s = cfg.step() as u64;
-            let mx = cfg.map_max() as u64;
-            let mut ws = vec![0, 1, s / 2, s - 1, s];
-            ws.sort_unstable();
-            ws.dedup();
-            let patterns: [[u64; 4]; 10] = [
-                [0, 0, 0, 0],
-                [mx, mx, mx, mx],
-                [0, mx, 0, mx],
-                [mx, 0, mx, 0],
-                [0, 0, mx, mx],
-                [mx, mx, 0, 0],
-                [0, mx, mx, 0],
-                [mx, 0, 0, mx],
-                [1, 2, 3, 4],
-                [mx / 2, mx / 2 + 1, mx / 2 - 1, mx / 3],
-            ];
-            for e in patterns {
-                for &wu in &ws {
-                    for &wv in &ws {
-                        out.push(vec![e[0], e[1], e[2], e[3], wu, wv]);
-                    }
-                }
-            }
-            for t in traces() {
-                let l = t.lookup;
-                out.push(vec![
-                    l.e[0] as u64,
-                    l.e[1] as u64,
-                    l.e[2] as u64,
-                    l.e[3] as u64,
-                    l.w_u as u64,
-                    l.w_v as u64,
-                ]);
-            }
-        }
-        Stage::ColorMul => {
-            let mx = cfg.map_max() as u64;
-            for i in [0, 1, mx / 2, mx - 1, mx] {
-                for c in COLOR_CORNERS {
-                    out.push(vec![i, c[0] as u64, c[1] as u64, c[2] as u64]);
-                }
-            }
-            // Every intensity once, with a full, a middle and a minimal channel.
-            for i in 0..=mx {
-                out.push(vec![i, 255, 128, 1]);
-            }
-        }
-        Stage::Top => unreachable!("top corners depend on the map part; see top_corners"),
-    }
-    out
-}
-
-/// The top's hand-picked inputs for one map: every gradient corner, colours cycling.
-pub fn top_corners(cfg: &Config, map: u64) -> Vec<Vec<u64>> {
-    gradient_corners(cfg)
+/// The gradient corners traced through the model with `maps`: the values they bring to each
+/// stage, which the stages' corner cases include.
+pub fn corner_traces<'a>(model: &'a Model, maps: &'a Maps) -> impl Iterator<Item = Trace> + 'a {
+    gradient_corners(&model.cfg)
         .into_iter()
-        .enumerate()
-        .map(|(i, g)| {
-            let mut v = vec![map];
-            v.extend(grads(cfg, g));
-            if cfg.color {
-                v.extend(
-                    COLOR_CORNERS[i % COLOR_CORNERS.len()]
-                        .iter()
-                        .map(|&c| c as u64),
-                );
-            }
-            v
-        })
-        .collect()
-}
-
-/// One random input of the top for one map.
-pub fn top_random(cfg: &Config, rng: &mut SplitMix64, map: u64) -> Vec<u64> {
-    let mut v = vec![map];
-    v.extend(grads(cfg, random_top_gradient(cfg, rng)));
-    if cfg.color {
-        for _ in 0..3 {
-            v.push(rng.bits(COLOR_BITS));
-        }
-    }
-    v
+        .map(move |g| model.trace(maps, g, [0; 3]))
 }
 
 /// A channel value that hits 0 and 255 more often than uniform draws would.
-fn color_channel(rng: &mut SplitMix64) -> u64 {
+pub fn color_channel(rng: &mut SplitMix64) -> u64 {
     match rng.below(16) {
         0 => 0,
         1 => 255,
         _ => rng.bits(COLOR_BITS),
-    }
-}
-
-/// One random input of a (non-top) stage, drawn from the values the stage can receive.
-pub fn random(stage: Stage, cfg: &Config, rng: &mut SplitMix64) -> Vec<u64> {
-    match stage {
-        Stage::ZeroDetect => (0..3)
-            .map(|_| {
-                if rng.chance(1, 2) {
-                    0
-                } else {
-                    rng.bits(cfg.grad_bits)
-                }
-            })
-            .collect(),
-        Stage::SortShift => grads(cfg, gradient_by_shift(cfg, rng, cfg.grad_bits)),
-        Stage::Normalise => {
-            let r = cfg.red_bits;
-            if rng.chance(1, 64) {
-                return vec![0, 0, 0];
-            }
-            let m = rng.range(1 << (r - 1), (1 << r) - 1);
-            let lane = |rng: &mut SplitMix64| match rng.below(16) {
-                0 | 1 => m,
-                2 => 0,
-                _ => rng.range(0, m),
-            };
-            let a = lane(rng);
-            let b = lane(rng);
-            vec![m, a, b]
-        }
-        Stage::AtanRom | Stage::LinearIndex => {
-            vec![rng.bits(cfg.frac_bits), rng.bits(cfg.frac_bits)]
-        }
-        Stage::MapLookup => {
-            let pmax = cfg.pos_max() as u64;
-            vec![
-                rng.below(3),
-                rng.bits(1),
-                rng.bits(1),
-                rng.bits(1),
-                rng.range(0, pmax),
-                rng.range(0, pmax),
-                rng.bits(1),
-            ]
-        }
-        Stage::Interpolate => {
-            let s = cfg.step() as u64;
-            let mut v: Vec<u64> = (0..4).map(|_| rng.bits(cfg.map_bits)).collect();
-            v.push(rng.range(0, s));
-            v.push(rng.range(0, s));
-            v
-        }
-        Stage::ColorMul => {
-            let mx = cfg.map_max() as u64;
-            let i = match rng.below(16) {
-                0 => 0,
-                1 => mx,
-                _ => rng.range(0, mx),
-            };
-            vec![
-                i,
-                color_channel(rng),
-                color_channel(rng),
-                color_channel(rng),
-            ]
-        }
-        Stage::Top => unreachable!("top inputs carry a map part; see top_random"),
     }
 }
 

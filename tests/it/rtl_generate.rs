@@ -10,7 +10,7 @@
 use crate::hdl::{generate, require};
 use crate::helpers;
 use rmapgen::config::Config;
-use rmapgen::rtl::{self, Module};
+use rmapgen::stages::{self, map_bank::banks, rmap_top};
 use std::path::Path;
 use std::process::Command;
 
@@ -283,14 +283,14 @@ fn manifest_agrees_with_the_files_and_the_latency_function() {
         let m = manifest(&dir);
         let cfg = config_of(&m);
         assert_eq!(m["rmapgen_version"], env!("CARGO_PKG_VERSION"));
-        assert_eq!(m["latency"], rtl::top_latency(&cfg), "{name}");
+        assert_eq!(m["latency"], rmap_top::top_latency(&cfg), "{name}");
         let listed: Vec<&str> = m["modules"]
             .as_array()
             .unwrap()
             .iter()
             .map(|x| x["name"].as_str().unwrap())
             .collect();
-        let expected: Vec<&str> = rtl::modules(&cfg).iter().map(|m| m.name()).collect();
+        let expected: Vec<&str> = stages::modules(&cfg).iter().map(|m| m.name()).collect();
         assert_eq!(listed, expected, "{name}");
         assert_eq!(listed[0], "rmap_top");
         // Exactly the listed modules have files.
@@ -299,7 +299,11 @@ fn manifest_agrees_with_the_files_and_the_latency_function() {
         assert_eq!(design_files(&dir), files, "{name}");
         for module in m["modules"].as_array().unwrap() {
             let mname = module["name"].as_str().unwrap();
-            let lat = rtl::latency(&cfg, Module::from_name(mname).unwrap());
+            let lat = stages::modules(&cfg)
+                .into_iter()
+                .find(|m| m.name() == mname)
+                .unwrap()
+                .latency(&cfg);
             assert_eq!(module["latency"], serde_json::json!(lat), "{name} {mname}");
             let text = std::fs::read_to_string(dir.join(format!("{mname}.v"))).unwrap();
             assert!(text.starts_with(&format!(
@@ -370,13 +374,13 @@ fn bank_files_hold_the_scene_map_in_both_buffers() {
             .collect()
     };
     let banks: Vec<Vec<u32>> = (0..4)
-        .map(|k| entries(&rtl::banks::bank_file(&cfg, k)))
+        .map(|k| entries(&banks::bank_file(&cfg, k)))
         .collect();
     for (axis, name) in ["x", "y", "z"].iter().enumerate() {
         let map = entries(&format!("map_{name}.hex"));
         for buf in 0..2 {
             for (addr, &e) in map.iter().enumerate() {
-                let s = rtl::banks::bank_slot(&cfg, buf, axis as u32, addr as u32);
+                let s = banks::bank_slot(&cfg, buf, axis as u32, addr as u32);
                 assert_eq!(
                     banks[s.bank][s.addr as usize], e,
                     "axis {name} buf {buf} addr {addr}"

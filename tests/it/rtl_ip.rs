@@ -11,7 +11,8 @@
 use crate::hdl::{self, config_of, icarus, last_line, require, sabotage, vvp};
 use crate::helpers;
 use rmapgen::config::Config;
-use rmapgen::rtl::{self, fpga, Module};
+use rmapgen::rtl::{self, fpga};
+use rmapgen::stages::{self, rmap_top, TOP};
 use std::path::Path;
 
 /// Generates a design into `dir` with `flags` and 300 random vectors per stage.
@@ -41,11 +42,11 @@ fn every_depth_passes_every_testbench_under_icarus() {
         assert!(
             tb.contains(&format!(
                 "localparam LATENCY    = {};",
-                rtl::top_latency(&cfg)
+                rmap_top::top_latency(&cfg)
             )),
             "{flags:?}"
         );
-        latencies.push(rtl::top_latency(&cfg));
+        latencies.push(rmap_top::top_latency(&cfg));
         let mut n = 0;
         for e in std::fs::read_dir(dir.join("tb")).unwrap() {
             let name = e.unwrap().file_name().to_string_lossy().into_owned();
@@ -125,7 +126,7 @@ fn core_and_readme_describe_the_directory() {
         )));
         assert!(core.contains("toplevel: rmap_top\n") && core.contains("toplevel: rmap_top_tb"));
         // Every module file and every memory's init file, each of which exists.
-        for m in rtl::modules(&cfg) {
+        for m in stages::modules(&cfg) {
             assert!(
                 core.contains(&format!("      - {}\n", m.file())),
                 "{}",
@@ -148,10 +149,13 @@ fn core_and_readme_describe_the_directory() {
             );
         }
         let readme = std::fs::read_to_string(dir.join("README.md")).unwrap();
-        for p in rtl::ports::ports(&cfg, Module::RmapTop) {
+        for p in TOP.ports(&cfg) {
             assert!(readme.contains(&format!("| `{}` |", p.name)), "{}", p.name);
         }
-        assert!(readme.contains(&format!("**Latency**: {} clocks", rtl::top_latency(&cfg))));
+        assert!(readme.contains(&format!(
+            "**Latency**: {} clocks",
+            rmap_top::top_latency(&cfg)
+        )));
         assert!(readme.contains("## Reset") && readme.contains("swap_i"));
         assert_eq!(readme.contains("`ready_i`"), cfg.handshake, "{flags:?}");
         // Both are in the manifest's file list.

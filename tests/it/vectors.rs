@@ -5,7 +5,8 @@ use crate::helpers;
 use rmapgen::config::Config;
 use rmapgen::model::{color_mul, interpolate, map_lookup, normalise, sort_shift, Model};
 use rmapgen::output::StagedDir;
-use rmapgen::vectors::{self, inputs, MapSet, Stage};
+use rmapgen::stages::{self, rmap_top, Vectors};
+use rmapgen::vectors::{self, inputs, MapSet};
 use std::collections::{BTreeSet, HashMap};
 use std::path::Path;
 
@@ -49,6 +50,21 @@ fn configs() -> Vec<Config> {
     ]
 }
 
+/// The checked stage named `name` (every one is present in the default configuration or in
+/// the one without compensation).
+fn by(name: &str) -> &'static dyn Vectors {
+    let off = Config {
+        compensation: false,
+        color: true,
+        ..Config::default()
+    };
+    stages::checked(&Config::default())
+        .into_iter()
+        .chain(stages::checked(&off))
+        .find(|s| s.name() == name)
+        .unwrap_or_else(|| panic!("no stage {name}"))
+}
+
 /// Writes the vectors of `cfg` into a fresh directory and returns (dir guard, path).
 fn write(cfg: &Config, random: usize, seed: u64) -> (tempfile::TempDir, std::path::PathBuf) {
     let tmp = helpers::tempdir();
@@ -59,12 +75,12 @@ fn write(cfg: &Config, random: usize, seed: u64) -> (tempfile::TempDir, std::pat
     (tmp, target)
 }
 
-fn read(dir: &Path, stage: Stage) -> String {
+fn read(dir: &Path, stage: &dyn Vectors) -> String {
     std::fs::read_to_string(dir.join(stage.vector_file())).unwrap()
 }
 
 /// One line as field name -> value.
-fn fields(cfg: &Config, stage: Stage, line: &str) -> HashMap<&'static str, u64> {
+fn fields(cfg: &Config, stage: &dyn Vectors, line: &str) -> HashMap<&'static str, u64> {
     let f = stage.fields(cfg);
     let vals =
         vectors::parse_line(&f, line).unwrap_or_else(|e| panic!("{}: {line:?}: {e}", stage.name()));
@@ -76,17 +92,17 @@ fn recompute(
     cfg: &Config,
     model: &Model,
     maps: &MapSet,
-    stage: Stage,
+    stage: &dyn Vectors,
     v: &HashMap<&str, u64>,
 ) -> Vec<(&'static str, u64)> {
     let g = |n: &str| inputs::dec_grad(cfg, v[n]);
     let u = |n: &str| v[n] as u32;
-    match stage {
-        Stage::ZeroDetect => {
+    match stage.name() {
+        "zero_detect" => {
             let t = model.trace(&maps.scene, [g("gx"), g("gy"), g("gz")], [0; 3]);
             vec![("zero", t.zero as u64)]
         }
-        Stage::SortShift => {
+        "sort_shift" => {
             let s = model
                 .trace(&maps.scene, [g("gx"), g("gy"), g("gz")], [0; 3])
                 .sort;
@@ -100,17 +116,17 @@ fn recompute(
                 ("b", s.b as u64),
             ]
         }
-        Stage::Normalise => {
+        "normalise" => {
             let n = normalise::eval(cfg, &model.recip, u("m"), u("a"), u("b"));
             vec![("u", n.u as u64), ("v", n.v as u64)]
         }
-        Stage::AtanRom | Stage::LinearIndex => {
+        "atan_rom" | "linear_index" => {
             vec![
                 ("pu", model.position(u("u")) as u64),
                 ("pv", model.position(u("v")) as u64),
             ]
         }
-        Stage::MapLookup => {
+        "map_lookup" => {
             let m = if v["buf"] == 0 {
                 &maps.scene
             } else {
@@ -137,7 +153,7 @@ fn recompute(
             }
             e
         }
-        Stage::Interpolate => {
+        "interpolate" => {
             let i = interpolate::eval(
                 cfg,
                 [u("e00"), u("e10"), u("e01"), u("e11")],
@@ -146,7 +162,7 @@ fn recompute(
             );
             vec![("i", i as u64)]
         }
-        Stage::ColorMul => {
+        "color_mul" => {
             let c = color_mul::eval(cfg, [u("r"), u("g"), u("b")], u("i"));
             vec![
                 ("r_o", c[0] as u64),
@@ -154,7 +170,7 @@ fn recompute(
                 ("b_o", c[2] as u64),
             ]
         }
-        Stage::Top => {
+        "rmap_top" => {
             let m = if v["map"] == 0 {
                 &maps.scene
             } else {
@@ -176,6 +192,7 @@ fn recompute(
             }
             e
         }
+        other => panic!("no recomputation for {other}"),
     }
 }
 
@@ -185,7 +202,7 @@ fn every_expected_value_is_the_models() {
         let model = Model::new(&cfg);
         let maps = MapSet::standard(&cfg);
         let (_tmp, dir) = write(&cfg, 300, 7);
-        for stage in vectors::stages(&cfg) {
+        for stage in stages::checked(&cfg) {
             let text = read(&dir, stage);
             assert!(text.ends_with('\n'));
             for (n, line) in text.lines().enumerate() {
@@ -214,7 +231,7 @@ fn byte_reproducible_for_a_seed() {
     let (_a, da) = write(&cfg, 500, 42);
     let (_b, db) = write(&cfg, 500, 42);
     let (_c, dc) = write(&cfg, 500, 43);
-    for stage in vectors::stages(&cfg) {
+    for stage in stages::checked(&cfg) {
         let (a, b, c) = (read(&da, stage), read(&db, stage), read(&dc, stage));
         assert_eq!(a, b, "{}", stage.name());
         assert_ne!(
@@ -227,8 +244,11 @@ fn byte_reproducible_for_a_seed() {
     // The stream for the C++ harness is the same file for the same count and seed.
     let p = da.join("stream.hex");
     let n = vectors::write_top_stream(&cfg, &MapSet::standard(&cfg), &p, 500, 42).unwrap();
-    assert_eq!(std::fs::read_to_string(&p).unwrap(), read(&da, Stage::Top));
-    assert_eq!(n, read(&da, Stage::Top).lines().count());
+    assert_eq!(
+        std::fs::read_to_string(&p).unwrap(),
+        read(&da, by("rmap_top"))
+    );
+    assert_eq!(n, read(&da, by("rmap_top")).lines().count());
 }
 
 #[test]
@@ -238,11 +258,11 @@ fn corner_cases_come_first() {
     let maps = MapSet::standard(&cfg);
     let (_a, da) = write(&cfg, 200, 1);
     let (_b, db) = write(&cfg, 200, 2);
-    for stage in vectors::stages(&cfg) {
-        let ncorners = if stage == Stage::Top {
-            inputs::top_corners(&cfg, 0).len()
+    for stage in stages::checked(&cfg) {
+        let ncorners = if stage.name() == "rmap_top" {
+            rmap_top::corners_for_map(&cfg, 0).len()
         } else {
-            inputs::corners(stage, &model, &maps.scene).len()
+            stage.corners(&model, &maps).len()
         };
         let (a, b) = (read(&da, stage), read(&db, stage));
         let (la, lb): (Vec<&str>, Vec<&str>) = (a.lines().collect(), b.lines().collect());
@@ -259,7 +279,7 @@ fn corner_cases_come_first() {
             stage.name()
         );
         // The top has each corner once per map and the swap witness once more.
-        let want = if stage == Stage::Top {
+        let want = if stage.name() == "rmap_top" {
             2 * ncorners + 1 + 200
         } else {
             ncorners + 200
@@ -267,17 +287,17 @@ fn corner_cases_come_first() {
         assert_eq!(la.len(), want, "{}", stage.name());
     }
     // The first corner of the gradient stages is the zero vector.
-    for stage in [Stage::ZeroDetect, Stage::SortShift] {
+    for stage in [by("zero_detect"), by("sort_shift")] {
         assert!(
             read(&da, stage).starts_with("000 000 000 "),
             "{}",
             stage.name()
         );
     }
-    assert!(read(&da, Stage::Top).starts_with("0 000 000 000 1 00\n"));
-    assert!(read(&da, Stage::Normalise).starts_with("00 00 00 ff ff\n"));
+    assert!(read(&da, by("rmap_top")).starts_with("0 000 000 000 1 00\n"));
+    assert!(read(&da, by("normalise")).starts_with("00 00 00 ff ff\n"));
     // The position stage is exhaustive first: u = 0..=255 in order.
-    let atan = read(&da, Stage::AtanRom);
+    let atan = read(&da, by("atan_rom"));
     for (u, line) in atan.lines().take(256).enumerate() {
         assert!(
             line.starts_with(&format!("{u:02x} {:02x} ", 255 - u)),
@@ -336,11 +356,11 @@ fn random_sort_shift_vectors_cover_every_shift() {
     };
     let model = Model::new(&cfg);
     let maps = MapSet::standard(&cfg);
-    let ncorners = inputs::corners(Stage::SortShift, &model, &maps.scene).len();
-    let text = vectors::stage_text(Stage::SortShift, &model, &maps, 2000, 5);
+    let ncorners = by("sort_shift").corners(&model, &maps).len();
+    let text = vectors::stage_text(by("sort_shift"), &model, &maps, 2000, 5);
     let mut count = vec![0u32; 17];
     for line in text.lines().skip(ncorners) {
-        let v = fields(&cfg, Stage::SortShift, line);
+        let v = fields(&cfg, by("sort_shift"), line);
         let g = [v["gx"], v["gy"], v["gz"]].map(|x| inputs::dec_grad(&cfg, x));
         if g != [0; 3] {
             count[sort_shift::eval(&cfg, g).shift as usize] += 1;
@@ -353,21 +373,21 @@ fn random_sort_shift_vectors_cover_every_shift() {
 fn top_vectors_are_map_0_then_map_1() {
     let cfg = Config::default();
     let (_t, dir) = write(&cfg, 1001, 3);
-    let maps: Vec<u64> = read(&dir, Stage::Top)
+    let maps: Vec<u64> = read(&dir, by("rmap_top"))
         .lines()
-        .map(|l| fields(&cfg, Stage::Top, l)["map"])
+        .map(|l| fields(&cfg, by("rmap_top"), l)["map"])
         .collect();
     let first1 = maps.iter().position(|&m| m == 1).expect("a map-1 part");
     assert!(maps[..first1].iter().all(|&m| m == 0) && maps[first1..].iter().all(|&m| m == 1));
-    let nc = inputs::top_corners(&cfg, 0).len();
+    let nc = rmap_top::corners_for_map(&cfg, 0).len();
     assert_eq!((first1, maps.len() - first1), (nc + 501 + 1, nc + 500));
     // The vectors on both sides of the swap are the same gradient with different results, so
     // a swap one sample early or late cannot pass.
-    let text = read(&dir, Stage::Top);
+    let text = read(&dir, by("rmap_top"));
     let lines: Vec<&str> = text.lines().collect();
     let (a, b) = (
-        fields(&cfg, Stage::Top, lines[first1 - 1]),
-        fields(&cfg, Stage::Top, lines[first1]),
+        fields(&cfg, by("rmap_top"), lines[first1 - 1]),
+        fields(&cfg, by("rmap_top"), lines[first1]),
     );
     for g in ["gx", "gy", "gz"] {
         assert_eq!(a[g], b[g]);
@@ -399,12 +419,12 @@ fn maps_read_back_from_a_generated_directory() {
     );
     // The generated top vectors use that scene's map.
     let model = Model::new(&cfg);
-    for line in std::fs::read_to_string(out.join(Stage::Top.vector_file()))
+    for line in std::fs::read_to_string(out.join(by("rmap_top").vector_file()))
         .unwrap()
         .lines()
     {
-        let v = fields(&cfg, Stage::Top, line);
-        for (name, want) in recompute(&cfg, &model, &m, Stage::Top, &v) {
+        let v = fields(&cfg, by("rmap_top"), line);
+        for (name, want) in recompute(&cfg, &model, &m, by("rmap_top"), &v) {
             assert_eq!(v[name], want, "{name} in {line}");
         }
     }
@@ -433,7 +453,7 @@ fn cli_writes_a_top_stream() {
     assert_eq!(
         text,
         vectors::stage_text(
-            Stage::Top,
+            by("rmap_top"),
             &Model::new(&cfg),
             &MapSet::standard(&cfg),
             100,

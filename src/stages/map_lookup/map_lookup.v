@@ -89,7 +89,7 @@ module map_lookup (
 {% for b in banks %}
   map_bank #(
     .INIT_FILE ("{= b.file =}")
-  ) u_bank_{= b.name =} (
+  ) {= b.inst =} (
     .clk_i     (clk_i),
     .en_i      (en_i),
     .rd_addr_i (addr{= b.name =}_q1),
@@ -189,7 +189,7 @@ module map_lookup (
 {% for b in banks %}
   map_bank #(
     .INIT_FILE ("{= b.file =}")
-  ) u_bank (
+  ) {= b.inst =} (
     .clk_i     (clk_i),
     .en_i      (en_i),
     .rd_addr_i (addr_q1),

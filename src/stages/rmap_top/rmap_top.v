@@ -2,7 +2,7 @@
 `default_nettype none
 
 // Reflectance-map shader: gradient in, intensity out, one sample per clock.
-// zero_detect runs beside sort_shift -> normalise -> {% if compensation %}atan_rom{% else %}linear_index{% endif %} -> map_lookup{% if interpolation %} -> interpolate{% endif %}{% if color %} -> color_mul{% endif %};
+// zero_detect runs beside sort_shift -> normalise -> {= position =} -> map_lookup{% if interpolation %} -> interpolate{% endif %}{% if color %} -> color_mul{% endif %};
 // pipe_delay lines carry the sideband (signs, axis, buffer{% if color %}, colour{% endif %}, zero flag) beside the
 // stages, and one output register applies the zero flag.
 // Stage latencies: {= latency_list =}, output register 1: total {= total =}.
@@ -121,11 +121,11 @@ module rmap_top (
     .v_o     (nm_v)
   );
 
-  // ---------------------------------------------------------------- {% if compensation %}atan_rom{% else %}linear_index{% endif %}
+  // ---------------------------------------------------------------- {= position =}
   wire           ps_valid;
   wire [POS-1:0] ps_u, ps_v;
 
-  {% if compensation %}atan_rom u_atan_rom{% else %}linear_index u_linear_index{% endif %} (
+  {= position =} u_{= position =} (
     .clk_i   (clk_i),
     .rst_ni  (rst_ni),
     .en_i    (en),

@@ -1,14 +1,14 @@
 //! Table look-up: split each position into a base entry and an interpolation weight, and
 //! read the base entry and its three higher neighbours from the map of the max axis.
 //!
-//! Map address: [`super::map_addr`].
+//! Map address: [`crate::model::map_addr`].
 //! With interpolation the base index is min(position >> interp_bits, entries - 2), so the
 //! outer entry is never a base, and the weight is position - base * step, in 0..=step.
 //! Without interpolation the position is the entry index and one entry is read.
 
-use super::map_addr::addr;
-use super::reflectance_map::Maps;
 use crate::config::Config;
+use crate::model::map_addr::addr;
+use crate::model::reflectance_map::Maps;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Hash)]
 pub struct Lookup {

@@ -46,6 +46,16 @@ pub fn bank_file(cfg: &Config, k: usize) -> String {
     }
 }
 
+/// The instance name of bank `k` in map_lookup.v.
+pub fn bank_instance(cfg: &Config, k: usize) -> String {
+    let name = &bank_names(cfg)[k];
+    if name.is_empty() {
+        "u_bank".to_string()
+    } else {
+        format!("u_bank_{name}")
+    }
+}
+
 /// The bank and bank address of logical entry `addr` of the map of `axis` in buffer `buf`.
 pub fn bank_slot(cfg: &Config, buf: u32, axis: u32, addr: u32) -> BankSlot {
     let a = MapAddr::decode(cfg, addr);

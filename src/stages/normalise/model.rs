@@ -3,8 +3,8 @@
 //! max saturates to all ones (which the index stages read as exactly 1) instead of needing
 //! an extra bit; any product that would round up to 1.0 saturates the same way.
 
-use super::recip_rom;
 use crate::config::Config;
+use crate::stages::recip_rom::model as recip_rom;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Hash)]
 pub struct Normalise {

@@ -1,0 +1,102 @@
+//! The two map buffers a design holds: buffer 0 is the scene's map (the design's initial
+//! contents of both buffers), buffer 1 the second map that testbenches load through the host
+//! port. The vectors, the testbenches and the bank init files all read this one value.
+
+use crate::config::Config;
+use crate::model::Maps;
+use crate::scene::Scene;
+use anyhow::{bail, Context, Result};
+use std::path::Path;
+
+/// The two map buffers the vectors assume: buffer 0 holds the scene's map (the design's
+/// initial contents), buffer 1 the second map the testbenches load through the host port.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct MapSet {
+    pub scene: Maps,
+    pub second: Maps,
+}
+
+impl MapSet {
+    /// The standard scene's map and the alternate scene's.
+    pub fn standard(cfg: &Config) -> MapSet {
+        MapSet::from_scenes(cfg, &Scene::standard(), &Scene::alternate())
+    }
+
+    pub fn from_scenes(cfg: &Config, scene: &Scene, second: &Scene) -> MapSet {
+        MapSet {
+            scene: scene.maps(cfg),
+            second: second.maps(cfg),
+        }
+    }
+
+    /// Reads `map_{x,y,z}.hex` and `map2_{x,y,z}.hex` from a generated design directory, so
+    /// the vectors match whatever scene the design was generated with.
+    pub fn from_dir(cfg: &Config, dir: &Path) -> Result<MapSet> {
+        Ok(MapSet {
+            scene: read_maps(cfg, dir, "map")?,
+            second: read_maps(cfg, dir, "map2")?,
+        })
+    }
+
+    /// Buffer 0 or 1.
+    pub fn buffer(&self, buf: u64) -> &Maps {
+        if buf == 0 {
+            &self.scene
+        } else {
+            &self.second
+        }
+    }
+}
+
+/// Largest map file `vectors --maps` reads (16 MiB): the widest configuration's map has
+/// 32 768 entries of a few bytes each; a file far beyond that is not a map.
+pub const MAX_MAP_FILE_BYTES: u64 = 16 << 20;
+
+/// Reads the three `$readmemh` files `<prefix>_{x,y,z}.hex` (logical address order).
+pub fn read_maps(cfg: &Config, dir: &Path, prefix: &str) -> Result<Maps> {
+    let mut data = Vec::with_capacity(3 * cfg.map_entries() as usize);
+    for axis in ["x", "y", "z"] {
+        let p = dir.join(format!("{prefix}_{axis}.hex"));
+        if p.is_dir() {
+            bail!("map {} is a directory, not a map file", p.display());
+        }
+        if let Ok(m) = std::fs::metadata(&p) {
+            if m.len() > MAX_MAP_FILE_BYTES {
+                bail!(
+                    "map {} is {} bytes, more than the limit of {MAX_MAP_FILE_BYTES} for a map file",
+                    p.display(),
+                    m.len()
+                );
+            }
+        }
+        let text = std::fs::read_to_string(&p)
+            .with_context(|| format!("cannot read map {}", p.display()))?;
+        let before = data.len();
+        for (n, line) in text.lines().enumerate() {
+            let t = line.split("//").next().unwrap_or("").trim();
+            if t.is_empty() {
+                continue;
+            }
+            let v = u32::from_str_radix(t, 16)
+                .with_context(|| format!("{}:{}: not a hex entry: {t:?}", p.display(), n + 1))?;
+            if v > cfg.map_max() {
+                bail!(
+                    "{}:{}: entry {v:#x} is wider than map_bits = {}",
+                    p.display(),
+                    n + 1,
+                    cfg.map_bits
+                );
+            }
+            data.push(v);
+        }
+        let got = data.len() - before;
+        if got != cfg.map_entries() as usize {
+            bail!(
+                "{} has {got} entries; the configuration needs {}",
+                p.display(),
+                cfg.map_entries()
+            );
+        }
+    }
+    Ok(Maps::from_data(cfg, data))
+}

@@ -1,0 +1,107 @@
+//! The distortion-compensation (atan) ROM: the position stage with compensation on. Each
+//! fraction reads the ROM [`INIT_FILE`]; the ROM is instantiated twice (u and v), so each
+//! copy is a single-port synchronous ROM in its own block RAM.
+
+pub mod model;
+
+use super::position;
+use super::testbench::TbData;
+use super::unit::{Head, Memory, Unit, Vectors};
+use crate::config::Config;
+use crate::model::{MapSet, Model};
+use crate::rng::SplitMix64;
+use crate::rtl::ports::Port;
+use crate::vectors::field::Field;
+use askama::Template;
+
+/// Its `$readmemh` file.
+pub const INIT_FILE: &str = "atan_rom.hex";
+
+pub struct AtanRom;
+
+/// A fabric register after the ROM's block-RAM output register (pipeline_depth >= 1).
+fn out_reg(cfg: &Config) -> bool {
+    cfg.pipeline_depth >= 1
+}
+
+#[derive(Template)]
+#[template(path = "atan_rom/atan_rom.v", syntax = "verilog")]
+struct Verilog {
+    h: Head,
+    latency: u32,
+    out_reg: bool,
+    init_file: &'static str,
+    pos: u32,
+    entries: u32,
+}
+
+crate::tb_template!(Testbench, "atan_rom/atan_rom_tb.v");
+
+impl Unit for AtanRom {
+    fn name(&self) -> &'static str {
+        "atan_rom"
+    }
+
+    fn ports(&self, cfg: &Config) -> Vec<Port> {
+        position::ports(cfg)
+    }
+
+    /// The block RAM's output register and the optional fabric register.
+    fn latency(&self, cfg: &Config) -> Option<u32> {
+        Some(1 + out_reg(cfg) as u32)
+    }
+
+    fn memories(&self, cfg: &Config) -> Vec<Memory> {
+        ["rom_u", "rom_v"]
+            .into_iter()
+            .map(|rom| {
+                Memory::new(
+                    rom,
+                    self.name(),
+                    INIT_FILE.into(),
+                    cfg.atan_entries(),
+                    cfg.pos_bits(),
+                    false,
+                )
+            })
+            .collect()
+    }
+
+    fn render(&self, cfg: &Config, h: Head) -> askama::Result<String> {
+        Verilog {
+            h,
+            latency: self.latency(cfg).expect("fixed"),
+            out_reg: out_reg(cfg),
+            init_file: INIT_FILE,
+            pos: cfg.pos_bits(),
+            entries: cfg.atan_entries(),
+        }
+        .render()
+    }
+
+    fn vectors(&self) -> Option<&dyn Vectors> {
+        Some(self)
+    }
+}
+
+impl Vectors for AtanRom {
+    fn fields(&self, cfg: &Config) -> Vec<Field> {
+        position::fields(cfg)
+    }
+
+    fn corners(&self, model: &Model, _maps: &MapSet) -> Vec<Vec<u64>> {
+        position::corners(&model.cfg)
+    }
+
+    fn random(&self, cfg: &Config, rng: &mut SplitMix64) -> Vec<u64> {
+        position::random(cfg, rng)
+    }
+
+    fn expected(&self, model: &Model, _maps: &MapSet, inp: &[u64]) -> Vec<u64> {
+        position::expected(model, inp)
+    }
+
+    fn testbench(&self, t: &TbData) -> askama::Result<String> {
+        Testbench { t }.render()
+    }
+}

@@ -1,0 +1,106 @@
+//! Where interpolate's registers sit: the weights' complements S - w (registered with the
+//! inputs at depth >= 1), then the u pass a0 = e00 (S - wu) + e10 wu + S/2 and a1 likewise,
+//! then the v pass r = a0 (S - wv) + a1 wv, which carries the rounding constant S^2/2 in
+//! from the u pass; i = r >> 2P. Every pass is an adder tree of weight-gated partial
+//! products.
+
+use crate::config::Config;
+use crate::rtl::adder_tree::{self, registered, registered_at, Sig, Step, Sum, Term, Tree};
+
+pub struct Plan {
+    pub in_reg: bool,
+    pub steps: Vec<Step>,
+    pub sum_r: Sum,
+    pub latency: u32,
+}
+
+impl Plan {
+    pub fn new(cfg: &Config) -> Plan {
+        let d = cfg.pipeline_depth;
+        let in_reg = d >= 1;
+        let p = cfg.interp_bits;
+        let m = cfg.map_bits;
+        let s = cfg.step() as u128;
+        let sfx = |n: &str| {
+            if in_reg {
+                format!("{n}_q1")
+            } else if n.starts_with('w') && n.ends_with('c') {
+                format!("{n}_d")
+            } else {
+                format!("{n}_i")
+            }
+        };
+        let pass = |name: &str, lo: Sig, hi: Sig, w: &str, wc: &str, c: u128, bound: u128| Tree {
+            name: name.into(),
+            terms: (0..=p)
+                .flat_map(|j| {
+                    [
+                        Term::Gated {
+                            sel: format!("{}[{j}]", sfx(wc)),
+                            x: lo.clone(),
+                            shift: j,
+                        },
+                        Term::Gated {
+                            sel: format!("{}[{j}]", sfx(w)),
+                            x: hi.clone(),
+                            shift: j,
+                        },
+                    ]
+                })
+                .chain((c > 0).then_some(Term::Const(c)))
+                .collect(),
+            bound: Some(bound),
+        };
+        let e = |n: &str| Sig::new(sfx(n), m);
+        let a_max = ((1u128 << m) - 1) * s + s / 2;
+        let u = [
+            pass("a0", e("e00"), e("e10"), "wu", "wuc", s / 2, a_max),
+            pass("a1", e("e01"), e("e11"), "wu", "wuc", s / 2, a_max),
+        ];
+        let nu = adder_tree::levels(&u[0]);
+        let bu = adder_tree::build(
+            "u pass",
+            &u,
+            &[
+                ("wv", Sig::new(sfx("wv"), p + 1)),
+                ("wvc", Sig::new(sfx("wvc"), p + 1)),
+            ],
+            &|k, _| registered_at(d, nu, k),
+        );
+        // The v pass gates a0 and a1 with the weights that rode along.
+        let (wv, wvc) = (&bu.riders[0], &bu.riders[1]);
+        let r_max = ((1u128 << m) - 1) * s * s + s * s / 2;
+        let v_terms = (0..=p)
+            .flat_map(|j| {
+                [
+                    Term::Gated {
+                        sel: format!("{}[{j}]", wvc.name),
+                        x: bu.sums[0].plain(),
+                        shift: j,
+                    },
+                    Term::Gated {
+                        sel: format!("{}[{j}]", wv.name),
+                        x: bu.sums[1].plain(),
+                        shift: j,
+                    },
+                ]
+            })
+            .collect();
+        let v = [Tree {
+            name: "r".into(),
+            terms: v_terms,
+            bound: Some(r_max),
+        }];
+        let nv = adder_tree::levels(&v[0]);
+        let bv = adder_tree::build("v pass", &v, &[], &|k, _| registered_at(d, nv, k));
+        let mut steps = bu.steps;
+        steps.extend(bv.steps);
+        let latency = in_reg as u32 + registered(&steps);
+        Plan {
+            in_reg,
+            sum_r: bv.sums[0].clone(),
+            steps,
+            latency,
+        }
+    }
+}

@@ -1,0 +1,94 @@
+//! Linear index: the position stage without distortion compensation,
+//! p = round(u * POS_MAX / 2^F), the all-ones fraction going to POS_MAX.
+
+pub mod model;
+mod plan;
+
+use super::position;
+use super::testbench::TbData;
+use super::unit::{Head, Unit, Vectors};
+use crate::config::Config;
+use crate::model::{MapSet, Model};
+use crate::rng::SplitMix64;
+use crate::rtl::adder_tree::Step;
+use crate::rtl::ports::Port;
+use crate::vectors::field::Field;
+use askama::Template;
+pub use plan::Plan;
+
+pub struct LinearIndex;
+
+#[derive(Template)]
+#[template(path = "linear_index/linear_index.v", syntax = "verilog")]
+struct Verilog {
+    h: Head,
+    depth: u32,
+    latency: u32,
+    f: u32,
+    pos: u32,
+    lw: u32,
+    pre_reg: bool,
+    steps: Vec<Step>,
+    sum_u: String,
+    sum_v: String,
+}
+
+crate::tb_template!(Testbench, "linear_index/linear_index_tb.v");
+
+impl Unit for LinearIndex {
+    fn name(&self) -> &'static str {
+        "linear_index"
+    }
+
+    fn ports(&self, cfg: &Config) -> Vec<Port> {
+        position::ports(cfg)
+    }
+
+    fn latency(&self, cfg: &Config) -> Option<u32> {
+        Some(Plan::new(cfg).latency)
+    }
+
+    fn render(&self, cfg: &Config, h: Head) -> askama::Result<String> {
+        let p = Plan::new(cfg);
+        let lw = p.sum_u.width();
+        Verilog {
+            h,
+            depth: cfg.pipeline_depth,
+            latency: p.latency,
+            f: cfg.frac_bits,
+            pos: cfg.pos_bits(),
+            lw,
+            pre_reg: p.pre_reg,
+            sum_u: p.sum_u.expr(lw),
+            sum_v: p.sum_v.expr(lw),
+            steps: p.steps,
+        }
+        .render()
+    }
+
+    fn vectors(&self) -> Option<&dyn Vectors> {
+        Some(self)
+    }
+}
+
+impl Vectors for LinearIndex {
+    fn fields(&self, cfg: &Config) -> Vec<Field> {
+        position::fields(cfg)
+    }
+
+    fn corners(&self, model: &Model, _maps: &MapSet) -> Vec<Vec<u64>> {
+        position::corners(&model.cfg)
+    }
+
+    fn random(&self, cfg: &Config, rng: &mut SplitMix64) -> Vec<u64> {
+        position::random(cfg, rng)
+    }
+
+    fn expected(&self, model: &Model, _maps: &MapSet, inp: &[u64]) -> Vec<u64> {
+        position::expected(model, inp)
+    }
+
+    fn testbench(&self, t: &TbData) -> askama::Result<String> {
+        Testbench { t }.render()
+    }
+}

@@ -1,0 +1,47 @@
+//! Where linear_index's registers sit: u' = u, or 2^F for the all-ones code (so that the
+//! border comes out exactly as POS_MAX), registered at depth >= 1; then
+//! p = (u' * POS_MAX + 2^(F-1)) >> F with the constant POS_MAX = (2^I - 1) * 2^P as an adder
+//! tree of I shifted copies of u'.
+
+use crate::config::Config;
+use crate::rtl::adder_tree::{self, registered, registered_at, Sig, Step, Sum, Term, Tree};
+
+pub struct Plan {
+    pub pre_reg: bool,
+    pub steps: Vec<Step>,
+    pub sum_u: Sum,
+    pub sum_v: Sum,
+    pub latency: u32,
+}
+
+impl Plan {
+    pub fn new(cfg: &Config) -> Plan {
+        let d = cfg.pipeline_depth;
+        let pre_reg = d >= 1;
+        let sfx = if pre_reg { "q1" } else { "d" };
+        let tree = |name: &str, x: &str| Tree {
+            name: name.into(),
+            terms: (0..cfg.index_bits)
+                .map(|b| Term::Plain {
+                    x: Sig::new(format!("{x}_{sfx}"), cfg.frac_bits + 1),
+                    shift: cfg.interp_bits + b,
+                })
+                .chain([Term::Const(cfg.frac_half() as u128)])
+                .collect(),
+            bound: Some((cfg.pos_max() as u128) << cfg.frac_bits | cfg.frac_half() as u128),
+        };
+        let trees = [tree("su", "ux"), tree("sv", "vx")];
+        let n = adder_tree::levels(&trees[0]);
+        let b = adder_tree::build("u' * POS_MAX and v' * POS_MAX", &trees, &[], &|k, _| {
+            registered_at(d, n, k)
+        });
+        let latency = pre_reg as u32 + registered(&b.steps);
+        Plan {
+            pre_reg,
+            sum_u: b.sums[0].clone(),
+            sum_v: b.sums[1].clone(),
+            steps: b.steps,
+            latency,
+        }
+    }
+}

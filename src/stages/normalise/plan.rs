@@ -1,0 +1,67 @@
+//! Where normalise's registers sit for a `pipeline_depth`: the ROM read and the compares
+//! take a clock, the ROM output is registered again at depth >= 1, then a * recip + HALF and
+//! b * recip + HALF are adder trees of the partial products, then rounding and saturation go
+//! into the output register. The template renders this plan and the latency counts it.
+
+use crate::config::Config;
+use crate::rtl::adder_tree::{self, registered, registered_at, Built, Sig, Step, Sum, Term, Tree};
+
+pub struct Plan {
+    pub rom_reg: bool,
+    pub steps: Vec<Step>,
+    /// The sums a * recip + HALF and b * recip + HALF.
+    pub sum_a: Sum,
+    pub sum_b: Sum,
+    /// a == m and b == m, delayed to the saturation.
+    pub a_max: Sig,
+    pub b_max: Sig,
+    pub latency: u32,
+}
+
+impl Plan {
+    pub fn new(cfg: &Config) -> Plan {
+        let d = cfg.pipeline_depth;
+        let rom_reg = d >= 1;
+        let q = if rom_reg { "q2" } else { "q1" };
+        let recip = Sig::new(format!("recip_{q}"), cfg.recip_bits);
+        let tree = |name: &str, x: &str| Tree {
+            name: name.into(),
+            terms: (0..cfg.red_bits)
+                .map(|j| Term::Gated {
+                    sel: format!("{x}_{q}[{j}]"),
+                    x: recip.clone(),
+                    shift: j,
+                })
+                .chain([Term::Const(cfg.norm_half() as u128)])
+                .collect(),
+            bound: None,
+        };
+        let trees = [tree("pa", "a"), tree("pb", "b")];
+        let n = adder_tree::levels(&trees[0]);
+        // The last level and the saturation share a clock, except at depth 2.
+        let anchor = if d >= 2 { n } else { n - 1 };
+        let Built {
+            steps,
+            sums,
+            riders,
+        } = adder_tree::build(
+            "a * recip and b * recip",
+            &trees,
+            &[
+                ("a_max", Sig::new(format!("a_max_{q}"), 1)),
+                ("b_max", Sig::new(format!("b_max_{q}"), 1)),
+            ],
+            &|k, _| registered_at(d, anchor, k),
+        );
+        let latency = 1 + rom_reg as u32 + registered(&steps) + 1;
+        Plan {
+            rom_reg,
+            sum_a: sums[0].clone(),
+            sum_b: sums[1].clone(),
+            a_max: riders[0].clone(),
+            b_max: riders[1].clone(),
+            steps,
+            latency,
+        }
+    }
+}

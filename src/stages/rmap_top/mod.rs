@@ -1,0 +1,197 @@
+//! The top, rmap_top: instantiates the stages a configuration needs in pipeline order, the
+//! sideband delay lines beside them, the map buffer swap, the output register (where the zero
+//! flag applies) and, with `handshake`, the valid/ready flow control. Its latency and its
+//! sideband delays are computed here from the stages' own latencies.
+
+mod latency;
+mod vectors;
+
+use super::color_mul::ColorMul;
+use super::interpolate::Interpolate;
+use super::map_lookup::MapLookup;
+use super::normalise::Normalise;
+use super::pipe_delay::PipeDelay;
+use super::sort_shift::SortShift;
+use super::unit::{Head, Memory, Unit, Vectors};
+use super::zero_detect::ZeroDetect;
+use crate::config::{Config, COLOR_BITS};
+use crate::rtl::ports::{i, o, Port};
+use askama::Template;
+pub use latency::{
+    pipeline, position, sideband_delays, top_latency, SidebandDelays, OUTPUT_LATENCY,
+};
+pub use vectors::{corners_for_map, random_for_map, stream_lines};
+
+pub struct RmapTop;
+
+#[derive(Template)]
+#[template(path = "rmap_top/rmap_top.v", syntax = "verilog")]
+struct Verilog {
+    h: Head,
+    handshake: bool,
+    interpolation: bool,
+    color: bool,
+    /// The position stage's module name.
+    position: &'static str,
+    r: u32,
+    f: u32,
+    pos: u32,
+    m: u32,
+    p: u32,
+    c: u32,
+    latency_list: String,
+    total: u32,
+    sign_delay: u32,
+    buf_delay: u32,
+    zero_delay: u32,
+    rgb_delay: u32,
+    i_delay: u32,
+}
+
+/// `sort_shift 4, normalise 6, ...`: each stage of [`pipeline`] with its latency.
+pub fn latency_list(cfg: &Config) -> String {
+    pipeline(cfg)
+        .iter()
+        .map(|s| {
+            format!(
+                "{} {}",
+                s.name(),
+                s.latency(cfg).expect("a stage has a latency")
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+impl Unit for RmapTop {
+    fn name(&self) -> &'static str {
+        "rmap_top"
+    }
+
+    fn ports(&self, cfg: &Config) -> Vec<Port> {
+        let (g, mb) = (cfg.grad_bits, cfg.map_bits);
+        let mut v = vec![
+            i("clk_i", 1, ""),
+            i("rst_ni", 1, "asynchronous, active low"),
+            i(
+                "valid_i",
+                1,
+                if cfg.handshake {
+                    "a sample is accepted at a rising edge with valid_i && ready_o"
+                } else {
+                    "a sample is accepted every cycle valid_i is high"
+                },
+            ),
+            i("gx_i", g, "G-bit two's complement"),
+            i("gy_i", g, ""),
+            i("gz_i", g, ""),
+        ];
+        if cfg.color {
+            v.push(i("r_i", COLOR_BITS, "sample colour"));
+            v.push(i("g_i", COLOR_BITS, ""));
+            v.push(i("b_i", COLOR_BITS, ""));
+        }
+        v.push(i("swap_i", 1, "exchange front and back map buffers"));
+        v.push(i("wr_en_i", 1, "host write into the back buffer"));
+        v.push(i("wr_axis_i", 2, ""));
+        v.push(i(
+            "wr_addr_i",
+            cfg.map_addr_bits(),
+            "{s_max, s_u, i_u, s_v, i_v}",
+        ));
+        v.push(i("wr_data_i", mb, ""));
+        if cfg.handshake {
+            v.push(i(
+                "ready_i",
+                1,
+                "the result leaves at a rising edge with valid_o && ready_i",
+            ));
+            v.push(o(
+                "ready_o",
+                1,
+                "the pipeline accepts a sample (a register; low in reset)",
+            ));
+        }
+        v.push(o(
+            "valid_o",
+            1,
+            if cfg.handshake {
+                "holds, with the outputs, until ready_i"
+            } else {
+                ""
+            },
+        ));
+        v.push(o("zero_o", 1, "the sample's gradient was zero"));
+        v.push(o("i_o", mb, "intensity (0 when zero_o)"));
+        if cfg.color {
+            v.push(o("r_o", COLOR_BITS, "colour times intensity"));
+            v.push(o("g_o", COLOR_BITS, ""));
+            v.push(o("b_o", COLOR_BITS, ""));
+        }
+        v
+    }
+
+    fn latency(&self, cfg: &Config) -> Option<u32> {
+        Some(top_latency(cfg))
+    }
+
+    /// In the order rmap_top.v instantiates them; stages the configuration leaves out are
+    /// absent, not bypassed.
+    fn children(&self, cfg: &Config) -> Vec<&'static dyn Unit> {
+        let mut v: Vec<&'static dyn Unit> = vec![
+            &ZeroDetect,
+            &SortShift,
+            &Normalise,
+            position(cfg),
+            &MapLookup,
+        ];
+        if cfg.interpolation {
+            v.push(&Interpolate);
+        }
+        if cfg.color {
+            v.push(&ColorMul);
+        }
+        v.push(&PipeDelay);
+        v
+    }
+
+    /// Every child's memories, under its instance `u_<module>`.
+    fn memories(&self, cfg: &Config) -> Vec<Memory> {
+        self.children(cfg)
+            .into_iter()
+            .flat_map(|c| {
+                let inst = format!("u_{}", c.name());
+                c.memories(cfg).into_iter().map(move |m| m.under(&inst))
+            })
+            .collect()
+    }
+
+    fn render(&self, cfg: &Config, h: Head) -> askama::Result<String> {
+        let d = sideband_delays(cfg);
+        Verilog {
+            h,
+            handshake: cfg.handshake,
+            interpolation: cfg.interpolation,
+            color: cfg.color,
+            position: position(cfg).name(),
+            r: cfg.red_bits,
+            f: cfg.frac_bits,
+            pos: cfg.pos_bits(),
+            m: cfg.map_bits,
+            p: cfg.interp_bits,
+            c: COLOR_BITS,
+            latency_list: latency_list(cfg),
+            total: top_latency(cfg),
+            sign_delay: d.sign,
+            buf_delay: d.buf,
+            zero_delay: d.zero,
+            rgb_delay: d.rgb.unwrap_or(0),
+            i_delay: d.intensity.unwrap_or(0),
+        }
+        .render()
+    }
+
+    fn vectors(&self) -> Option<&dyn Vectors> {
+        Some(self)
+    }
+}

@@ -1,0 +1,68 @@
+//! What a testbench template reads ([`TbData`]): built by `rtl::tb` from a stage's ports,
+//! fields and latency, rendered by the stage's own `<name>_tb.v` (which extends
+//! `templates/tb/base_tb.v`).
+
+/// A signal of the testbench: a design port.
+pub struct Sig {
+    pub name: &'static str,
+    /// `[n-1:0]`, or blanks for one bit, padded so the names line up.
+    pub range: String,
+    pub init: String,
+    /// The instance connection, `.name (name)`, names padded.
+    pub pin: String,
+}
+
+/// A vector field as the testbench stores and drives or checks it.
+pub struct FieldView {
+    pub name: &'static str,
+    pub bits: u32,
+    /// Always a range, `[0:0]` for one bit, so every ring is declared alike.
+    pub range: String,
+    /// The design port the field drives or is compared with; empty for `map` of the top,
+    /// which steers the testbench itself.
+    pub port: String,
+}
+
+/// Everything the testbench templates read.
+pub struct TbData {
+    pub header: String,
+    pub module: &'static str,
+    pub summary: String,
+    pub vector_file: String,
+    pub field_list: String,
+    pub latency: u32,
+    pub depth: u32,
+    pub depth_bits: u32,
+    pub full_speed: u32,
+    pub reset_at: u32,
+    pub timeout: u32,
+    pub seed: u32,
+    pub has_en: bool,
+    /// The top with valid/ready flow control: ready_i random, acceptance by ready_o.
+    pub handshake: bool,
+    /// `{zero_o, i_o, ...}`: every checked output, and its width (the hold check).
+    pub outs_concat: String,
+    pub outs_bits: u32,
+    pub inputs: Vec<Sig>,
+    pub outputs: Vec<Sig>,
+    pub ports: Vec<Sig>,
+    pub fields: Vec<FieldView>,
+    /// Input fields with a port.
+    pub in_fields: Vec<FieldView>,
+    pub out_fields: Vec<FieldView>,
+    pub scan_format: String,
+    pub scan_args: String,
+    pub in_format: String,
+    pub in_args: String,
+    pub out_format: String,
+    pub exp_args: String,
+    pub got_args: String,
+    /// Files the design reads with `$readmemh` (and the testbench itself, for `map2_*`).
+    pub hex_files: Vec<String>,
+    /// The second map, loaded through the host port (map_lookup and the top).
+    pub map2_files: Vec<String>,
+    pub map_entries: u32,
+    pub map_addr_bits: u32,
+    pub map_bits: u32,
+    pub nwrites: u32,
+}
