@@ -2,7 +2,7 @@
 //! configuration (Icarus, Verilator and Yosys all accept them), then one entry per line.
 
 use crate::config::Config;
-use crate::model::{atan_rom, recip_rom, Maps};
+use crate::model::{Maps, Model};
 use crate::stages;
 
 /// Hex digits of a `bits`-wide value.
@@ -25,25 +25,21 @@ pub fn format(cfg: &Config, what: &str, bits: u32, entries: &[u32]) -> String {
     s
 }
 
-/// The fixed ROMs and a scene's maps, as (file name, contents).
-pub fn all(cfg: &Config, maps: &Maps) -> Vec<(String, String)> {
+/// The fixed ROMs (the model's tables) and a scene's maps, as (file name, contents).
+pub fn all(model: &Model, maps: &Maps) -> Vec<(String, String)> {
+    let cfg = &model.cfg;
     let mut v = vec![(
         stages::recip_rom::INIT_FILE.to_string(),
-        format(
-            cfg,
-            "reciprocal ROM",
-            cfg.recip_bits,
-            &recip_rom::contents(cfg),
-        ),
+        format(cfg, "reciprocal ROM", cfg.recip_bits, &model.recip),
     )];
-    if cfg.compensation {
+    if let Some(atan) = &model.atan {
         v.push((
             stages::atan_rom::INIT_FILE.to_string(),
             format(
                 cfg,
                 "distortion compensation (atan) ROM",
                 cfg.pos_bits(),
-                &atan_rom::contents(cfg),
+                atan,
             ),
         ));
     }

@@ -4,6 +4,7 @@
 pub mod bench;
 pub mod cmd;
 pub mod config;
+pub mod design;
 pub mod disk;
 pub mod fit;
 pub mod geometry;

@@ -4,12 +4,12 @@
 
 use super::config_args::ConfigArgs;
 use crate::config::Config;
+use crate::design::Design;
 use crate::output::{Policy, StagedDir};
 use crate::rtl::Manifest;
 use crate::rtl::{self, tb};
 use crate::scene::Scene;
 use crate::vectors;
-use crate::vectors::MapSet;
 use anyhow::Result;
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -72,10 +72,10 @@ pub fn write_dir(
     let out = StagedDir::new(out, policy)?;
     // Built once: the design's init files and the vectors see the same maps, this scene's
     // and the alternate scene's that testbenches load through the host port.
-    let maps = MapSet::from_scenes(cfg, scene, &Scene::alternate());
-    let manifest = rtl::write_design(cfg, &maps, &out)?;
-    vectors::write_all_with_maps(cfg, &out, vectors, seed, &maps)?;
-    tb::write_all(cfg, &out)?;
+    let design = Design::for_scene(cfg, scene)?;
+    let manifest = rtl::write_design(&design, &out)?;
+    vectors::write_all(&design, &out, vectors, seed)?;
+    tb::write_all(&design, &out)?;
     for (name, text) in extra {
         out.write_text(name, text)?;
     }

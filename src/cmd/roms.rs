@@ -1,9 +1,9 @@
 //! `rmapgen roms`: the ROM and map contents as `$readmemh` files, nothing else.
 
 use super::config_args::ConfigArgs;
+use crate::design::Design;
 use crate::output::StagedDir;
 use crate::scene::Scene;
-use crate::vectors::MapSet;
 use anyhow::Context;
 use anyhow::Result;
 use clap::Args;
@@ -60,10 +60,7 @@ pub fn run(a: &RomsArgs) -> Result<()> {
         );
     }
     let out = StagedDir::new(target, &policy)?;
-    for (name, text) in crate::rtl::hex_files(
-        &cfg,
-        &MapSet::from_scenes(&cfg, &scene, &Scene::alternate()),
-    ) {
+    for (name, text) in crate::rtl::hex_files(&Design::for_scene(&cfg, &scene)?) {
         out.write_text(&name, &text)?;
     }
     if a.update.is_some() {

@@ -548,11 +548,7 @@ fn best(
 pub fn cells(cfg: &Config, scene: &Scene) -> Result<u64> {
     let tmp = crate::output::Scratch::new()?;
     let out = crate::output::StagedDir::new(&tmp.path().join("design"), &Default::default())?;
-    let manifest = crate::rtl::write_design(
-        cfg,
-        &crate::vectors::MapSet::from_scenes(cfg, scene, &Scene::alternate()),
-        &out,
-    )?;
+    let manifest = crate::rtl::write_design(&crate::design::Design::for_scene(cfg, scene)?, &out)?;
     let dir = out.commit()?;
     let files: Vec<String> = manifest.modules.iter().map(|m| m.file.clone()).collect();
     let yosys = fpga::Options::default().yosys;

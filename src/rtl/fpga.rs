@@ -161,7 +161,7 @@ pub fn ice40_report(cfg: &Config, opts: &Options) -> Result<FpgaReport> {
     cfg.validate()?;
     let tmp = crate::output::Scratch::new()?;
     let out = StagedDir::new(&tmp.path().join("rtl"), &Default::default())?;
-    super::write_design(cfg, &crate::vectors::MapSet::standard(cfg), &out)?;
+    super::write_design(&crate::design::Design::standard(cfg)?, &out)?;
     let dir = out.commit()?;
     run_dir(&dir, opts)
 }

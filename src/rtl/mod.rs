@@ -11,9 +11,8 @@ pub mod ports;
 pub mod tb;
 pub mod verilated;
 
-use crate::config::Config;
+use crate::design::Design;
 use crate::hexfile;
-use crate::model::MapSet;
 use crate::output::StagedDir;
 use crate::stages::map_bank::banks;
 use crate::stages::{self, Head};
@@ -25,8 +24,10 @@ pub use ports::{Dir, Port, Width};
 /// scene's logical maps map_<axis>.hex, the second map map2_<axis>.hex (the alternate scene's,
 /// which testbenches load through the host port) and the map banks' init files. `generate`
 /// and `roms` both write exactly these.
-pub fn hex_files(cfg: &Config, maps: &MapSet) -> Vec<(String, String)> {
-    let mut v = hexfile::all(cfg, &maps.scene);
+pub fn hex_files(design: &Design) -> Vec<(String, String)> {
+    let cfg = design.cfg();
+    let maps = &design.maps;
+    let mut v = hexfile::all(&design.model, &maps.scene);
     let alt = &maps.second;
     for (axis, name) in ["x", "y", "z"].iter().enumerate() {
         let what = format!(
@@ -44,10 +45,10 @@ pub fn hex_files(cfg: &Config, maps: &MapSet) -> Vec<(String, String)> {
 /// Writes every module's `.v`, the ROM and map init files, the logical maps of the scene
 /// (`map_<axis>.hex`) and of the alternate scene (`map2_<axis>.hex`, which testbenches load
 /// through the host port), the FuseSoC core and README of [`package`], and `manifest.json`.
-/// Returns the manifest. `maps` are built once by the caller, which hands the same value to
-/// the vectors.
-pub fn write_design(cfg: &Config, maps: &MapSet, out: &StagedDir) -> Result<Manifest> {
-    cfg.validate()?;
+/// Returns the manifest. The caller builds `design` once and hands the same value to the
+/// vectors and the testbenches.
+pub fn write_design(design: &Design, out: &StagedDir) -> Result<Manifest> {
+    let cfg = design.cfg();
     let mut files = Vec::new();
     let mut write = |name: String, text: &str| -> Result<()> {
         out.write_text(&name, text)?;
@@ -61,7 +62,7 @@ pub fn write_design(cfg: &Config, maps: &MapSet, out: &StagedDir) -> Result<Mani
         write(m.file(), &text)?;
     }
     let mut hex = Vec::new();
-    for (name, text) in hex_files(cfg, maps) {
+    for (name, text) in hex_files(design) {
         hex.push(name.clone());
         write(name, &text)?;
     }

@@ -13,6 +13,7 @@
 //! harness `tb/top_stream.cpp` of the repository needs).
 
 use crate::config::Config;
+use crate::design::Design;
 use crate::output::StagedDir;
 use crate::rtl::ports::{self, Width};
 use crate::stages::rmap_top::top_latency;
@@ -268,8 +269,8 @@ pub fn harness_header(cfg: &Config) -> String {
 
 /// Writes `tb/<module>_tb.v` for every stage present in `cfg` and the top, plus
 /// `tb/config.toml` and `tb/rmap_top_config.h`.
-pub fn write_all(cfg: &Config, out: &StagedDir) -> Result<()> {
-    cfg.validate()?;
+pub fn write_all(design: &Design, out: &StagedDir) -> Result<()> {
+    let cfg = design.cfg();
     for stage in stages::checked(cfg) {
         out.write_text(&format!("tb/{}_tb.v", stage.name()), &render(cfg, stage)?)?;
     }

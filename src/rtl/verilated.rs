@@ -51,12 +51,9 @@ impl VerilatedTop {
         let dir = crate::output::Scratch::new()?;
         let design = dir.path().join("design");
         let staged = StagedDir::new(&design, &Default::default())?;
-        super::write_design(
-            cfg,
-            &crate::vectors::MapSet::from_scenes(cfg, scene, &Scene::alternate()),
-            &staged,
-        )?;
-        crate::rtl::tb::write_all(cfg, &staged)?;
+        let d = crate::design::Design::for_scene(cfg, scene)?;
+        super::write_design(&d, &staged)?;
+        crate::rtl::tb::write_all(&d, &staged)?;
         staged.commit()?;
         let harness = dir.path().join("top_apply.cpp");
         std::fs::write(&harness, HARNESS)?;

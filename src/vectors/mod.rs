@@ -12,6 +12,7 @@ pub mod field;
 pub mod inputs;
 
 use crate::config::Config;
+use crate::design::Design;
 use crate::hexfile;
 pub use crate::model::map_set::{read_maps, MapSet, MAX_MAP_FILE_BYTES};
 use crate::model::Model;
@@ -159,27 +160,15 @@ pub fn stage_text(
     s
 }
 
-/// Writes `vectors/<stage>.hex` for every stage present in `cfg`, and `vectors/rmap_top.hex`,
-/// with the standard scene's map in buffer 0 and the alternate scene's in buffer 1.
-pub fn write_all(cfg: &Config, out: &StagedDir, random: usize, seed: u64) -> Result<()> {
-    write_all_with_maps(cfg, out, random, seed, &MapSet::standard(cfg))
-}
-
-/// [`write_all`] for a design generated with other maps (another scene).
-pub fn write_all_with_maps(
-    cfg: &Config,
-    out: &StagedDir,
-    random: usize,
-    seed: u64,
-    maps: &MapSet,
-) -> Result<()> {
-    cfg.validate()?;
+/// Writes `vectors/<stage>.hex` for every stage present in the design, and
+/// `vectors/rmap_top.hex`, expecting buffer 0 to hold the design's scene map and buffer 1 its
+/// second map.
+pub fn write_all(design: &Design, out: &StagedDir, random: usize, seed: u64) -> Result<()> {
     check_stage_vectors(random, "--vectors")?;
-    let model = Model::new(cfg);
-    for stage in stages::checked(cfg) {
+    for stage in stages::checked(design.cfg()) {
         out.write_text(
             &stage.vector_file(),
-            &stage_text(stage, &model, maps, random, seed),
+            &stage_text(stage, &design.model, &design.maps, random, seed),
         )?;
     }
     Ok(())

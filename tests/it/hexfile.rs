@@ -24,7 +24,7 @@ fn hex_files_equal_model_tables() {
         },
     ] {
         let scene = Scene::standard();
-        let files = hexfile::all(&cfg, &scene.maps(&cfg));
+        let files = hexfile::all(&Model::new(&cfg), &scene.maps(&cfg));
         let get = |name: &str| {
             files
                 .iter()
@@ -51,7 +51,7 @@ fn hex_files_equal_model_tables() {
 #[test]
 fn hex_digits_fit_widths() {
     let cfg = Config::default();
-    for (name, text) in hexfile::all(&cfg, &Scene::standard().maps(&cfg)) {
+    for (name, text) in hexfile::all(&Model::new(&cfg), &Scene::standard().maps(&cfg)) {
         let w = if name.starts_with("recip") { 3 } else { 2 };
         assert!(
             text.lines()

@@ -130,7 +130,7 @@ fn scenes_select_the_fit_and_the_hex_writer_follows() {
     let maps = scene.maps(&cfg);
     let p = scene.prepared();
     assert_eq!(maps, map_fit::contents(&cfg, MapFit::Lsq, |n| p.shade(n)));
-    let files = hexfile::all(&cfg, &scene.maps(&cfg));
+    let files = hexfile::all(&rmapgen::model::Model::new(&cfg), &scene.maps(&cfg));
     let (_, x) = files.iter().find(|(n, _)| n == "map_x.hex").unwrap();
     let entries: Vec<u32> = x
         .lines()

@@ -3,6 +3,7 @@
 
 use crate::helpers;
 use rmapgen::config::Config;
+use rmapgen::design::Design;
 use rmapgen::model::{color_mul, interpolate, map_lookup, normalise, sort_shift, Model};
 use rmapgen::output::StagedDir;
 use rmapgen::stages::{self, rmap_top, Vectors};
@@ -70,7 +71,7 @@ fn write(cfg: &Config, random: usize, seed: u64) -> (tempfile::TempDir, std::pat
     let tmp = helpers::tempdir();
     let target = tmp.path().join("out");
     let out = StagedDir::new(&target, &Default::default()).unwrap();
-    vectors::write_all(cfg, &out, random, seed).unwrap();
+    vectors::write_all(&Design::standard(cfg).unwrap(), &out, random, seed).unwrap();
     out.commit().unwrap();
     (tmp, target)
 }
