@@ -10,8 +10,13 @@
 //! on a scene's Pareto front when no other row of that scene is at least as good in both error
 //! (RMSE) and cost (bits), or in both error and one-thread speed.
 
+pub mod ice40;
 pub mod octahedral;
+pub mod pareto;
 pub mod plot;
+pub mod row;
+pub mod table;
+mod timing;
 
 use crate::config::Config;
 use crate::model::fast::FastShader;
@@ -20,14 +25,15 @@ use crate::model::Model;
 use crate::output::StagedDir;
 use crate::reference::Reference;
 use crate::render::{self, metrics, sphere_gradients};
-use crate::rng::SplitMix64;
-use crate::rtl::fpga::{self, FpgaReport};
 use crate::scene::Scene;
 use anyhow::Result;
+use ice40::{ice40_figures, Ice40};
 use octahedral::Octahedral;
+use pareto::mark_pareto;
 use rayon::prelude::*;
-use serde::Serialize;
-use std::time::Instant;
+use row::Row;
+use table::{csv, markdown};
+use timing::{median, time, uniform};
 
 /// What to measure.
 #[derive(Clone, Debug)]
@@ -50,42 +56,6 @@ impl Default for Options {
             yosys: true,
             quick: false,
         }
-    }
-}
-
-/// One measured row.
-#[derive(Clone, Debug, Serialize)]
-pub struct Row {
-    pub scene: String,
-    /// A short name of the configuration (or the octahedral map).
-    pub design: String,
-    pub config: String,
-    pub map_fit: String,
-    pub entries: u32,
-    pub max_abs_error: u32,
-    pub rmse: f64,
-    pub psnr_db: f64,
-    pub msamples_1_thread: f64,
-    pub msamples_all_cores: f64,
-    /// All-core throughput over the float reference's, same inputs.
-    pub float_ratio: f64,
-    pub map_build_us: f64,
-    pub rom_bits: u64,
-    pub map_bits: u64,
-    /// iCE40 HX8K after place and route: logic cells, block RAMs, Fmax (with the tools).
-    pub ice40_cells: Option<u32>,
-    pub ice40_brams: Option<u32>,
-    pub fmax_mhz: Option<f64>,
-    /// The flow ran and the design does not fit the HX8K (the cells, RAMs and Fmax are then
-    /// None).
-    pub ice40_too_big: bool,
-    pub pareto_cost: bool,
-    pub pareto_speed: bool,
-}
-
-impl Row {
-    pub fn bits(&self) -> u64 {
-        self.rom_bits + self.map_bits
     }
 }
 
@@ -162,73 +132,6 @@ pub fn scenes() -> Vec<(String, Scene)> {
         ("two_lights".into(), Scene::alternate()),
         ("diffuse".into(), diffuse),
     ]
-}
-
-/// Seconds per call of `f`: after one warm-up call, the best of three windows of at least
-/// `seconds` / 3 each (and at least one call), so a busy moment on the machine counts less.
-fn time(seconds: f64, mut f: impl FnMut()) -> f64 {
-    f();
-    (0..3)
-        .map(|_| {
-            let start = Instant::now();
-            let mut n = 0u32;
-            while n == 0 || start.elapsed().as_secs_f64() < seconds / 3.0 {
-                f();
-                n += 1;
-            }
-            start.elapsed().as_secs_f64() / n as f64
-        })
-        .fold(f64::INFINITY, f64::min)
-}
-
-/// Median seconds of `runs` calls.
-fn median(runs: usize, mut f: impl FnMut()) -> f64 {
-    let mut t: Vec<f64> = (0..runs)
-        .map(|_| {
-            let s = Instant::now();
-            f();
-            s.elapsed().as_secs_f64()
-        })
-        .collect();
-    t.sort_by(f64::total_cmp);
-    t[runs / 2]
-}
-
-fn uniform(n: usize) -> Vec<[i32; 3]> {
-    let mut rng = SplitMix64::new(1);
-    (0..n)
-        .map(|_| [(); 3].map(|_| rng.range(0, 4095) as i32 - 2048))
-        .collect()
-}
-
-/// What the iCE40 flow gave for one configuration.
-#[derive(Clone, Debug)]
-pub enum Ice40 {
-    /// Yosys or nextpnr-ice40 is not installed (or the flow was not asked for).
-    NotRun,
-    /// The design needs more of the device than it has (nextpnr's complaint).
-    DoesNotFit(String),
-    Placed(Box<FpgaReport>),
-}
-
-/// The iCE40 figures of each configuration (in parallel, one flow per core); `NotRun` for
-/// all when Yosys or nextpnr-ice40 is missing. A design too big for the HX8K is a figure, any
-/// other failure an error.
-pub fn ice40_figures(configs: &[Config]) -> Result<Vec<Ice40>> {
-    let opts = fpga::Options::default();
-    if !fpga::tools_available(&opts) {
-        return Ok(vec![Ice40::NotRun; configs.len()]);
-    }
-    configs
-        .par_iter()
-        .map(|c| match fpga::ice40_report(c, &opts) {
-            Ok(r) => Ok(Ice40::Placed(Box::new(r))),
-            Err(e) => match e.downcast_ref::<fpga::DoesNotFit>() {
-                Some(d) => Ok(Ice40::DoesNotFit(d.message.clone())),
-                None => Err(e.context(format!("iCE40 flow of {}", c.summary()))),
-            },
-        })
-        .collect()
 }
 
 /// Measures every row; `progress` is called once per finished step with a description.
@@ -377,100 +280,6 @@ pub fn run(opts: &Options, progress: &dyn Fn(&str)) -> Result<Vec<Row>> {
     }
     mark_pareto(&mut rows);
     Ok(rows)
-}
-
-/// Marks each scene's Pareto fronts: (bits, RMSE) and (one-thread speed, RMSE).
-pub fn mark_pareto(rows: &mut [Row]) {
-    let snapshot = rows.to_vec();
-    for r in rows.iter_mut() {
-        let same = snapshot.iter().filter(|o| o.scene == r.scene);
-        let (mut cost, mut speed) = (true, true);
-        for o in same {
-            if o.bits() <= r.bits() && o.rmse <= r.rmse && (o.bits() < r.bits() || o.rmse < r.rmse)
-            {
-                cost = false;
-            }
-            if o.msamples_1_thread >= r.msamples_1_thread
-                && o.rmse <= r.rmse
-                && (o.msamples_1_thread > r.msamples_1_thread || o.rmse < r.rmse)
-            {
-                speed = false;
-            }
-        }
-        r.pareto_cost = cost;
-        r.pareto_speed = speed;
-    }
-}
-
-/// The rows as a Markdown table.
-pub fn markdown(rows: &[Row]) -> String {
-    let mut s = String::from(
-        "| scene | design | map | entries | max abs (LSB) | RMSE (LSB) | PSNR (dB) | 1 thread (M/s) | all cores (M/s) | x float | map build (us) | ROM + map bits | iCE40 cells | block RAMs | Fmax (MHz) | Pareto |\n\
-         |---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n",
-    );
-    for r in rows {
-        let pareto = match (r.pareto_cost, r.pareto_speed) {
-            (true, true) => "cost, speed",
-            (true, false) => "cost",
-            (false, true) => "speed",
-            _ => "",
-        };
-        s += &format!(
-            "| {} | {} | {} | {} | {} | {:.3} | {:.2} | {:.0} | {:.0} | {:.1} | {:.0} | {} | {} | {} | {} | {} |\n",
-            r.scene,
-            r.design,
-            r.map_fit,
-            r.entries,
-            r.max_abs_error,
-            r.rmse,
-            r.psnr_db,
-            r.msamples_1_thread,
-            r.msamples_all_cores,
-            r.float_ratio,
-            r.map_build_us,
-            r.bits(),
-            if r.ice40_too_big {
-                "does not fit".into()
-            } else {
-                r.ice40_cells.map_or("-".into(), |c| c.to_string())
-            },
-            r.ice40_brams.map_or("-".into(), |c| c.to_string()),
-            r.fmax_mhz.map_or("-".into(), |f| format!("{f:.1}")),
-            pareto
-        );
-    }
-    s
-}
-
-/// The rows as CSV with a header line.
-pub fn csv(rows: &[Row]) -> String {
-    let mut s = String::from("scene,design,config,map_fit,entries,max_abs_error,rmse,psnr_db,msamples_1_thread,msamples_all_cores,float_ratio,map_build_us,rom_bits,map_bits,ice40_cells,ice40_brams,fmax_mhz,ice40_too_big,pareto_cost,pareto_speed\n");
-    for r in rows {
-        s += &format!(
-            "{},{},\"{}\",{},{},{},{:.4},{:.3},{:.2},{:.2},{:.2},{:.1},{},{},{},{},{},{},{},{}\n",
-            r.scene,
-            r.design,
-            r.config,
-            r.map_fit,
-            r.entries,
-            r.max_abs_error,
-            r.rmse,
-            r.psnr_db,
-            r.msamples_1_thread,
-            r.msamples_all_cores,
-            r.float_ratio,
-            r.map_build_us,
-            r.rom_bits,
-            r.map_bits,
-            r.ice40_cells.map_or(String::new(), |c| c.to_string()),
-            r.ice40_brams.map_or(String::new(), |c| c.to_string()),
-            r.fmax_mhz.map_or(String::new(), |f| format!("{f:.2}")),
-            r.ice40_too_big,
-            r.pareto_cost,
-            r.pareto_speed
-        );
-    }
-    s
 }
 
 /// Writes bench.md, bench.csv, bench.json and the plots (PNG and SVG).

@@ -71,7 +71,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let rows = rows?;
     bench::write(&rows, &out)?;
     let p = out.commit()?;
-    print!("{}", bench::markdown(&rows));
+    print!("{}", bench::table::markdown(&rows));
     eprintln!(
         "rmapgen: wrote bench.md, bench.csv, bench.json and plots to {}",
         p.display()

@@ -4,7 +4,9 @@
 use super::generate;
 use super::parse;
 use crate::config::Config;
-use crate::fit::{self, CostKind, Options, Outcome, Target};
+use crate::fit::outcome::Outcome;
+use crate::fit::target::Target;
+use crate::fit::{self, CostKind, Options};
 use crate::model::map_fit::MapFit;
 use crate::scene::Scene;
 use anyhow::Result;

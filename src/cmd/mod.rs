@@ -46,7 +46,7 @@ mod limits_in_help {
     fn help_quotes_the_constants() {
         use crate::render::MAX_SIZE;
         use crate::vectors::{MAX_STAGE_VECTORS, MAX_STREAM_VECTORS};
-        use crate::volume::cast::{MAX_BRICK, MAX_STEP, MIN_STEP};
+        use crate::volume::cast::options::{MAX_BRICK, MAX_STEP, MIN_STEP};
         has::<super::generate::GenerateArgs>("vectors", &format!("[0..={MAX_STAGE_VECTORS}]"));
         has::<super::fit::FitArgs>("vectors", &format!("[0..={MAX_STAGE_VECTORS}]"));
         has::<super::fit::FitArgs>("size", &format!("[{}..={MAX_SIZE}]", super::fit::MIN_SIZE));

@@ -9,8 +9,12 @@ use crate::output::StagedDir;
 use crate::reference::Reference;
 use crate::scene::transfer::Transfer;
 use crate::scene::Scene;
-use crate::volume::cast::{self, CastOptions, Caster, ModelShader, Prepared, Stats};
+use crate::volume::cast::frame::Stats;
+use crate::volume::cast::options::{self, CastOptions};
+use crate::volume::cast::shader::ModelShader;
+use crate::volume::cast::Caster;
 use crate::volume::load::{self, RawFormat};
+use crate::volume::prepared::Prepared;
 use crate::volume::report::{self, VolumeRender};
 use crate::volume::{synthetic, Volume, ENGINE_SCENE_TOML};
 use anyhow::{bail, Context, Result};
@@ -60,13 +64,13 @@ pub struct VolumeArgs {
     #[arg(long, value_name = "N", default_value_t = 512, value_parser = super::parse::count::<u32>())]
     pub size: u32,
     /// Sample step along a ray, in smallest voxel spacings [0.05..=4].
-    #[arg(long, value_name = "S", default_value_t = cast::DEFAULT_STEP, value_parser = super::parse::positive())]
+    #[arg(long, value_name = "S", default_value_t = options::DEFAULT_STEP, value_parser = super::parse::positive())]
     pub step: f64,
     /// Early ray termination: accumulated opacity at which a pixel counts as opaque (0, 1].
-    #[arg(long, value_name = "A", default_value_t = cast::DEFAULT_ERT, value_parser = super::parse::positive())]
+    #[arg(long, value_name = "A", default_value_t = options::DEFAULT_ERT, value_parser = super::parse::positive())]
     pub ert: f64,
     /// Brick side in cells for empty-space skipping [a power of two, 2..=64].
-    #[arg(long, value_name = "N", default_value_t = cast::DEFAULT_BRICK, value_parser = super::parse::count::<usize>())]
+    #[arg(long, value_name = "N", default_value_t = options::DEFAULT_BRICK, value_parser = super::parse::count::<usize>())]
     pub brick: usize,
     /// Turn skipping off (empty space, early termination, unshaded samples): same image,
     /// more work.

@@ -166,7 +166,7 @@ pub struct Report {
     pub worst_error: Option<WorstError>,
     pub classes: Vec<ClassStats>,
     /// Exhaustive runs only: how the intensity error was found (see [`exhaustive`]).
-    pub search: Option<exhaustive::SearchStats>,
+    pub search: Option<exhaustive::error_search::SearchStats>,
     pub seconds: f64,
 }
 

@@ -8,10 +8,11 @@
 //!   quantised to `grad_bits` two's complement: the shader's input, as hardware receives it.
 //! - [`bricks`]: per-brick value ranges for empty-space skipping.
 //! - [`transfer`]: the opacity transfer function of the scene file.
+//! - [`prepared`]: a volume's gradients and bricks, computed once for every view.
 //! - [`camera`] and [`cast`]: orthographic ray casting with trilinear sampling, front-to-back
 //!   compositing, empty-space skipping and early ray termination; each sample is shaded by a
-//!   [`cast::Shader`] (the float reference or the bit-accurate model), or its gradients are
-//!   collected for a batch shader (an RTL simulation, through
+//!   [`cast::shader::Shader`] (the float reference or the bit-accurate model), or its
+//!   gradients are collected for a batch shader (an RTL simulation, through
 //!   [`crate::model::IntensitySource`]).
 //! - [`report`]: one render with every shader, the images, the error statistics and
 //!   `metrics.json`.
@@ -21,6 +22,7 @@ pub mod camera;
 pub mod cast;
 pub mod gradient;
 pub mod load;
+pub mod prepared;
 pub mod report;
 pub mod synthetic;
 

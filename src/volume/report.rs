@@ -5,7 +5,11 @@
 //! [`crate::render::metrics`] and [`crate::render::images`]; the statistics are taken over
 //! the pixels the volume covers (accumulated opacity > 0), as the sphere's over its disc.
 
-use super::cast::{CastOptions, Caster, Frame, ModelShader, Prepared, Stats};
+use super::cast::frame::{Frame, Stats};
+use super::cast::options::CastOptions;
+use super::cast::shader::ModelShader;
+use super::cast::Caster;
+use super::prepared::Prepared;
 use super::VolumeInfo;
 use crate::config::Config;
 use crate::model::IntensitySource;
@@ -364,7 +368,7 @@ mod tests {
     struct AsModel(ModelShader);
     impl IntensitySource for AsModel {
         fn intensities(&self, g: &[[i32; 3]]) -> Result<Vec<u32>> {
-            use crate::volume::cast::Shader;
+            use crate::volume::cast::shader::Shader;
             Ok(g.iter().map(|&g| self.0.intensity(g)).collect())
         }
     }

@@ -2,7 +2,8 @@
 //! follows its definition.
 
 use super::helpers;
-use rmapgen::bench::{self, Row};
+use rmapgen::bench::row::Row;
+use rmapgen::bench::{pareto, table};
 
 fn row(scene: &str, bits: u64, speed: f64, rmse: f64) -> Row {
     Row {
@@ -38,7 +39,7 @@ fn pareto_fronts_per_scene() {
         row("a", 100, 10.0, 2.5), // dominated by the first
         row("b", 900, 1.0, 9.0), // alone in its scene: on both fronts
     ];
-    bench::mark_pareto(&mut rows);
+    pareto::mark_pareto(&mut rows);
     let fronts: Vec<(bool, bool)> = rows
         .iter()
         .map(|r| (r.pareto_cost, r.pareto_speed))
@@ -53,10 +54,10 @@ fn pareto_fronts_per_scene() {
             (true, true)
         ]
     );
-    let md = bench::markdown(&rows);
+    let md = table::markdown(&rows);
     assert_eq!(md.lines().count(), 2 + rows.len());
     assert!(md.lines().nth(2).unwrap().ends_with("| cost |"), "{md}");
-    let csv = bench::csv(&rows);
+    let csv = table::csv(&rows);
     assert_eq!(csv.lines().count(), 1 + rows.len());
     assert!(csv.lines().all(|l| l.split(',').count() == 20), "{csv}");
 }
@@ -69,11 +70,11 @@ fn a_design_too_big_for_the_device_is_a_figure() {
     placed.fmax_mhz = Some(154.44);
     let mut big = row("s", 200, 1.0, 0.5);
     big.ice40_too_big = true;
-    let md = bench::markdown(&[placed.clone(), big.clone()]);
+    let md = table::markdown(&[placed.clone(), big.clone()]);
     let lines: Vec<&str> = md.lines().collect();
     assert!(lines[2].contains("| 1714 | 11 | 154.4 |"), "{md}");
     assert!(lines[3].contains("| does not fit | - | - |"), "{md}");
-    let csv = bench::csv(&[placed, big]);
+    let csv = table::csv(&[placed, big]);
     let last: Vec<&str> = csv.lines().last().unwrap().split(',').collect();
     assert_eq!(
         last[last.len() - 6..last.len() - 2],

@@ -833,10 +833,10 @@ fn readme_limits_table_quotes_the_constants() {
         ),
         format!(
             "`{}..={}` voxels",
-            rmapgen::volume::cast::MIN_STEP,
-            rmapgen::volume::cast::MAX_STEP
+            rmapgen::volume::cast::options::MIN_STEP,
+            rmapgen::volume::cast::options::MAX_STEP
         ),
-        format!("`2..={}`", rmapgen::volume::cast::MAX_BRICK),
+        format!("`2..={}`", rmapgen::volume::cast::options::MAX_BRICK),
         format!("`1..={}`", rmapgen::cmd::volume::MAX_REPEAT),
         format!("`(0, {}]` MHz", rmapgen::cmd::fpga::MAX_FREQ_MHZ),
         format!("`{}` bytes each", rmapgen::vectors::MAX_MAP_FILE_BYTES),

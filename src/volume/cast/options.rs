@@ -1,0 +1,115 @@
+//! How to cast ([`CastOptions`]): image size, sample step, early-ray-termination threshold,
+//! brick size and skipping, with their defaults and allowed ranges. Separate from the caster
+//! because the command line and the report take them without casting.
+
+use anyhow::{ensure, Result};
+use serde::Serialize;
+
+/// Default early-ray-termination threshold.
+pub const DEFAULT_ERT: f64 = 0.99;
+/// Default sample step, in units of the smallest voxel spacing.
+pub const DEFAULT_STEP: f64 = 0.5;
+/// Default brick size (cells per side) for empty-space skipping.
+pub const DEFAULT_BRICK: usize = 8;
+/// Smallest sample step in voxels (`--step`): the samples on a ray, hence the work of a
+/// frame, grow as 1 / step.
+pub const MIN_STEP: f64 = 0.05;
+/// Largest sample step in voxels: beyond it samples skip whole cells.
+pub const MAX_STEP: f64 = 4.0;
+/// Largest brick side in cells (`--brick`): larger bricks are rarely empty.
+pub const MAX_BRICK: usize = 64;
+
+/// How to cast.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct CastOptions {
+    /// Image width and height in pixels.
+    pub size: u32,
+    /// Sample step along a ray, in units of the smallest voxel spacing.
+    pub step: f64,
+    /// Early-ray-termination threshold on the accumulated opacity, in (0, 1].
+    pub ert: f64,
+    /// Cells per brick side for empty-space skipping.
+    pub brick: usize,
+    /// Skip empty space, terminate early and shade only contributing samples.
+    pub skip: bool,
+}
+
+impl Default for CastOptions {
+    fn default() -> Self {
+        CastOptions {
+            size: 512,
+            step: DEFAULT_STEP,
+            ert: DEFAULT_ERT,
+            brick: DEFAULT_BRICK,
+            skip: true,
+        }
+    }
+}
+
+impl CastOptions {
+    pub fn validate(&self) -> Result<()> {
+        ensure!(
+            (1..=crate::render::MAX_SIZE).contains(&self.size),
+            "image size {} is out of range; allowed 1..={}",
+            self.size,
+            crate::render::MAX_SIZE
+        );
+        ensure!(
+            self.step.is_finite() && self.step >= MIN_STEP && self.step <= MAX_STEP,
+            "step {} is out of range; allowed {MIN_STEP}..={MAX_STEP} (voxels)",
+            self.step
+        );
+        ensure!(
+            self.ert > 0.0 && self.ert <= 1.0,
+            "ert {} is out of range; allowed (0, 1]",
+            self.ert
+        );
+        ensure!(
+            (2..=MAX_BRICK).contains(&self.brick) && self.brick.is_power_of_two(),
+            "brick {} is not allowed; give a power of two in 2..={MAX_BRICK}",
+            self.brick
+        );
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn options_are_checked() {
+        let bad = |o: CastOptions| o.validate().unwrap_err().to_string();
+        assert!(bad(CastOptions {
+            size: 0,
+            ..CastOptions::default()
+        })
+        .contains("size 0"));
+        assert!(bad(CastOptions {
+            step: 0.0,
+            ..CastOptions::default()
+        })
+        .contains("step"));
+        assert!(bad(CastOptions {
+            ert: 1.5,
+            ..CastOptions::default()
+        })
+        .contains("ert"));
+        assert!(bad(CastOptions {
+            brick: 1,
+            ..CastOptions::default()
+        })
+        .contains("brick"));
+        assert!(bad(CastOptions {
+            brick: 12,
+            ..CastOptions::default()
+        })
+        .contains("power of two"));
+        CastOptions {
+            brick: 16,
+            ..CastOptions::default()
+        }
+        .validate()
+        .unwrap();
+    }
+}
