@@ -11,7 +11,7 @@
 // 1. The first clock reads the ROM and compares; the next registers the ROM's output; then
 // a * recip + HALF is an adder tree of the partial products (a[j] ? recip << j : 0), one LUT
 // level and one carry chain per level, registered as pipeline_depth = 2 places them
-// (rmapgen::rtl::pipe); the last clock rounds and saturates. Latency 6.
+// (rmapgen::stages::normalise::Plan); the last clock rounds and saturates. Latency 6.
 module normalise (
   input  wire       clk_i,
   input  wire       rst_ni,   // asynchronous, active low: clears valid bits only

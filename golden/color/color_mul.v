@@ -10,7 +10,7 @@
 // The numerator is an adder tree of colour-bit-gated copies of the intensity
 // (c[j] ? i << (j+1) : 0) plus D; the product by K a tree of shifted copies of the numerator,
 // one per set bit of K. One LUT level and one carry chain per level, registered as
-// pipeline_depth = 2 places them (rmapgen::rtl::pipe). Latency 5.
+// pipeline_depth = 2 places them (rmapgen::stages::color_mul::Plan). Latency 5.
 module color_mul (
   input  wire       clk_i,
   input  wire       rst_ni,   // asynchronous, active low: clears valid bits only

@@ -10,7 +10,7 @@
 // i = (e00*S*S + (e10-e00)*wu*S + ...) rounded half up, as in the model. Each pass is an adder
 // tree of weight-gated partial products (w[j] ? e << j : 0), all unsigned, one LUT level and
 // one carry chain per level, registered as pipeline_depth = 2 places them
-// (rmapgen::rtl::pipe). Latency 7.
+// (rmapgen::stages::interpolate::Plan). Latency 7.
 module interpolate (
   input  wire       clk_i,
   input  wire       rst_ni,   // asynchronous, active low: clears valid bits only

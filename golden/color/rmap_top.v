@@ -41,7 +41,7 @@ module rmap_top (
   localparam P   = 3;  // interpolation weight fraction bits
   localparam C   = 8;  // colour channel width
 
-  // Sideband delays, from rmapgen::rtl::latency (the stage latencies above).
+  // Sideband delays, from rmapgen::stages::rmap_top (the stage latencies above).
   localparam SIGN_DELAY = 8;  // sort_shift out to map_lookup in
   localparam BUF_DELAY  = 12;  // accept to map_lookup in
   localparam ZERO_DELAY = 27;  // zero_detect out to the output register

@@ -43,7 +43,7 @@ module rmap_top (
   localparam M   = 8;  // map entry and intensity width
   localparam P   = 3;  // interpolation weight fraction bits
 
-  // Sideband delays, from rmapgen::rtl::latency (the stage latencies above).
+  // Sideband delays, from rmapgen::stages::rmap_top (the stage latencies above).
   localparam SIGN_DELAY = 8;  // sort_shift out to map_lookup in
   localparam BUF_DELAY  = 12;  // accept to map_lookup in
   localparam ZERO_DELAY = 22;  // zero_detect out to the output register

@@ -8,7 +8,7 @@
 // i = (e00*S*S + (e10-e00)*wu*S + ...) rounded half up, as in the model. Each pass is an adder
 // tree of weight-gated partial products (w[j] ? e << j : 0), all unsigned, one LUT level and
 // one carry chain per level, registered as pipeline_depth = {= depth =} places them
-// (rmapgen::rtl::pipe). Latency {= latency =}.
+// (rmapgen::stages::interpolate::Plan). Latency {= latency =}.
 module interpolate (
 {= h.ports =}
 );

@@ -6,7 +6,7 @@
 // all-ones code (tan = 1) goes to the border exactly: it is read as u' = 2^F, which gives
 // p = POS_MAX. The constant POS_MAX = (2^I - 1) * 2^P makes u' * POS_MAX a sum of I shifted
 // copies of u', an adder tree registered as pipeline_depth = {= depth =} places it
-// (rmapgen::rtl::pipe). Latency {= latency =}.
+// (rmapgen::stages::linear_index::Plan). Latency {= latency =}.
 module linear_index (
 {= h.ports =}
 );

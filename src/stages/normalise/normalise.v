@@ -8,7 +8,7 @@
 // 1. The first clock reads the ROM and compares;{% if rom_reg %} the next registers the ROM's output;{% endif %} then
 // a * recip + HALF is an adder tree of the partial products (a[j] ? recip << j : 0), one LUT
 // level and one carry chain per level, registered as pipeline_depth = {= depth =} places them
-// (rmapgen::rtl::pipe); the last clock rounds and saturates. Latency {= latency =}.
+// (rmapgen::stages::normalise::Plan); the last clock rounds and saturates. Latency {= latency =}.
 module normalise (
 {= h.ports =}
 );

@@ -33,7 +33,7 @@ module rmap_top (
   localparam C   = {= c =};  // colour channel width
 {%- endif %}
 
-  // Sideband delays, from rmapgen::rtl::latency (the stage latencies above).
+  // Sideband delays, from rmapgen::stages::rmap_top (the stage latencies above).
   localparam SIGN_DELAY = {= sign_delay =};  // sort_shift out to map_lookup in
   localparam BUF_DELAY  = {= buf_delay =};  // accept to map_lookup in
   localparam ZERO_DELAY = {= zero_delay =};  // zero_detect out to the output register
