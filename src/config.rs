@@ -34,7 +34,7 @@ pub struct Config {
     /// results do not depend on it): 0 compact (fewest registers, lowest latency), 1 adds a
     /// register after every memory read and after every second adder level of the
     /// multipliers, 2 (the default) registers every adder level. Range [`PIPELINE_DEPTHS`];
-    /// `rtl::pipe` places the registers and `rtl::latency` counts them.
+    /// each stage's `Plan` places the registers and its `Unit::latency` counts them.
     pub pipeline_depth: u32,
     /// A valid/ready handshake (AXI-Stream style) on the top: `ready_o` tells the source a
     /// sample is accepted, `ready_i` low stalls the whole pipeline. Off: a plain valid

@@ -1,7 +1,7 @@
 //! The address layout of a per-axis map, defined once: `{s_max, s_u, i_u, s_v, i_v}`, signs
 //! one bit each and indices `index_bits` each (`3 + 2 * index_bits` bits). The map builders
 //! write entries at these addresses, the look-up stage reads them, and the RTL's banks
-//! (`rtl::banks`) split the same fields across their four memories.
+//! (`stages::map_bank::banks`) split the same fields across their four memories.
 
 use crate::config::Config;
 

@@ -1,4 +1,4 @@
-//! The generated design as IP a team adopts (src/rtl/pipe.rs, fpga.rs, package.rs): every
+//! The generated design as IP a team adopts (src/stages/, src/rtl/fpga.rs, package.rs): every
 //! pipeline depth passes every testbench; the valid/ready handshake passes under random
 //! backpressure and its testbench catches a broken queue; the FuseSoC core and README list
 //! what the directory holds; +vcd writes a waveform; the iCE40 flow reports a missed target as
