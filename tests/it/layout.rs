@@ -171,3 +171,73 @@ fn a_planted_cycle_is_found() {
     assert!(!g["scene"].contains("config"), "comments are not uses");
     assert!(g["scene"].contains("model"));
 }
+
+/// The imports that point upward: `config` using anything but `toml_input`, or a stage's
+/// bit-accurate model (`stages::<stage>::model`, the definition the generator, the vectors and
+/// the renders build on) reaching back into any of them or into a stage's generator unit.
+fn upward_imports(g: &BTreeMap<String, BTreeSet<String>>) -> Vec<String> {
+    let mut out = Vec::new();
+    for d in g.get("config").into_iter().flatten() {
+        if d != "toml_input" {
+            out.push(format!("config -> {d}"));
+        }
+    }
+    let above = [
+        "rtl", "vectors", "cmd", "render", "volume", "fit", "bench", "stress",
+    ];
+    for (m, deps) in g {
+        if !(m.starts_with("stages::") && m.ends_with("::model")) {
+            continue;
+        }
+        for d in deps {
+            let top = d.split("::").next().unwrap_or("");
+            let unit = d.starts_with("stages::") && !d.ends_with("::model");
+            if above.contains(&top) || unit {
+                out.push(format!("{m} -> {d}"));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn config_and_the_stage_models_import_nothing_above_them() {
+    let g = graph(&modules(&crate::helpers::root().join("src")));
+    let models = g
+        .keys()
+        .filter(|m| m.starts_with("stages::") && m.ends_with("::model"))
+        .count();
+    assert!(models >= 9, "found {models} stage models");
+    assert_eq!(upward_imports(&g), Vec::<String>::new());
+}
+
+#[test]
+fn planted_upward_imports_are_found() {
+    let mods: BTreeMap<String, String> = [
+        (
+            "config",
+            "use crate::toml_input;\nuse crate::rtl::ports::Port;\n",
+        ),
+        ("toml_input", ""),
+        ("rtl", ""),
+        ("rtl::ports", ""),
+        ("stages", ""),
+        ("stages::normalise", "use crate::rtl::ports::Port;\n"),
+        ("stages::normalise::model", "use crate::config::Config;\n"),
+        ("stages::sort_shift", ""),
+        (
+            "stages::sort_shift::model",
+            "use crate::stages::normalise::Plan;\n",
+        ),
+    ]
+    .into_iter()
+    .map(|(a, b)| (a.to_string(), b.to_string()))
+    .collect();
+    assert_eq!(
+        upward_imports(&graph(&mods)),
+        [
+            "config -> rtl::ports",
+            "stages::sort_shift::model -> stages::normalise"
+        ]
+    );
+}
