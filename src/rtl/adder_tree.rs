@@ -320,6 +320,14 @@ impl Sum {
     }
 }
 
+/// The suffix of a stage's registers at the end of its clock `clock`: `q<clock>` (`a_q2` is
+/// `a` registered in the second clock). A plan names the registers its trees read with it and
+/// hands the suffix to the template, which declares them under that name, so no register
+/// name is spelled in both places.
+pub fn clock_q(clock: u32) -> String {
+    format!("q{clock}")
+}
+
 /// Registered adder levels among `steps`: the clocks the trees add to a stage's latency.
 pub fn registered(steps: &[Step]) -> u32 {
     steps.iter().filter(|s| s.registered).count() as u32

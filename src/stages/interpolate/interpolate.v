@@ -25,19 +25,19 @@ module interpolate (
   assign wvc_d = S - wv_i;
 {%- if in_reg %}
 
-  reg [M-1:0] e00_q1, e10_q1, e01_q1, e11_q1;
-  reg [P:0]   wu_q1, wv_q1, wuc_q1, wvc_q1;
+  reg [M-1:0] e00_{= in_q =}, e10_{= in_q =}, e01_{= in_q =}, e11_{= in_q =};
+  reg [P:0]   wu_{= in_q =}, wv_{= in_q =}, wuc_{= in_q =}, wvc_{= in_q =};
 
   always @(posedge clk_i) begin
     if (en_i) begin
-      e00_q1 <= e00_i;
-      e10_q1 <= e10_i;
-      e01_q1 <= e01_i;
-      e11_q1 <= e11_i;
-      wu_q1  <= wu_i;
-      wv_q1  <= wv_i;
-      wuc_q1 <= wuc_d;
-      wvc_q1 <= wvc_d;
+      e00_{= in_q =} <= e00_i;
+      e10_{= in_q =} <= e10_i;
+      e01_{= in_q =} <= e01_i;
+      e11_{= in_q =} <= e11_i;
+      wu_{= in_q =}  <= wu_i;
+      wv_{= in_q =}  <= wv_i;
+      wuc_{= in_q =} <= wuc_d;
+      wvc_{= in_q =} <= wvc_d;
     end
   end
 {%- endif %}

@@ -29,6 +29,7 @@ struct Verilog {
     s: u32,
     rw: u32,
     in_reg: bool,
+    in_q: String,
     steps: Vec<Step>,
     sum_r: String,
 }
@@ -69,6 +70,7 @@ impl Unit for Interpolate {
             s: cfg.step(),
             rw: cfg.interp_r_bits(),
             in_reg: p.in_reg,
+            in_q: p.in_q.clone(),
             sum_r: p.sum_r.expr(cfg.interp_r_bits()),
             steps: p.steps,
         }

@@ -5,10 +5,14 @@
 //! products.
 
 use crate::config::Config;
-use crate::rtl::adder_tree::{self, registered, registered_at, Sig, Step, Sum, Term, Tree};
+use crate::rtl::adder_tree::{
+    self, clock_q, registered, registered_at, Sig, Step, Sum, Term, Tree,
+};
 
 pub struct Plan {
     pub in_reg: bool,
+    /// The suffix of the registered inputs and complements (with `in_reg`).
+    pub in_q: String,
     pub steps: Vec<Step>,
     pub sum_r: Sum,
     pub latency: u32,
@@ -21,9 +25,10 @@ impl Plan {
         let p = cfg.interp_bits;
         let m = cfg.map_bits;
         let s = cfg.step() as u128;
+        let in_q = clock_q(1);
         let sfx = |n: &str| {
             if in_reg {
-                format!("{n}_q1")
+                format!("{n}_{in_q}")
             } else if n.starts_with('w') && n.ends_with('c') {
                 format!("{n}_d")
             } else {
@@ -98,6 +103,7 @@ impl Plan {
         let latency = in_reg as u32 + registered(&steps);
         Plan {
             in_reg,
+            in_q: in_q.clone(),
             sum_r: bv.sums[0].clone(),
             steps,
             latency,

@@ -22,12 +22,12 @@ module linear_index (
   assign vx_d = (v_i == {F{1'b1}}) ? {1'b1, {F{1'b0}}} : {1'b0, v_i};
 {%- if pre_reg %}
 
-  reg [F:0] ux_q1, vx_q1;
+  reg [F:0] ux_{= in_q =}, vx_{= in_q =};
 
   always @(posedge clk_i) begin
     if (en_i) begin
-      ux_q1 <= ux_d;
-      vx_q1 <= vx_d;
+      ux_{= in_q =} <= ux_d;
+      vx_{= in_q =} <= vx_d;
     end
   end
 {%- endif %}

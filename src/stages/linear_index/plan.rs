@@ -4,10 +4,14 @@
 //! tree of I shifted copies of u'.
 
 use crate::config::Config;
-use crate::rtl::adder_tree::{self, registered, registered_at, Sig, Step, Sum, Term, Tree};
+use crate::rtl::adder_tree::{
+    self, clock_q, registered, registered_at, Sig, Step, Sum, Term, Tree,
+};
 
 pub struct Plan {
     pub pre_reg: bool,
+    /// The suffix of u' and v' registered (with `pre_reg`); the trees read `_d` without.
+    pub in_q: String,
     pub steps: Vec<Step>,
     pub sum_u: Sum,
     pub sum_v: Sum,
@@ -18,7 +22,8 @@ impl Plan {
     pub fn new(cfg: &Config) -> Plan {
         let d = cfg.pipeline_depth;
         let pre_reg = d >= 1;
-        let sfx = if pre_reg { "q1" } else { "d" };
+        let in_q = clock_q(1);
+        let sfx = if pre_reg { in_q.as_str() } else { "d" };
         let tree = |name: &str, x: &str| Tree {
             name: name.into(),
             terms: (0..cfg.index_bits)
@@ -38,6 +43,7 @@ impl Plan {
         let latency = pre_reg as u32 + registered(&b.steps);
         Plan {
             pre_reg,
+            in_q: in_q.clone(),
             sum_u: b.sums[0].clone(),
             sum_v: b.sums[1].clone(),
             steps: b.steps,

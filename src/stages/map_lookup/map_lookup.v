@@ -114,20 +114,20 @@ module map_lookup (
 
   // ---------------------------------------------------------------- stage 3
   // The block RAMs' clock-to-output is slow; the neighbour reorder starts from a register.
-  reg [M-1:0] d00_q3, d10_q3, d01_q3, d11_q3;
-  reg         odd_u_q3, odd_v_q3;
-  reg [P:0]   wu_q3, wv_q3;
+  reg [M-1:0] d00_{= rd =}, d10_{= rd =}, d01_{= rd =}, d11_{= rd =};
+  reg         odd_u_{= rd =}, odd_v_{= rd =};
+  reg [P:0]   wu_{= rd =}, wv_{= rd =};
 
   always @(posedge clk_i) begin
     if (en_i) begin
-      d00_q3   <= d00_q2;
-      d10_q3   <= d10_q2;
-      d01_q3   <= d01_q2;
-      d11_q3   <= d11_q2;
-      odd_u_q3 <= odd_u_q2;
-      odd_v_q3 <= odd_v_q2;
-      wu_q3    <= wu_q2;
-      wv_q3    <= wv_q2;
+      d00_{= rd =}   <= d00_q2;
+      d10_{= rd =}   <= d10_q2;
+      d01_{= rd =}   <= d01_q2;
+      d11_{= rd =}   <= d11_q2;
+      odd_u_{= rd =} <= odd_u_q2;
+      odd_v_{= rd =} <= odd_v_q2;
+      wu_{= rd =}    <= wu_q2;
+      wv_{= rd =}    <= wv_q2;
     end
   end
 {%- endif %}
@@ -204,11 +204,11 @@ module map_lookup (
 
   // ---------------------------------------------------------------- stage 3
   // The block RAM's clock-to-output is slow: a fabric register follows it.
-  reg [M-1:0] d_q3;
+  reg [M-1:0] d_{= rd =};
 
   always @(posedge clk_i) begin
     if (en_i) begin
-      d_q3 <= d_q2;
+      d_{= rd =} <= d_q2;
     end
   end
 {%- endif %}

@@ -10,6 +10,7 @@ use super::unit::{port_of, Head, Memory, Unit, Vectors};
 use crate::config::Config;
 use crate::model::{MapSet, Model};
 use crate::rng::SplitMix64;
+use crate::rtl::adder_tree::clock_q;
 use crate::rtl::ports::{i, o, stage_head, Port};
 use crate::vectors::field::Field;
 use crate::vectors::inputs::{corner_traces, position_corners};
@@ -35,11 +36,6 @@ impl Plan {
     /// The number of the output stage, which is the latency.
     pub fn out_stage(self) -> u32 {
         3 + self.bank_reg as u32
-    }
-
-    /// The register suffix of a stage's values, `q<stage>`.
-    fn q(stage: u32) -> String {
-        format!("q{stage}")
     }
 }
 
@@ -147,8 +143,8 @@ impl Unit for MapLookup {
             latency: out,
             bank_reg: plan.bank_reg,
             out,
-            rd: Plan::q(out - 1),
-            out_q: Plan::q(out),
+            rd: clock_q(out - 1),
+            out_q: clock_q(out),
             interpolation: cfg.interpolation,
             i: cfg.index_bits,
             p: cfg.interp_bits,

@@ -45,17 +45,17 @@ module normalise (
 
   // ---------------------------------------------------------------- ROM output register
   // The block RAM's clock-to-output is slow; the multipliers start from a fabric register.
-  reg [W-1:0] recip_q2;
-  reg [R-1:0] a_q2, b_q2;
-  reg         a_max_q2, b_max_q2;
+  reg [W-1:0] recip_{= tree_q =};
+  reg [R-1:0] a_{= tree_q =}, b_{= tree_q =};
+  reg         a_max_{= tree_q =}, b_max_{= tree_q =};
 
   always @(posedge clk_i) begin
     if (en_i) begin
-      recip_q2 <= recip_q1;
-      a_q2     <= a_q1;
-      b_q2     <= b_q1;
-      a_max_q2 <= a_max_q1;
-      b_max_q2 <= b_max_q1;
+      recip_{= tree_q =} <= recip_q1;
+      a_{= tree_q =}     <= a_q1;
+      b_{= tree_q =}     <= b_q1;
+      a_max_{= tree_q =} <= a_max_q1;
+      b_max_{= tree_q =} <= b_max_q1;
     end
   end
 {%- endif %}

@@ -4,10 +4,15 @@
 //! into the output register. The template renders this plan and the latency counts it.
 
 use crate::config::Config;
-use crate::rtl::adder_tree::{self, registered, registered_at, Built, Sig, Step, Sum, Term, Tree};
+use crate::rtl::adder_tree::{
+    self, clock_q, registered, registered_at, Built, Sig, Step, Sum, Term, Tree,
+};
 
 pub struct Plan {
     pub rom_reg: bool,
+    /// The suffix of the registers the trees read: the ROM read's (`q1`), or the ROM output
+    /// register's (`q2`) with `rom_reg`.
+    pub tree_q: String,
     pub steps: Vec<Step>,
     /// The sums a * recip + HALF and b * recip + HALF.
     pub sum_a: Sum,
@@ -22,7 +27,8 @@ impl Plan {
     pub fn new(cfg: &Config) -> Plan {
         let d = cfg.pipeline_depth;
         let rom_reg = d >= 1;
-        let q = if rom_reg { "q2" } else { "q1" };
+        let tree_q = clock_q(1 + rom_reg as u32);
+        let q = &tree_q;
         let recip = Sig::new(format!("recip_{q}"), cfg.recip_bits);
         let tree = |name: &str, x: &str| Tree {
             name: name.into(),
@@ -56,6 +62,7 @@ impl Plan {
         let latency = 1 + rom_reg as u32 + registered(&steps) + 1;
         Plan {
             rom_reg,
+            tree_q: tree_q.clone(),
             sum_a: sums[0].clone(),
             sum_b: sums[1].clone(),
             a_max: riders[0].clone(),
