@@ -80,17 +80,19 @@ pub fn run(a: &SimArgs) -> Result<ExitCode> {
     if !opts.runs_something() {
         bail!("nothing to run: give --icarus, --verilator or --stream N");
     }
-    if let Some(tool) = opts.missing_tools().first() {
-        bail!("{tool} not found (make tools installs it)");
-    }
+    // Bad input first, then the tools, then the runs.
     let failed = if a.matrix {
-        matrix(a, &opts)?
+        let rows = selected_rows(&a.row)?;
+        need_tools(&opts)?;
+        matrix(a, &opts, &rows)?
     } else {
         let dir = a
             .dir
             .as_deref()
             .expect("clap requires DIR without --matrix");
         let design = DesignDir::open(dir)?;
+        check_only(&design, &opts)?;
+        need_tools(&opts)?;
         !simulate(&design, a, &opts)?.failed.is_empty()
     };
     Ok(if failed {
@@ -100,9 +102,15 @@ pub fn run(a: &SimArgs) -> Result<ExitCode> {
     })
 }
 
-/// The runs on one design, its build products staged into BUILD/<name>; prints as it goes
-/// and the summary at the end.
-fn simulate(design: &DesignDir, a: &SimArgs, opts: &Options) -> Result<Outcome> {
+fn need_tools(opts: &Options) -> Result<()> {
+    match opts.missing_tools().first() {
+        Some(tool) => bail!("{tool} not found (make tools installs it)"),
+        None => Ok(()),
+    }
+}
+
+/// `--only MODULE` names a testbench of the design.
+fn check_only(design: &DesignDir, opts: &Options) -> Result<()> {
     if let Some(m) = opts.only.as_deref() {
         anyhow::ensure!(
             design.testbench(m).is_file(),
@@ -111,6 +119,13 @@ fn simulate(design: &DesignDir, a: &SimArgs, opts: &Options) -> Result<Outcome> 
             design.path().display()
         );
     }
+    Ok(())
+}
+
+/// The runs on one design, its build products staged into BUILD/<name>; prints as it goes
+/// and the summary at the end.
+fn simulate(design: &DesignDir, a: &SimArgs, opts: &Options) -> Result<Outcome> {
+    check_only(design, opts)?;
     let target = a.build.join(design.name());
     let staged = StagedDir::new(&target, &a.force.policy(&[Some(design.path())]))?;
     let build = absolute(staged.path());
@@ -133,11 +148,10 @@ fn simulate(design: &DesignDir, a: &SimArgs, opts: &Options) -> Result<Outcome> 
 
 /// Every selected row of the grid: generated into DIR/<row>, then simulated. Whether any
 /// failed.
-fn matrix(a: &SimArgs, opts: &Options) -> Result<bool> {
-    let rows = selected_rows(&a.row)?;
+fn matrix(a: &SimArgs, opts: &Options, rows: &[GridRow]) -> Result<bool> {
     let root = a.dir.clone().unwrap_or_else(|| "build/matrix".into());
     let mut failed = Vec::new();
-    for r in &rows {
+    for r in rows {
         println!("==== {}: {} ({})", r.name, r.config.summary(), r.covers);
         let design = generate_row(r, &root.join(r.name), a)?;
         if !simulate(&design, a, opts)?.failed.is_empty() {
