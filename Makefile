@@ -41,15 +41,20 @@ roms: build
 test: tools cargo-test lint synth sim-all sim-handshake fpga-check
 	@echo "make test: all checks passed"
 
-# ---- Simulation (tb/run_sims.sh): every testbench of the design generated with $(GEN_FLAGS)
-# into $(SIM_OUT) (not the committed rtl_out/), under Verilator (sim), Icarus (sim-icarus) or
-# both (sim-all); build products in build/sim/. sim-matrix runs both simulators over the
-# configuration list of tb/sim_matrix.sh (into build/matrix/).
+# ---- Simulation (rmapgen sim, src/sim/): every testbench of the design generated with
+# $(GEN_FLAGS) into $(SIM_OUT) (not the committed rtl_out/), under Verilator (sim), Icarus
+# (sim-icarus) or both (sim-all); build products and logs in $(SIM_BUILD)/<design>.
+# sim-matrix runs both simulators over every configuration of the parameter grid (src/grid.rs),
+# generated into $(MATRIX_OUT)/<row>; MATRIX_ROWS=a,b picks rows.
 GEN_FLAGS     ?=
 SIM_OUT       ?= build/rtl_sim
+SIM_BUILD     ?= build/sim
 SIM_STREAM    ?= 1000000
 SIM_TB_STREAM ?= 100000
-SIM_ENV        = IVERILOG=$(IVERILOG) VVP=$(VVP) VERILATOR=$(VERILATOR) RMAPGEN=$(abspath $(RMAPGEN))
+MATRIX_OUT    ?= build/matrix
+MATRIX_ROWS   ?=
+SIM_ENV        = IVERILOG=$(IVERILOG) VVP=$(VVP) VERILATOR=$(VERILATOR)
+SIM            = $(SIM_ENV) $(RMAPGEN) sim --build $(SIM_BUILD)
 
 .PHONY: sim sim-icarus sim-all sim-matrix sim-gen
 
@@ -59,20 +64,21 @@ sim-gen: build
 # Verilator: every testbench, the top's on $(SIM_TB_STREAM) more vectors, and the C++ harness
 # on $(SIM_STREAM) random vectors.
 sim: sim-gen
-	$(SIM_ENV) tb/run_sims.sh --verilator --stream $(SIM_STREAM) --tb-stream $(SIM_TB_STREAM) $(SIM_OUT)
+	$(SIM) --verilator --stream $(SIM_STREAM) --tb-stream $(SIM_TB_STREAM) $(SIM_OUT)
 
 sim-icarus: sim-gen
-	$(SIM_ENV) tb/run_sims.sh --icarus --tb-stream $(SIM_TB_STREAM) $(SIM_OUT)
+	$(SIM) --icarus --tb-stream $(SIM_TB_STREAM) $(SIM_OUT)
 
 sim-all: sim-gen
-	$(SIM_ENV) tb/run_sims.sh --icarus --verilator --stream $(SIM_STREAM) --tb-stream $(SIM_TB_STREAM) $(SIM_OUT)
+	$(SIM) --icarus --verilator --stream $(SIM_STREAM) --tb-stream $(SIM_TB_STREAM) $(SIM_OUT)
 
 sim-matrix: build
-	$(SIM_ENV) STREAM=$(SIM_STREAM) tb/sim_matrix.sh
+	$(SIM) --matrix $(if $(MATRIX_ROWS),--row $(MATRIX_ROWS)) --icarus --verilator --stream $(SIM_STREAM) $(MATRIX_OUT)
 
 # ---- Design (src/rtl, templates/): the default design into $(OUT); Verilator lint of its
-# .v files (testbenches excluded; any warning fails); Yosys synthesis of rmap_top for the
-# iCE40 (any latch fails; prints cells, memory bits and SB_RAM40_4K; logs in $(SYNTH_DIR)).
+# .v files (rmapgen lint: testbenches excluded; any warning fails); Yosys synthesis of rmap_top
+# for the iCE40 (rmapgen synth: any latch fails; prints cells, memory bits and SB_RAM40_4K;
+# logs in $(SYNTH_DIR)).
 SYNTH_DIR ?= build/synth
 
 .PHONY: generate lint synth
@@ -85,13 +91,11 @@ generate: build
 golden: generate
 	for d in golden/*/; do $(RMAPGEN) generate --config $$d/tb/config.toml --out $$d || exit 1; done
 
-lint:
-	@test -f $(OUT)/rmap_top.v || { echo "lint: no $(OUT)/rmap_top.v; run 'make generate'" >&2; exit 1; }
-	cd $(OUT) && $(VERILATOR) --lint-only -Wall --top-module rmap_top *.v
-	@echo "lint: $(OUT) is clean (verilator -Wall, no warnings)"
+lint: build
+	VERILATOR=$(VERILATOR) $(RMAPGEN) lint $(OUT)
 
-synth:
-	YOSYS=$(YOSYS) scripts/synth.sh $(OUT) $(SYNTH_DIR)
+synth: build
+	YOSYS=$(YOSYS) $(RMAPGEN) synth --logs $(SYNTH_DIR) $(OUT)
 
 # ---- Flow control: the default configuration with the valid/ready handshake (--handshake)
 # into $(HS_OUT); its top testbench on $(SIM_TB_STREAM) vectors under random backpressure in
@@ -102,7 +106,7 @@ HS_OUT ?= build/rtl_handshake
 
 sim-handshake: build
 	$(RMAPGEN) generate --out $(HS_OUT) --handshake $(GEN_FLAGS)
-	$(SIM_ENV) tb/run_sims.sh --icarus --verilator --only rmap_top --stream $(SIM_STREAM) --tb-stream $(SIM_TB_STREAM) $(HS_OUT)
+	$(SIM) --icarus --verilator --only rmap_top --stream $(SIM_STREAM) --tb-stream $(SIM_TB_STREAM) $(HS_OUT)
 
 # ---- FPGA (src/rtl/fpga.rs): Yosys synth_ice40 and nextpnr-ice40 on $(OUT): post-route Fmax,
 # logic cells, block RAMs, critical path; fails if a ROM or map bank is not in block RAM (a
@@ -125,14 +129,13 @@ fpga-check: build
 	@WITH_FPGA=1 scripts/install-tools.sh
 	YOSYS=$(YOSYS) $(RMAPGEN) fpga $(FPGA_ARGS) --require-timing
 
-# ---- Waves: the top testbench of $(SIM_OUT) under Icarus with +vcd=, for GTKWave.
-WAVE ?= build/wave/rmap_top.vcd
+# ---- Waves: the top testbench of $(SIM_OUT) under Icarus with +vcd=, for GTKWave, into
+# $(WAVE_DIR)/<design>/icarus/rmap_top_tb.vcd.
+WAVE_DIR ?= build/wave
+WAVE      = $(WAVE_DIR)/$(notdir $(SIM_OUT))/icarus/rmap_top_tb.vcd
 
 .PHONY: wave
 
 wave: sim-gen
-	@mkdir -p $(dir $(WAVE)) build/wave
-	$(IVERILOG) -g2005 -Wall -Wno-timescale -s rmap_top_tb -o build/wave/rmap_top_tb.vvp $(SIM_OUT)/tb/rmap_top_tb.v $(filter-out $(SIM_OUT)/tb/%,$(wildcard $(SIM_OUT)/*.v))
-	cd $(SIM_OUT) && $(VVP) -N $(abspath build/wave/rmap_top_tb.vvp) +vcd=$(abspath $(WAVE)) > $(abspath build/wave/run.log)
-	@tail -n 1 build/wave/run.log
+	$(SIM_ENV) $(RMAPGEN) sim --build $(WAVE_DIR) --icarus --only rmap_top --vcd $(SIM_OUT)
 	@echo "wave: $(WAVE) (gtkwave $(WAVE))"

@@ -48,22 +48,41 @@ enum Command {
     /// measured in order of cost until the first meets the target, so every cheaper one is
     /// measured and rejected. Exit 2 with the lowest error reachable when none does.
     Fit(cmd::fit::FitArgs),
+    /// Run the self-checking testbenches of a generated design under Icarus Verilog and/or
+    /// Verilator, and the Verilator C++ harness on a random stream of top vectors; exit 1 if
+    /// any run fails.
+    ///
+    /// A run passes when the simulator exits 0 and its last line is `N passed, 0 failed`
+    /// with N > 0. With --matrix, every configuration of the parameter grid is generated and
+    /// simulated in turn.
+    Sim(cmd::sim::SimArgs),
+    /// Synthesise a generated design with Yosys as a check: no latch, the memories inferred;
+    /// prints its cells, memory bits and block RAMs (exit 1 if Yosys fails on it).
+    Synth(cmd::synth::SynthArgs),
+    /// Lint a generated design with Verilator --lint-only -Wall (exit 1 on any warning).
+    Lint(cmd::lint::LintArgs),
 }
 
-fn run(cli: Cli) -> anyhow::Result<()> {
+fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     // Staged output is removed on Ctrl-C, SIGTERM and SIGHUP (src/output/signals.rs).
     rmapgen::output::signals::install()
         .map_err(|e| anyhow::anyhow!("cannot install the signal handler: {e}"))?;
+    // Commands that check a design exit 1 when the design fails the check; the others have
+    // only success and bad input.
+    let done = |r: anyhow::Result<()>| r.map(|()| ExitCode::SUCCESS);
     match cli.command {
-        Command::Generate(a) => cmd::generate::run(&a),
-        Command::Roms(a) => cmd::roms::run(&a),
-        Command::Render(a) => cmd::render::run(&a),
-        Command::Vectors(a) => cmd::vectors::run(&a),
-        Command::Stress(a) => cmd::stress::run(&a),
-        Command::Bench(a) => cmd::bench::run(&a),
-        Command::Fpga(a) => cmd::fpga::run(&a),
-        Command::Fit(a) => cmd::fit::run(&a),
-        Command::Volume(a) => cmd::volume::run(&a),
+        Command::Generate(a) => done(cmd::generate::run(&a)),
+        Command::Roms(a) => done(cmd::roms::run(&a)),
+        Command::Render(a) => done(cmd::render::run(&a)),
+        Command::Vectors(a) => done(cmd::vectors::run(&a)),
+        Command::Stress(a) => done(cmd::stress::run(&a)),
+        Command::Bench(a) => done(cmd::bench::run(&a)),
+        Command::Fpga(a) => done(cmd::fpga::run(&a)),
+        Command::Fit(a) => done(cmd::fit::run(&a)),
+        Command::Volume(a) => done(cmd::volume::run(&a)),
+        Command::Sim(a) => cmd::sim::run(&a),
+        Command::Synth(a) => cmd::synth::run(&a),
+        Command::Lint(a) => cmd::lint::run(&a),
     }
 }
 
@@ -160,7 +179,7 @@ fn main() -> ExitCode {
         Err(code) => return code,
     };
     match run(cli) {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(code) => code,
         Err(e) => {
             // One line, the whole cause chain.
             let msg = format!("{e:#}").replace(['\n', '\r'], " ");

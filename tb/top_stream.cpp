@@ -1,9 +1,10 @@
 // top_stream.cpp: streams a large vector file through the Verilated rmap_top, one sample per
 // clock, and compares every output with the model's expectation.
 //
-// Build (tb/run_sims.sh does this once per configuration):
-//   verilator --cc --exe --build -O3 --top-module rmap_top <out>/*.v tb/top_stream.cpp \
-//             -CFLAGS "-O2 -I<out>/tb" -Mdir build/... -o top_stream
+// Built and run by `rmapgen sim --stream N` (src/sim/), which embeds this file; the Verilator
+// command line is rmapgen::toolchain::verilator::harness:
+//   verilator --cc --exe --build -O3 ... --top-module rmap_top <out>/*.v top_stream.cpp \
+//             -CFLAGS "-O2 -I<out>/tb" --Mdir build/... -o top_stream
 // Run from the generated directory (the design's $readmemh files and map2_<axis>.hex resolve
 // against it):
 //   top_stream VECTOR_FILE

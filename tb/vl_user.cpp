@@ -1,5 +1,6 @@
 // vl_user.cpp: Verilator's $finish and $stop for the self-checking testbenches, compiled in
-// with -CFLAGS -DVL_USER_FINISH -CFLAGS -DVL_USER_STOP (see tb/run_sims.sh).
+// with -CFLAGS -DVL_USER_FINISH -CFLAGS -DVL_USER_STOP (rmapgen::toolchain::verilator::binary,
+// which embeds this file).
 //
 // The default $finish prints "- tb.v:N: Verilog $finish" after the testbench's verdict; this
 // one prints nothing, so `N passed, M failed` stays the last line. The default $stop (and

@@ -45,6 +45,41 @@ pub struct ConfigArgs {
 }
 
 impl ConfigArgs {
+    /// The flags that give `cfg` (those that differ from the default; `--interp-bits 0` is
+    /// implied by `--no-interpolation`), for `generate` and the other commands that take them.
+    pub fn flags(cfg: &Config) -> Vec<String> {
+        let d = Config::default();
+        let mut f = Vec::new();
+        for (name, v) in [
+            ("grad_bits", cfg.grad_bits),
+            ("red_bits", cfg.red_bits),
+            ("recip_bits", cfg.recip_bits),
+            ("frac_bits", cfg.frac_bits),
+            ("index_bits", cfg.index_bits),
+            ("interp_bits", cfg.interp_bits),
+            ("map_bits", cfg.map_bits),
+        ] {
+            let implied = name == "interp_bits" && !cfg.interpolation && v == 0;
+            if v != d.field(name) && !implied {
+                f.extend([format!("--{}", name.replace('_', "-")), v.to_string()]);
+            }
+        }
+        if cfg.pipeline_depth != d.pipeline_depth {
+            f.extend(["--pipeline-depth".into(), cfg.pipeline_depth.to_string()]);
+        }
+        for (on, flag) in [
+            (!cfg.compensation, "--no-compensation"),
+            (!cfg.interpolation, "--no-interpolation"),
+            (cfg.color, "--color"),
+            (cfg.handshake, "--handshake"),
+        ] {
+            if on {
+                f.push(flag.into());
+            }
+        }
+        f
+    }
+
     /// The configuration file with the flags applied, validated once: a file that is invalid
     /// alone but valid with the flags (`interp_bits = 0` and `--no-interpolation`) is
     /// accepted. An error names where each value it is about came from (a flag, the file's
@@ -135,6 +170,34 @@ impl ConfigArgs {
                     .collect();
                 anyhow::bail!("{e} ({})", from.join(", "))
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        cfg: ConfigArgs,
+    }
+
+    fn resolve(flags: &[String]) -> Config {
+        let cli = Cli::try_parse_from(std::iter::once("t".to_string()).chain(flags.to_vec()))
+            .unwrap_or_else(|e| panic!("{flags:?}: {e}"));
+        cli.cfg.resolve().unwrap()
+    }
+
+    #[test]
+    fn flags_give_back_the_configuration() {
+        assert!(ConfigArgs::flags(&Config::default()).is_empty());
+        let mut configs: Vec<Config> = crate::grid::rows().into_iter().map(|r| r.config).collect();
+        configs.push(crate::grid::narrowest());
+        for c in configs {
+            assert_eq!(resolve(&ConfigArgs::flags(&c)), c);
         }
     }
 }

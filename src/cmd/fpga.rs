@@ -92,7 +92,6 @@ fn flow(a: &FpgaArgs, logs: &Path) -> Result<fpga::FpgaReport> {
         freq_mhz: a.freq,
         seed: a.seed,
         logs: Some(logs.to_path_buf()),
-        ..Options::default()
     };
     let (what, report) = match &a.dir {
         Some(d) => (d.display().to_string(), fpga::run_dir(d, &opts)?),

@@ -27,12 +27,17 @@ pub struct GenerateArgs {
     #[command(flatten)]
     pub force: super::force::ForceArg,
     /// Seeded random vectors per stage, after the hand-picked corner cases [0..=1000000].
-    #[arg(long, value_name = "N", default_value_t = 2000, value_parser = super::parse::count::<usize>())]
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_VECTORS, value_parser = super::parse::count::<usize>())]
     pub vectors: usize,
     /// Seed of the random vectors.
-    #[arg(long, value_name = "S", default_value_t = 1, value_parser = super::parse::at_least::<u64>(0))]
+    #[arg(long, value_name = "S", default_value_t = DEFAULT_SEED, value_parser = super::parse::at_least::<u64>(0))]
     pub seed: u64,
 }
+
+/// Seeded random vectors per stage by default (`--vectors`).
+pub const DEFAULT_VECTORS: usize = 2000;
+/// Seed of the random vectors by default (`--seed`).
+pub const DEFAULT_SEED: u64 = 1;
 
 pub fn run(a: &GenerateArgs) -> Result<()> {
     vectors::check_stage_vectors(a.vectors, "--vectors")?;

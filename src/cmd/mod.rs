@@ -6,10 +6,13 @@ pub mod fit;
 pub mod force;
 pub mod fpga;
 pub mod generate;
+pub mod lint;
 pub mod parse;
 pub mod render;
 pub mod roms;
+pub mod sim;
 pub mod stress;
+pub mod synth;
 pub mod vectors;
 pub mod volume;
 
@@ -75,6 +78,8 @@ mod limits_in_help {
         );
         has::<super::fpga::FpgaArgs>("freq", &format!("(0, {}]", super::fpga::MAX_FREQ_MHZ));
         has::<super::bench::BenchArgs>("seconds", &format!("(0, {}]", super::bench::MAX_SECONDS));
+        has::<super::sim::SimArgs>("stream", &format!("[0..={MAX_STREAM_VECTORS};"));
+        has::<super::sim::SimArgs>("tb-stream", &format!("[0..={MAX_STREAM_VECTORS}]"));
     }
 
     #[test]

@@ -2,21 +2,20 @@
 //! because it is the search's one step that runs an outside tool.
 
 use crate::config::Config;
-use crate::rtl::fpga;
 use crate::scene::Scene;
 use anyhow::{Context, Result};
 
-/// Cells of Yosys synthesis for the iCE40 (`synth_ice40` through [`fpga::synth_ice40`], as
-/// `rmapgen fpga` runs it: memories in block RAM, each SB_RAM40_4K one cell) of a
-/// configuration's design with the scene's maps. `YOSYS` names the tool.
+/// Cells of Yosys synthesis for the iCE40 (`synth_ice40` through
+/// [`crate::toolchain::yosys::synth_ice40`], as `rmapgen fpga` runs it: memories in block RAM,
+/// each SB_RAM40_4K one cell) of a configuration's design with the scene's maps. `YOSYS` names
+/// the tool.
 pub fn cells(cfg: &Config, scene: &Scene) -> Result<u64> {
     let tmp = crate::output::Scratch::new()?;
     let out = crate::output::StagedDir::new(&tmp.path().join("design"), &Default::default())?;
     let manifest = crate::rtl::write_design(&crate::design::Design::for_scene(cfg, scene)?, &out)?;
     let dir = out.commit()?;
     let files: Vec<String> = manifest.modules.iter().map(|m| m.file.clone()).collect();
-    let yosys = fpga::Options::default().yosys;
-    let stat = fpga::synth_ice40(&dir, "rmap_top", &files, tmp.path(), &yosys)
+    let stat = crate::toolchain::yosys::synth_ice40(&dir, "rmap_top", &files, tmp.path())
         .with_context(|| format!("--cost cells: synthesis of {}", cfg.summary()))?;
     Ok(stat.cells as u64)
 }

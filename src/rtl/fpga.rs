@@ -16,10 +16,10 @@
 use super::manifest;
 use crate::config::Config;
 use crate::output::StagedDir;
+use crate::toolchain::{self, complaint, nextpnr, yosys};
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 /// Where and how to place and route.
 #[derive(Clone, Debug)]
@@ -32,8 +32,6 @@ pub struct Options {
     pub freq_mhz: f64,
     /// nextpnr's placer seed (fixed, so a run is reproducible).
     pub seed: u64,
-    pub yosys: String,
-    pub nextpnr: String,
     /// Keep the logs, netlist and report here (else in a temporary directory).
     pub logs: Option<PathBuf>,
 }
@@ -45,8 +43,6 @@ impl Default for Options {
             package: "ct256".into(),
             freq_mhz: 125.0,
             seed: 1,
-            yosys: std::env::var("YOSYS").unwrap_or_else(|_| "yosys".into()),
-            nextpnr: std::env::var("NEXTPNR").unwrap_or_else(|_| "nextpnr-ice40".into()),
             logs: None,
         }
     }
@@ -143,16 +139,10 @@ impl FpgaReport {
     }
 }
 
-/// Whether Yosys and nextpnr-ice40 both run.
-pub fn tools_available(opts: &Options) -> bool {
-    let runs = |tool: &str, arg: &str| {
-        Command::new(tool)
-            .arg(arg)
-            .output()
-            .map(|o| o.status.success())
-            .unwrap_or(false)
-    };
-    runs(&opts.yosys, "-V") && runs(&opts.nextpnr, "--version")
+/// Whether Yosys and nextpnr-ice40 both run (the programs YOSYS and NEXTPNR name, see
+/// [`crate::toolchain`]); the options do not change which.
+pub fn tools_available(_opts: &Options) -> bool {
+    yosys::available() && nextpnr::available()
 }
 
 /// Generates `cfg`'s design (the standard scene's maps) into a temporary directory and runs
@@ -178,26 +168,6 @@ fn signal(cell: &str) -> String {
     cell[..end].to_string()
 }
 
-/// The first line of a tool's output that says what went wrong.
-fn complaint(text: &str) -> String {
-    let lines: Vec<&str> = text
-        .lines()
-        .map(str::trim)
-        .filter(|l| !l.is_empty())
-        .collect();
-    lines
-        .iter()
-        .find(|l| l.starts_with("ERROR:"))
-        .or_else(|| {
-            lines
-                .iter()
-                .find(|l| l.contains("unrecognised option") || l.contains("unknown option"))
-        })
-        .or(lines.last())
-        .map(|l| l.to_string())
-        .unwrap_or_else(|| "no output".into())
-}
-
 /// The design needs more of some resource (logic cells, block RAMs, pins) than the device
 /// has: an error a caller may tell apart (`anyhow::Error::downcast_ref`), for instance to
 /// report "does not fit" as a figure. The message is nextpnr's complaint.
@@ -205,86 +175,6 @@ fn complaint(text: &str) -> String {
 #[error("{message}")]
 pub struct DoesNotFit {
     pub message: String,
-}
-
-/// What Yosys's `synth_ice40` mapped the design to.
-#[derive(Clone, Debug, PartialEq)]
-pub struct YosysStat {
-    /// Every cell, each SB_RAM40_4K one.
-    pub cells: u32,
-    pub luts: u32,
-    pub carries: u32,
-    /// SB_DFF* of every kind.
-    pub flip_flops: u32,
-}
-
-/// Yosys `synth_ice40` of `top` from `files` in the generated directory `dir` (run there, so
-/// that `$readmemh` finds the hex files): the netlist `<top>.json`, `yosys.log` and the
-/// statistics go to `logs`. The one place rmapgen runs synth_ice40 (`rmapgen fpga`, bench,
-/// `fit --cost cells`).
-pub fn synth_ice40(
-    dir: &Path,
-    top: &str,
-    files: &[String],
-    logs: &Path,
-    yosys: &str,
-) -> Result<YosysStat> {
-    let json = logs.join(format!("{top}.json"));
-    let stat = logs.join("yosys_stat.txt");
-    let script = format!(
-        "read_verilog {}; synth_ice40 -top {top} -json {}; tee -q -o {} stat",
-        files.join(" "),
-        json.display(),
-        stat.display()
-    );
-    let run = Command::new(yosys)
-        .current_dir(dir)
-        .args(["-q", "-l"])
-        .arg(logs.join("yosys.log"))
-        .args(["-p", &script])
-        .output()
-        .with_context(|| format!("cannot run {yosys} (make tools installs it)"))?;
-    if !run.status.success() {
-        let log = std::fs::read_to_string(logs.join("yosys.log")).unwrap_or_default();
-        bail!(
-            "yosys synth_ice40 failed: {}",
-            complaint(&format!("{log}\n{}", String::from_utf8_lossy(&run.stderr)))
-        );
-    }
-    let stat_text = std::fs::read_to_string(&stat)?;
-    // The last count of each cell type: stat prints the top module last.
-    let count = |name: &str| -> u32 {
-        stat_text
-            .lines()
-            .rev()
-            .filter_map(|l| {
-                let mut w = l.split_whitespace();
-                let (a, b) = (w.next()?, w.next()?);
-                (a == name).then(|| b.parse::<u32>().ok())?
-            })
-            .next()
-            .unwrap_or(0)
-    };
-    let flip_flops: u32 = stat_text
-        .lines()
-        .filter_map(|l| {
-            let mut w = l.split_whitespace();
-            let (a, b) = (w.next()?, w.next()?);
-            a.starts_with("SB_DFF").then(|| b.parse::<u32>().ok())?
-        })
-        .sum();
-    let cells = stat_text
-        .lines()
-        .rev()
-        .find_map(|l| l.trim().strip_prefix("Number of cells:"))
-        .and_then(|n| n.trim().parse().ok())
-        .context("yosys printed no cell count")?;
-    Ok(YosysStat {
-        cells,
-        luts: count("SB_LUT4"),
-        carries: count("SB_CARRY"),
-        flip_flops,
-    })
 }
 
 /// Runs the flow on a generated directory (it needs `manifest.json` and the `.v` and `.hex`
@@ -326,23 +216,21 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
 
     // nextpnr checks the device and package without a design, in milliseconds: a name it
     // does not know fails here, before the synthesis.
-    let check = Command::new(&opts.nextpnr)
-        .arg(format!("--{}", opts.device))
-        .args(["--package", &opts.package])
-        .output()
-        .with_context(|| format!("cannot run {} (make fpga installs it)", opts.nextpnr))?;
-    if !check.status.success() {
-        bail!(
-            "{} --{} --package {}: {}",
-            opts.nextpnr,
-            opts.device,
-            opts.package,
-            complaint(&format!(
-                "{}\n{}",
-                String::from_utf8_lossy(&check.stdout),
-                String::from_utf8_lossy(&check.stderr)
-            ))
-        );
+    let target = nextpnr::Target {
+        device: &opts.device,
+        package: &opts.package,
+        freq_mhz: opts.freq_mhz,
+        seed: opts.seed,
+    };
+    let part = format!(
+        "{} --{} --package {}",
+        nextpnr::nextpnr(),
+        opts.device,
+        opts.package
+    );
+    let check = toolchain::capture(&mut nextpnr::check_part(&target))?;
+    if !check.success() {
+        bail!("{part}: {}", complaint(&check.output));
     }
 
     let tmp;
@@ -357,7 +245,7 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
         }
     };
     let json = logs.join(format!("{top}.json"));
-    let stat = synth_ice40(dir, &top, &files, &logs, &opts.yosys)?;
+    let stat = yosys::synth_ice40(dir, &top, &files, &logs)?;
 
     // Which block RAMs hold which memory: memory_bram names them <memory>.<row>.<column>.
     let netlist: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json)?)
@@ -397,34 +285,16 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
     // nextpnr: a timing failure is allowed (it is a figure); anything else is an error.
     let report = logs.join("nextpnr_report.json");
     let log = logs.join("nextpnr.log");
-    let run = Command::new(&opts.nextpnr)
-        .arg(format!("--{}", opts.device))
-        .args(["--package", &opts.package, "--json"])
-        .arg(&json)
-        .arg("--asc")
-        .arg(logs.join(format!("{top}.asc")))
-        .args(["--freq", &format!("{}", opts.freq_mhz)])
-        .args(["--seed", &opts.seed.to_string()])
-        .arg("--timing-allow-fail")
-        .arg("--report")
-        .arg(&report)
-        .arg("--log")
-        .arg(&log)
-        .output()
-        .with_context(|| format!("cannot run {} (make fpga installs it)", opts.nextpnr))?;
-    let out = format!(
-        "{}\n{}",
-        String::from_utf8_lossy(&run.stdout),
-        String::from_utf8_lossy(&run.stderr)
-    );
+    let run = toolchain::capture(&mut nextpnr::place_and_route(
+        &target,
+        &json,
+        &logs.join(format!("{top}.asc")),
+        &report,
+        &log,
+    ))?;
+    let out = run.output;
     if !run.status.success() {
-        let message = format!(
-            "{} --{} --package {}: {}",
-            opts.nextpnr,
-            opts.device,
-            opts.package,
-            complaint(&out)
-        );
+        let message = format!("{part}: {}", complaint(&out));
         if out.contains("no BELs remaining") || out.contains("Unable to find a placement location")
         {
             return Err(DoesNotFit { message }.into());
@@ -506,7 +376,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn signals_and_complaints() {
+    fn signals() {
         assert_eq!(
             signal("u_normalise.pb_l1_0_q_SB_CARRY_I0_9$CARRY"),
             "u_normalise.pb_l1_0_q"
@@ -514,14 +384,6 @@ mod tests {
         assert_eq!(
             signal("u_atan_rom.pv_q2_SB_DFF_Q_5_DFFLC"),
             "u_atan_rom.pv_q2"
-        );
-        assert_eq!(
-            complaint("Info: x\nERROR: Unsupported package 'ct257'.\n0 warnings, 1 error\n"),
-            "ERROR: Unsupported package 'ct257'."
-        );
-        assert_eq!(
-            complaint("unrecognised option '--hx9k'\n"),
-            "unrecognised option '--hx9k'"
         );
     }
 }

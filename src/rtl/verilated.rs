@@ -6,8 +6,9 @@ use crate::config::Config;
 use crate::model::IntensitySource;
 use crate::output::StagedDir;
 use crate::scene::Scene;
+use crate::toolchain::{run_tool, verilator};
 use crate::vectors::inputs::enc_grad;
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -19,30 +20,6 @@ pub struct VerilatedTop {
     _dir: crate::output::Scratch,
     design: PathBuf,
     exe: PathBuf,
-}
-
-/// Runs a tool, turning a failure into an error that names the command and shows its output.
-fn run_tool(cmd: &mut Command, what: &str) -> Result<()> {
-    let out = cmd
-        .output()
-        .with_context(|| format!("cannot run {what} ({cmd:?}); is it installed? (make tools)"))?;
-    if !out.status.success() {
-        let text = format!(
-            "{}{}",
-            String::from_utf8_lossy(&out.stdout),
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let tail: Vec<&str> = text
-            .lines()
-            .rev()
-            .take(12)
-            .collect::<Vec<_>>()
-            .into_iter()
-            .rev()
-            .collect();
-        bail!("{what} failed ({cmd:?}): {}", tail.join(" | "));
-    }
-    Ok(())
 }
 
 impl VerilatedTop {
@@ -63,27 +40,17 @@ impl VerilatedTop {
             .collect();
         sources.sort();
         let mdir = dir.path().join("obj");
-        let mut cmd =
-            Command::new(std::env::var("VERILATOR").unwrap_or_else(|_| "verilator".into()));
-        cmd.args([
-            "--cc",
-            "--exe",
-            "--build",
-            "-O3",
-            "--x-assign",
-            "fast",
-            "--x-initial",
-            "fast",
-            "--noassert",
-        ])
-        .args(["-Wno-fatal", "--top-module", "rmap_top", "--Mdir"])
-        .arg(&mdir)
-        .args(["-o", "top_apply"])
-        .args(&sources)
-        .arg(&harness)
-        .arg("-CFLAGS")
-        .arg(format!("-O2 -I{}", design.join("tb").display()));
-        run_tool(&mut cmd, "verilator")?;
+        run_tool(
+            &mut verilator::harness(
+                "rmap_top",
+                &mdir,
+                "top_apply",
+                &sources,
+                &harness,
+                &design.join("tb"),
+            ),
+            "verilator",
+        )?;
         Ok(VerilatedTop {
             cfg: cfg.clone(),
             design,

@@ -1,39 +1,33 @@
 //! Helpers for the tests that run the simulators, Verilator's lint and Yosys on generated
 //! designs: generating a directory, compiling and running its testbenches, reading verdicts.
+//! Every tool's command line comes from `rmapgen::toolchain`.
 //!
 //! The tools are required when CI=true (a missing tool fails the test there); elsewhere a
 //! missing tool skips the test with a message on stderr.
 #![allow(dead_code)]
 
 use crate::helpers;
+use rmapgen::cmd::config_args::ConfigArgs;
 use rmapgen::config::Config;
+use rmapgen::toolchain::{self, icarus, verilator};
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// The narrowest widths every range allows, as `generate` flags.
-pub const NARROWEST: &[&str] = &[
-    "--grad-bits",
-    "8",
-    "--red-bits",
-    "6",
-    "--frac-bits",
-    "4",
-    "--recip-bits",
-    "5",
-    "--index-bits",
-    "2",
-    "--interp-bits",
-    "1",
-    "--map-bits",
-    "6",
-];
+/// `generate` flags for the narrowest widths every range allows, with interpolation
+/// (`rmapgen::grid::narrowest`), and otherwise the defaults.
+pub fn narrowest_flags() -> Vec<String> {
+    ConfigArgs::flags(&rmapgen::grid::narrowest())
+}
+
+/// `flags` as the `&str`s [`generate`] takes.
+pub fn strs(flags: &[String]) -> Vec<&str> {
+    flags.iter().map(String::as_str).collect()
+}
 
 /// Whether `tool` is on PATH; panics when it is not and CI=true.
 pub fn require(tool: &str) -> bool {
-    let found = std::env::var_os("PATH")
-        .map(|p| std::env::split_paths(&p).any(|d| d.join(tool).is_file()))
-        .unwrap_or(false);
+    let found = toolchain::installed(tool);
     if !found {
         if std::env::var("CI").map(|v| v == "true").unwrap_or(false) {
             panic!("{tool} is not installed and CI=true: run `make tools`");
@@ -61,6 +55,13 @@ pub fn generate(dir: &Path, flags: &[&str], vectors: usize) {
         "generate {flags:?}: {}",
         String::from_utf8_lossy(&o.stderr)
     );
+}
+
+/// Generates `cfg`'s design into `dir` (through the `generate` flags that give it), with
+/// `vectors` random vectors per stage.
+pub fn generate_config(dir: &Path, cfg: &Config, vectors: usize) {
+    generate(dir, &strs(&ConfigArgs::flags(cfg)), vectors);
+    assert_eq!(&config_of(dir), cfg, "the flags give the configuration");
 }
 
 /// The configuration a generated directory was made for, read back from its manifest.
@@ -101,13 +102,9 @@ pub fn testbenches(dir: &Path) -> Vec<String> {
 /// .vvp path.
 pub fn icarus(dir: &Path, module: &str, build: &Path) -> PathBuf {
     let vvp = build.join(format!("{module}_tb.vvp"));
-    let o = Command::new("iverilog")
-        .args(["-g2005", "-Wall", "-Wno-timescale", "-s"])
-        .arg(format!("{module}_tb"))
-        .arg("-o")
-        .arg(&vvp)
-        .arg(dir.join(format!("tb/{module}_tb.v")))
-        .args(design_files(dir))
+    let mut files = vec![dir.join(format!("tb/{module}_tb.v"))];
+    files.extend(design_files(dir));
+    let o = icarus::compile(&format!("{module}_tb"), &vvp, &files)
         .output()
         .expect("iverilog runs");
     assert!(
@@ -122,15 +119,10 @@ pub fn icarus(dir: &Path, module: &str, build: &Path) -> PathBuf {
 /// kept as the last line by tb/vl_user.cpp) in `build/<module>`; returns the executable.
 pub fn verilator(dir: &Path, module: &str, build: &Path) -> PathBuf {
     let mdir = build.join(format!("verilator_{module}"));
-    let o = Command::new("verilator")
-        .args(["--binary", "-j", "2", "--top-module"])
-        .arg(format!("{module}_tb"))
-        .args(["-o", "sim", "--Mdir"])
-        .arg(&mdir)
-        .arg(dir.join(format!("tb/{module}_tb.v")))
-        .args(design_files(dir))
-        .arg(helpers::root().join("tb/vl_user.cpp"))
-        .args(["-CFLAGS", "-DVL_USER_FINISH", "-CFLAGS", "-DVL_USER_STOP"])
+    let mut files = vec![dir.join(format!("tb/{module}_tb.v"))];
+    files.extend(design_files(dir));
+    let o = verilator::binary(&format!("{module}_tb"), &mdir, &files)
+        .expect("the build directory is writable")
         .output()
         .expect("verilator runs");
     assert!(
@@ -138,7 +130,7 @@ pub fn verilator(dir: &Path, module: &str, build: &Path) -> PathBuf {
         "verilator {module}: {}",
         String::from_utf8_lossy(&o.stderr)
     );
-    mdir.join("sim")
+    mdir.join(verilator::BINARY_EXE)
 }
 
 /// Runs a command from the generated directory: (exit code, stdout + stderr).
@@ -154,9 +146,11 @@ pub const NO_ARGS: &[&str] = &[];
 
 /// Runs a compiled Icarus testbench from the generated directory.
 pub fn vvp<S: AsRef<OsStr>>(dir: &Path, bin: &Path, args: &[S]) -> (Option<i32>, String) {
-    let mut c = Command::new("vvp");
-    c.arg("-N").arg(bin).args(args);
-    run_in(dir, c)
+    let args: Vec<String> = args
+        .iter()
+        .map(|a| a.as_ref().to_string_lossy().into_owned())
+        .collect();
+    run_in(dir, icarus::simulate(dir, bin, &args))
 }
 
 /// Runs a Verilated testbench from the generated directory.
@@ -189,10 +183,7 @@ pub fn assert_passed(what: &str, (code, out): &(Option<i32>, String), n: usize) 
 
 /// `verilator --lint-only -Wall` over the design: it must exit 0 and print nothing.
 pub fn assert_lint_clean(what: &str, dir: &Path) {
-    let o = Command::new("verilator")
-        .args(["--lint-only", "-Wall", "--top-module", "rmap_top"])
-        .args(design_files(dir))
-        .current_dir(dir)
+    let o = verilator::lint(dir, "rmap_top", &design_files(dir))
         .output()
         .expect("verilator runs");
     let said = format!(

@@ -3,6 +3,7 @@
 mod alloc;
 mod bench;
 mod cmd_render;
+mod cmd_sim;
 mod errors;
 mod fast;
 mod fit;

@@ -2,64 +2,20 @@
 //! is exactly what the default configuration generates; stages a configuration switches off
 //! are absent; output is byte-reproducible; errors exit 2 and leave nothing behind; the
 //! manifest agrees with the files; and the design lints clean (Verilator -Wall), compiles
-//! (Icarus) and synthesises without latches into block RAM (Yosys) for the checked configs.
+//! (Icarus) and synthesises without latches into block RAM (Yosys) in every configuration of
+//! the parameter grid (`rmapgen::grid`).
 //!
 //! The tools are required when CI=true (a missing tool fails the test there); elsewhere a
 //! missing tool skips with a message on stderr.
 
-use crate::hdl::{generate, require};
+use crate::hdl::{generate, generate_config, require};
 use crate::helpers;
 use rmapgen::config::Config;
+use rmapgen::grid;
 use rmapgen::stages::{self, map_bank::banks, rmap_top};
+use rmapgen::toolchain::icarus;
 use std::path::Path;
-use std::process::Command;
 
-/// The configurations the design is checked in, as `generate` flags (docs/ARCHITECTURE.md).
-const CHECKED: &[(&str, &[&str])] = &[
-    ("default", &[]),
-    ("no-compensation", &["--no-compensation"]),
-    ("no-interpolation", &["--no-interpolation"]),
-    ("color", &["--color"]),
-    (
-        "widest",
-        &[
-            "--grad-bits",
-            "16",
-            "--red-bits",
-            "12",
-            "--frac-bits",
-            "12",
-            "--recip-bits",
-            "14",
-            "--index-bits",
-            "6",
-            "--interp-bits",
-            "5",
-            "--map-bits",
-            "12",
-        ],
-    ),
-    ("narrowest", crate::hdl::NARROWEST),
-    (
-        "bare-color",
-        &["--no-compensation", "--no-interpolation", "--color"],
-    ),
-    (
-        "no-truncation",
-        &[
-            "--grad-bits",
-            "8",
-            "--red-bits",
-            "8",
-            "--frac-bits",
-            "7",
-            "--recip-bits",
-            "20",
-        ],
-    ),
-];
-
-/// The configuration `generate` resolves from `flags`, read back from the manifest.
 /// The names of the design's .v files, sorted.
 fn design_files(dir: &Path) -> Vec<String> {
     crate::hdl::design_files(dir)
@@ -277,9 +233,11 @@ fn declared_ports(text: &str) -> Vec<(String, String, String)> {
 #[test]
 fn manifest_agrees_with_the_files_and_the_latency_function() {
     let t = helpers::tempdir();
-    for (name, flags) in CHECKED {
+    // Every configuration of the parameter grid (src/grid.rs).
+    for row in grid::rows() {
+        let name = row.name;
         let dir = t.path().join(name);
-        generate(&dir, flags, 5);
+        generate_config(&dir, &row.config, 5);
         let m = manifest(&dir);
         let cfg = config_of(&m);
         assert_eq!(m["rmapgen_version"], env!("CARGO_PKG_VERSION"));
@@ -398,17 +356,19 @@ fn verilator_lint_is_silent_and_icarus_compiles() {
         return;
     }
     let t = helpers::tempdir();
-    for (name, flags) in CHECKED {
+    for row in grid::rows() {
+        let name = row.name;
         let dir = t.path().join(name);
-        generate(&dir, flags, 1);
-        let files = design_files(&dir);
+        generate_config(&dir, &row.config, 1);
         crate::hdl::assert_lint_clean(name, &dir);
-        let o = Command::new("iverilog")
-            .args(["-g2005", "-Wall", "-o", "/dev/null"])
-            .args(&files)
-            .current_dir(&dir)
-            .output()
-            .expect("iverilog runs");
+        let o = icarus::compile(
+            "rmap_top",
+            Path::new("/dev/null"),
+            &crate::hdl::design_files(&dir),
+        )
+        .current_dir(&dir)
+        .output()
+        .expect("iverilog runs");
         let said = format!(
             "{}{}",
             String::from_utf8_lossy(&o.stdout),
@@ -429,11 +389,12 @@ fn default_synthesises_without_latches_into_block_ram() {
     let t = helpers::tempdir();
     let dir = t.path().join("rtl");
     generate(&dir, &[], 1);
-    let o = Command::new(helpers::root().join("scripts/synth.sh"))
-        .arg(&dir)
-        .arg(t.path().join("synth"))
-        .output()
-        .expect("scripts/synth.sh runs");
+    let o = helpers::run(&[
+        "synth",
+        dir.to_str().unwrap(),
+        "--logs",
+        t.path().join("synth").to_str().unwrap(),
+    ]);
     let said = String::from_utf8_lossy(&o.stdout);
     assert!(
         o.status.success(),

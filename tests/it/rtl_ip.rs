@@ -27,10 +27,15 @@ fn every_depth_passes_every_testbench_under_icarus() {
     }
     // The default depth (2) runs in sim.rs and make sim-all; here 0 and 1, with the optional
     // stages switched both ways, and the narrowest widths at depth 1.
+    let narrowest_depth1 = [
+        vec!["--pipeline-depth".to_string(), "1".into()],
+        hdl::narrowest_flags(),
+    ]
+    .concat();
     let configs: [&[&str]; 3] = [
         &["--pipeline-depth", "0", "--color"],
         &["--pipeline-depth", "1", "--no-compensation", "--color"],
-        &[&["--pipeline-depth", "1"], hdl::NARROWEST].concat(),
+        &hdl::strs(&narrowest_depth1),
     ];
     let mut latencies = Vec::new();
     for flags in configs {
@@ -190,16 +195,7 @@ fn fpga_tools() -> bool {
 
 /// A small configuration, so that the flow takes seconds.
 fn narrow() -> Config {
-    Config {
-        grad_bits: 8,
-        red_bits: 6,
-        frac_bits: 4,
-        recip_bits: 5,
-        index_bits: 2,
-        interp_bits: 1,
-        map_bits: 6,
-        ..Config::default()
-    }
+    rmapgen::grid::narrowest()
 }
 
 #[test]
@@ -232,7 +228,7 @@ fn fpga_fails_on_a_memory_in_logic_and_on_a_design_too_big() {
     // The narrow configuration's ROMs are small enough that Yosys would build them from LUTs
     // without the ram_style attribute.
     let dir = tmp.path().join("d");
-    hdl::generate(&dir, hdl::NARROWEST, 1);
+    hdl::generate(&dir, &hdl::strs(&hdl::narrowest_flags()), 1);
     sabotage(
         &dir,
         "recip_rom.v",

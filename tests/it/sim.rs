@@ -36,10 +36,11 @@ fn every_testbench_passes_under_icarus() {
     if !require("iverilog") || !require("vvp") {
         return;
     }
+    let narrowest = hdl::narrowest_flags();
     let configs: [&[&str]; 3] = [
         &[],
         &["--no-compensation", "--no-interpolation", "--color"],
-        hdl::NARROWEST,
+        &hdl::strs(&narrowest),
     ];
     for flags in configs {
         let tmp = helpers::tempdir();

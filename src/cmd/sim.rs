@@ -1,0 +1,201 @@
+//! `rmapgen sim`: the self-checking testbenches of a generated design under Icarus Verilog
+//! and/or Verilator, and the Verilator C++ harness on a long random stream of top vectors
+//! ([`crate::sim`]); with `--matrix`, every configuration of the parameter grid
+//! ([`crate::grid`]) generated and simulated in turn.
+//!
+//! Exit 0 when every run passed, 1 when one failed (each failure printed with its command and
+//! the tail of its output), 2 for bad input (one line, nothing written).
+
+use super::force::ForceArg;
+use super::generate;
+use super::parse;
+use crate::design_dir::DesignDir;
+use crate::grid::{self, GridRow};
+use crate::output::{absolute, StagedDir};
+use crate::scene::Scene;
+use crate::sim::{self, Options, Outcome};
+use crate::vectors::MAX_STREAM_VECTORS;
+use anyhow::{bail, Result};
+use clap::Args;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+#[derive(Args, Debug)]
+pub struct SimArgs {
+    /// The generated design directory (`rmapgen generate --out DIR`). With --matrix, where
+    /// each row's design is generated, as DIR/<row> [default: build/matrix].
+    #[arg(value_name = "DIR", required_unless_present = "matrix")]
+    pub dir: Option<PathBuf>,
+    /// Every testbench (DIR/tb/*_tb.v) under Icarus Verilog.
+    #[arg(long)]
+    pub icarus: bool,
+    /// Every testbench under Verilator (--binary).
+    #[arg(long)]
+    pub verilator: bool,
+    /// N random top vectors through the Verilator C++ harness tb/top_stream.cpp
+    /// [0..=10000000000; the stream files must fit the free space of the build directory].
+    #[arg(long, value_name = "N", default_value_t = 0, value_parser = parse::whole::<u64>(0, MAX_STREAM_VECTORS))]
+    pub stream: u64,
+    /// Also N random top vectors through the top's testbench (+vectors=FILE) in each
+    /// simulator selected, for the Verilog testbench's throughput [0..=10000000000].
+    #[arg(long, value_name = "N", default_value_t = 0, value_parser = parse::whole::<u64>(0, MAX_STREAM_VECTORS))]
+    pub tb_stream: u64,
+    /// Only the testbench of module MODULE (DIR/tb/MODULE_tb.v).
+    #[arg(long, value_name = "MODULE")]
+    pub only: Option<String>,
+    /// Dump a VCD of every Icarus testbench run (+vcd=) into the build directory, for
+    /// GTKWave.
+    #[arg(long, requires = "icarus")]
+    pub vcd: bool,
+    /// Build products and logs go to BUILD/<name of the design directory> (replaced whole,
+    /// also when a simulation fails, so its logs can be read).
+    #[arg(long, value_name = "BUILD", default_value = "build/sim")]
+    pub build: PathBuf,
+    /// Generate every configuration of the parameter grid (src/grid.rs) into DIR/<row> and
+    /// run the simulations asked for on each.
+    #[arg(long)]
+    pub matrix: bool,
+    /// With --matrix: only these rows (repeat the flag or separate with commas).
+    #[arg(long, value_name = "NAME", requires = "matrix", value_delimiter = ',')]
+    pub row: Vec<String>,
+    #[command(flatten)]
+    pub force: ForceArg,
+}
+
+impl SimArgs {
+    fn options(&self) -> Options {
+        Options {
+            icarus: self.icarus,
+            verilator: self.verilator,
+            stream: self.stream,
+            tb_stream: self.tb_stream,
+            only: self.only.clone(),
+            vcd: self.vcd,
+        }
+    }
+}
+
+pub fn run(a: &SimArgs) -> Result<ExitCode> {
+    let opts = a.options();
+    if !opts.runs_something() {
+        bail!("nothing to run: give --icarus, --verilator or --stream N");
+    }
+    // Bad input first, then the tools, then the runs.
+    let failed = if a.matrix {
+        let rows = selected_rows(&a.row)?;
+        need_tools(&opts)?;
+        matrix(a, &opts, &rows)?
+    } else {
+        let dir = a
+            .dir
+            .as_deref()
+            .expect("clap requires DIR without --matrix");
+        let design = DesignDir::open(dir)?;
+        check_only(&design, &opts)?;
+        need_tools(&opts)?;
+        !simulate(&design, a, &opts)?.failed.is_empty()
+    };
+    Ok(if failed {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+fn need_tools(opts: &Options) -> Result<()> {
+    match opts.missing_tools().first() {
+        Some(tool) => bail!("{tool} not found (make tools installs it)"),
+        None => Ok(()),
+    }
+}
+
+/// `--only MODULE` names a testbench of the design.
+fn check_only(design: &DesignDir, opts: &Options) -> Result<()> {
+    if let Some(m) = opts.only.as_deref() {
+        anyhow::ensure!(
+            design.testbench(m).is_file(),
+            "--only {m}: no testbench {} in {}",
+            design.testbench(m).display(),
+            design.path().display()
+        );
+    }
+    Ok(())
+}
+
+/// The runs on one design, its build products staged into BUILD/<name>; prints as it goes
+/// and the summary at the end.
+fn simulate(design: &DesignDir, a: &SimArgs, opts: &Options) -> Result<Outcome> {
+    check_only(design, opts)?;
+    let target = a.build.join(design.name());
+    let staged = StagedDir::new(&target, &a.force.policy(&[Some(design.path())]))?;
+    let build = absolute(staged.path());
+    crate::disk::check_space(
+        &build,
+        opts.stream_bytes(design),
+        &format!(
+            "the vector streams (--stream, --tb-stream) in {}",
+            target.display()
+        ),
+    )?;
+    let result = sim::run(design, &build, &absolute(&target), opts, &mut |l| {
+        println!("{l}")
+    });
+    staged.commit()?;
+    let outcome = result?;
+    print!("{}", outcome.summary(design));
+    Ok(outcome)
+}
+
+/// Every selected row of the grid: generated into DIR/<row>, then simulated. Whether any
+/// failed.
+fn matrix(a: &SimArgs, opts: &Options, rows: &[GridRow]) -> Result<bool> {
+    let root = a.dir.clone().unwrap_or_else(|| "build/matrix".into());
+    let mut failed = Vec::new();
+    for r in rows {
+        println!("==== {}: {} ({})", r.name, r.config.summary(), r.covers);
+        let design = generate_row(r, &root.join(r.name), a)?;
+        if !simulate(&design, a, opts)?.failed.is_empty() {
+            failed.push(r.name);
+        }
+    }
+    if failed.is_empty() {
+        println!("sim: every configuration passed ({} rows)", rows.len());
+    } else {
+        println!("sim: FAILED: {}", failed.join(" "));
+    }
+    Ok(!failed.is_empty())
+}
+
+/// The rows named (all when none is), in the grid's order; an unknown name is an error
+/// listing the rows.
+fn selected_rows(names: &[String]) -> Result<Vec<GridRow>> {
+    let rows = grid::rows();
+    if let Some(n) = names
+        .iter()
+        .find(|n| !rows.iter().any(|r| r.name == n.as_str()))
+    {
+        let all: Vec<&str> = rows.iter().map(|r| r.name).collect();
+        bail!(
+            "--row {n}: no such row in the grid; rows: {}",
+            all.join(", ")
+        );
+    }
+    Ok(rows
+        .into_iter()
+        .filter(|r| names.is_empty() || names.iter().any(|n| n == r.name))
+        .collect())
+}
+
+/// Generates a row's design (the standard scene, `generate`'s default vectors) into `dir`.
+fn generate_row(r: &GridRow, dir: &Path, a: &SimArgs) -> Result<DesignDir> {
+    let (dir, _) = generate::write_dir(
+        &r.config,
+        &Scene::standard(),
+        dir,
+        &a.force.policy(&[]),
+        generate::DEFAULT_VECTORS,
+        generate::DEFAULT_SEED,
+        &[],
+    )?;
+    DesignDir::open(&dir)
+}

@@ -1,0 +1,261 @@
+//! The external tools rmapgen runs: Icarus Verilog ([`icarus`]), Verilator ([`verilator`]),
+//! Yosys ([`yosys`]) and nextpnr-ice40 ([`nextpnr`]). Each tool's module builds every command
+//! line of that tool, one function per kind of run; nothing else in the crate, its tests or the
+//! Makefile spells a tool's flags. The program names come from the environment variables the
+//! Makefile passes (IVERILOG, VVP, VERILATOR, YOSYS, NEXTPNR), else the usual names on PATH.
+//!
+//! Running: [`run_tool`] for a command whose failure is an error (the error names the command
+//! and quotes the tail of its output), [`capture`] and [`run_logged`] for one whose output the
+//! caller judges (a testbench's verdict line, a lint's silence).
+
+pub mod icarus;
+pub mod nextpnr;
+pub mod verilator;
+pub mod yosys;
+
+use anyhow::{bail, Context, Result};
+use std::path::Path;
+use std::process::{Command, ExitStatus, Stdio};
+use std::time::Instant;
+
+/// Lines of a failed tool's output quoted in [`run_tool`]'s error.
+const ERROR_TAIL: usize = 12;
+
+/// The program to run for a tool: the environment variable `var` when it is set and not
+/// empty (`make IVERILOG=/opt/iverilog/bin/iverilog`), else `default`.
+pub fn program(var: &str, default: &str) -> String {
+    std::env::var(var)
+        .ok()
+        .filter(|v| !v.is_empty())
+        .unwrap_or_else(|| default.to_string())
+}
+
+/// Whether `program` can be started: a path that is a file, or a name found on PATH.
+pub fn installed(program: &str) -> bool {
+    if program.contains('/') {
+        return Path::new(program).is_file();
+    }
+    std::env::var_os("PATH")
+        .map(|p| std::env::split_paths(&p).any(|d| d.join(program).is_file()))
+        .unwrap_or(false)
+}
+
+/// Parallel jobs for a tool's own build (Verilator's C++ compile): JOBS from the environment,
+/// else the cores available.
+pub fn jobs() -> usize {
+    std::env::var("JOBS")
+        .ok()
+        .and_then(|j| j.parse().ok())
+        .filter(|&j| j > 0)
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(2, |n| n.get()))
+}
+
+/// What a finished tool run gave.
+#[derive(Debug)]
+pub struct Ran {
+    pub status: ExitStatus,
+    /// stdout and stderr: in the order written for [`run_logged`], stdout then stderr for
+    /// [`capture`].
+    pub output: String,
+    /// Wall-clock seconds the run took.
+    pub seconds: f64,
+}
+
+impl Ran {
+    pub fn success(&self) -> bool {
+        self.status.success()
+    }
+
+    /// The last line of the output (empty if the output ends with an empty line), as `tail -n
+    /// 1` gives it.
+    pub fn last_line(&self) -> &str {
+        self.output.lines().last().unwrap_or("")
+    }
+
+    /// `exit N`, or `killed by signal N`.
+    pub fn exit(&self) -> String {
+        use std::os::unix::process::ExitStatusExt;
+        match (self.status.code(), self.status.signal()) {
+            (Some(c), _) => format!("exit {c}"),
+            (None, Some(s)) => format!("killed by signal {s}"),
+            (None, None) => "no exit status".into(),
+        }
+    }
+}
+
+fn start_error(cmd: &Command, e: std::io::Error) -> anyhow::Error {
+    anyhow::anyhow!(
+        "cannot run {}: {e}; is it installed? (make tools)",
+        cmd.get_program().to_string_lossy()
+    )
+}
+
+/// Runs `cmd` to the end with its output captured.
+pub fn capture(cmd: &mut Command) -> Result<Ran> {
+    let t0 = Instant::now();
+    let out = cmd
+        .stdin(Stdio::null())
+        .output()
+        .map_err(|e| start_error(cmd, e))?;
+    let mut output = String::from_utf8_lossy(&out.stdout).into_owned();
+    if !output.is_empty() && !output.ends_with('\n') && !out.stderr.is_empty() {
+        output.push('\n');
+    }
+    output.push_str(&String::from_utf8_lossy(&out.stderr));
+    Ok(Ran {
+        status: out.status,
+        output,
+        seconds: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// Runs `cmd` to the end with stdout and stderr both written to `log` in the order the tool
+/// wrote them (as a shell's `>log 2>&1`), and read back.
+pub fn run_logged(cmd: &mut Command, log: &Path) -> Result<Ran> {
+    let file =
+        std::fs::File::create(log).with_context(|| format!("cannot write {}", log.display()))?;
+    let err = file
+        .try_clone()
+        .with_context(|| format!("cannot write {}", log.display()))?;
+    let t0 = Instant::now();
+    let status = cmd
+        .stdin(Stdio::null())
+        .stdout(file)
+        .stderr(err)
+        .status()
+        .map_err(|e| start_error(cmd, e))?;
+    let seconds = t0.elapsed().as_secs_f64();
+    let bytes = std::fs::read(log).with_context(|| format!("cannot read {}", log.display()))?;
+    Ok(Ran {
+        status,
+        output: String::from_utf8_lossy(&bytes).into_owned(),
+        seconds,
+    })
+}
+
+/// Runs `cmd`; a failure (it cannot start, or exits non-zero) is an error that names `what`
+/// and the command and quotes the last lines of its output.
+pub fn run_tool(cmd: &mut Command, what: &str) -> Result<Ran> {
+    let ran = capture(cmd).with_context(|| format!("{what}: {}", shell_line(cmd)))?;
+    if !ran.success() {
+        bail!(
+            "{what} failed ({}; {}): {}",
+            shell_line(cmd),
+            ran.exit(),
+            tail(&ran.output, ERROR_TAIL).join(" | ")
+        );
+    }
+    Ok(ran)
+}
+
+/// The last `n` lines of `text`.
+pub fn tail(text: &str, n: usize) -> Vec<&str> {
+    let lines: Vec<&str> = text.lines().collect();
+    lines[lines.len().saturating_sub(n)..].to_vec()
+}
+
+/// The first line of a tool's output that says what went wrong: its first `ERROR:` line, an
+/// unknown option, or else its last line.
+pub fn complaint(text: &str) -> String {
+    let lines: Vec<&str> = text
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect();
+    lines
+        .iter()
+        .find(|l| l.starts_with("ERROR:"))
+        .or_else(|| {
+            lines
+                .iter()
+                .find(|l| l.contains("unrecognised option") || l.contains("unknown option"))
+        })
+        .or(lines.last())
+        .map(|l| l.to_string())
+        .unwrap_or_else(|| "no output".into())
+}
+
+/// A command as a shell line a person can paste: `(cd DIR && PROGRAM ARGS)` when it runs in
+/// another directory, each word quoted when it needs to be.
+pub fn shell_line(cmd: &Command) -> String {
+    let words: Vec<String> = std::iter::once(cmd.get_program())
+        .chain(cmd.get_args())
+        .map(|w| quote(&w.to_string_lossy()))
+        .collect();
+    match cmd.get_current_dir() {
+        Some(d) => format!(
+            "(cd {} && {})",
+            quote(&d.to_string_lossy()),
+            words.join(" ")
+        ),
+        None => words.join(" "),
+    }
+}
+
+fn quote(word: &str) -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "_-./=+:,@%".contains(c);
+    if !word.is_empty() && word.chars().all(plain) {
+        word.to_string()
+    } else {
+        format!("'{}'", word.replace('\'', r"'\''"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shell_lines_quote_what_a_shell_would_split() {
+        let mut c = Command::new("yosys");
+        c.args(["-p", "read_verilog a.v; stat", "it's"]);
+        assert_eq!(
+            shell_line(&c),
+            r"yosys -p 'read_verilog a.v; stat' 'it'\''s'"
+        );
+        c.current_dir("/tmp/d x");
+        assert!(shell_line(&c).starts_with("(cd '/tmp/d x' && yosys -p "));
+    }
+
+    #[test]
+    fn tails_and_complaints() {
+        assert_eq!(tail("a\nb\nc\n", 2), ["b", "c"]);
+        assert_eq!(tail("a", 5), ["a"]);
+        assert_eq!(
+            complaint("Info: x\nERROR: Unsupported package 'ct257'.\n0 warnings, 1 error\n"),
+            "ERROR: Unsupported package 'ct257'."
+        );
+        assert_eq!(
+            complaint("unrecognised option '--hx9k'\n"),
+            "unrecognised option '--hx9k'"
+        );
+        assert_eq!(complaint(""), "no output");
+    }
+
+    #[test]
+    fn a_failing_tool_is_an_error_naming_the_command_and_quoting_its_output() {
+        let mut c = Command::new("sh");
+        c.args(["-c", "echo one; echo two >&2; exit 3"]);
+        let e = run_tool(&mut c, "the shell").unwrap_err().to_string();
+        assert!(e.starts_with("the shell failed (sh -c "), "{e}");
+        assert!(e.contains("exit 3") && e.ends_with("one | two"), "{e}");
+        let e = run_tool(&mut Command::new("/nonexistent/tool"), "x").unwrap_err();
+        assert!(
+            format!("{e:#}").contains("cannot run /nonexistent/tool"),
+            "{e:#}"
+        );
+    }
+
+    #[test]
+    fn a_logged_run_keeps_the_order_of_stdout_and_stderr() {
+        let d = tempfile::tempdir().unwrap();
+        let log = d.path().join("log");
+        let mut c = Command::new("sh");
+        c.args(["-c", "echo a; echo b >&2; echo c"]);
+        let ran = run_logged(&mut c, &log).unwrap();
+        assert!(ran.success());
+        assert_eq!(ran.output, "a\nb\nc\n");
+        assert_eq!(ran.last_line(), "c");
+        assert_eq!(std::fs::read_to_string(&log).unwrap(), "a\nb\nc\n");
+    }
+}

@@ -1,0 +1,246 @@
+//! Yosys: `synth_ice40` for place and route ([`synth_ice40`]: what `rmapgen fpga`, bench and
+//! `fit --cost cells` measure) and the synthesis check of `rmapgen synth` ([`check`]: no
+//! latch, the memories inferred, the cells mapped for the iCE40 or to generic gates). Both run
+//! in the generated directory, so that `$readmemh` finds the hex files, and write their logs,
+//! statistics and netlist to a log directory, never into the design.
+
+use anyhow::{bail, Context, Result};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The log every run writes into its log directory.
+pub const LOG: &str = "yosys.log";
+
+/// `YOSYS`, else `yosys`.
+pub fn yosys() -> String {
+    super::program("YOSYS", "yosys")
+}
+
+/// Whether Yosys runs (`yosys -V`).
+pub fn available() -> bool {
+    Command::new(yosys())
+        .arg("-V")
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+/// `yosys -q -l LOGS/yosys.log -p SCRIPT`, run from `dir`.
+fn command(dir: &Path, logs: &Path, script: &str) -> Command {
+    let mut c = Command::new(yosys());
+    c.args(["-q", "-l"])
+        .arg(logs.join(LOG))
+        .args(["-p", script])
+        .current_dir(dir);
+    c
+}
+
+/// What `synth_ice40` mapped the design to.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Ice40Stat {
+    /// Every cell, each SB_RAM40_4K one.
+    pub cells: u32,
+    pub luts: u32,
+    pub carries: u32,
+    /// SB_DFF* of every kind.
+    pub flip_flops: u32,
+}
+
+/// `synth_ice40 -top TOP` of `files` (names in `dir`) for place and route: the netlist
+/// `LOGS/<top>.json`, `yosys.log` and the statistics `yosys_stat.txt` go to `logs`. The flow
+/// `rmapgen fpga`, bench and `fit --cost cells` measure (figures in README.md come from it).
+pub fn synth_ice40(dir: &Path, top: &str, files: &[String], logs: &Path) -> Result<Ice40Stat> {
+    let json = logs.join(format!("{top}.json"));
+    let stat = logs.join("yosys_stat.txt");
+    let script = format!(
+        "read_verilog {}; synth_ice40 -top {top} -json {}; tee -q -o {} stat",
+        files.join(" "),
+        json.display(),
+        stat.display()
+    );
+    let ran = super::capture(&mut command(dir, logs, &script))?;
+    if !ran.success() {
+        let log = std::fs::read_to_string(logs.join(LOG)).unwrap_or_default();
+        bail!(
+            "yosys synth_ice40 failed: {}",
+            super::complaint(&format!("{log}\n{}", ran.output))
+        );
+    }
+    let text = std::fs::read_to_string(&stat)
+        .with_context(|| format!("cannot read {}", stat.display()))?;
+    let counts = cell_counts(&text);
+    Ok(Ice40Stat {
+        cells: last_number(&text, "Number of cells:").context("yosys printed no cell count")?,
+        luts: last_count(&counts, |t| t == "SB_LUT4"),
+        carries: last_count(&counts, |t| t == "SB_CARRY"),
+        flip_flops: counts
+            .iter()
+            .filter(|(t, _)| t.starts_with("SB_DFF"))
+            .map(|c| c.1)
+            .sum(),
+    })
+}
+
+/// What [`check`] maps the design to after its checks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Flow {
+    /// `synth_ice40`, also writing the netlist `<top>.json`.
+    Ice40,
+    /// Yosys's own `synth` without its memory mapping: memories stay memory cells (`$mem_v2`),
+    /// as an ASIC flow maps them to SRAM macros, so any width can be checked, also designs far
+    /// larger than an FPGA; everything else goes to generic gates.
+    Generic,
+}
+
+/// What [`check`] found.
+#[derive(Clone, Debug)]
+pub struct Check {
+    /// Yosys exited 0: no latch and the synthesis ran through.
+    pub passed: bool,
+    /// The log, for people.
+    pub log: PathBuf,
+    /// The log's lines with `ERROR`, `Assertion` or `Warning` (what went wrong, on failure).
+    pub problems: Vec<String>,
+    /// The final statistics from `Number of cells` on.
+    pub cells_report: String,
+    pub cells: u32,
+    /// Memory bits before memory mapping.
+    pub memory_bits: u64,
+    /// SB_RAM40_4K block RAMs (iCE40) or `$mem_v2` memories kept (generic).
+    pub memories: u32,
+}
+
+/// The synthesis check of a generated design: `read_verilog FILES; hierarchy -check -top TOP;
+/// proc; flatten`, the memory statistics, `select -assert-none` on every kind of latch (`proc`
+/// turns an incomplete combinational assignment into one), then `flow`, its cell statistics
+/// and (generic) `check -assert`. Logs and statistics go to `logs`. A failure of Yosys is a
+/// [`Check`] with `passed` false; an error only when Yosys cannot run.
+pub fn check(dir: &Path, top: &str, files: &[String], logs: &Path, flow: Flow) -> Result<Check> {
+    let memory = logs.join("memory.txt");
+    let cells = logs.join("cells.txt");
+    let front = format!(
+        "read_verilog {}; hierarchy -check -top {top}; proc; flatten;
+tee -q -o {} stat;
+select -assert-none t:$dlatch t:$adlatch t:$dlatchsr t:$_DLATCH_* t:$_DLATCHSR_*;",
+        files.join(" "),
+        memory.display()
+    );
+    let script = match flow {
+        // synth's own script without memory_map: the coarse pass infers the memories, the
+        // fine steps map everything else to gates.
+        Flow::Generic => format!(
+            "{front}
+synth -top {top} -run coarse:fine;
+opt -fast -full; opt -full; techmap; opt -fast; abc -fast; opt -fast;
+tee -q -o {} stat; check -assert",
+            cells.display()
+        ),
+        Flow::Ice40 => format!(
+            "{front}
+synth_ice40 -top {top} -json {};
+tee -q -o {} stat",
+            logs.join(format!("{top}.json")).display(),
+            cells.display()
+        ),
+    };
+    let ran = super::capture(&mut command(dir, logs, &script))?;
+    let log = logs.join(LOG);
+    if !ran.success() {
+        let text = std::fs::read_to_string(&log)
+            .ok()
+            .filter(|t| !t.is_empty())
+            .unwrap_or(ran.output);
+        let problems = text
+            .lines()
+            .filter(|l| {
+                ["ERROR", "Assertion", "Warning"]
+                    .iter()
+                    .any(|w| l.contains(w))
+            })
+            .map(String::from)
+            .collect();
+        return Ok(Check {
+            passed: false,
+            log,
+            problems,
+            cells_report: String::new(),
+            cells: 0,
+            memory_bits: 0,
+            memories: 0,
+        });
+    }
+    let read = |p: &Path| {
+        std::fs::read_to_string(p).with_context(|| format!("cannot read {}", p.display()))
+    };
+    let (memory_text, cells_text) = (read(&memory)?, read(&cells)?);
+    let counts = cell_counts(&cells_text);
+    let kind = match flow {
+        Flow::Ice40 => "SB_RAM40_4K",
+        Flow::Generic => "$mem_v2",
+    };
+    Ok(Check {
+        passed: true,
+        log,
+        problems: Vec::new(),
+        cells_report: cells_text
+            .find("Number of cells")
+            .map(|i| {
+                let start = cells_text[..i].rfind('\n').map_or(0, |n| n + 1);
+                cells_text[start..].to_string()
+            })
+            .unwrap_or_default(),
+        cells: last_number(&cells_text, "Number of cells:")
+            .context("yosys printed no cell count")?,
+        memory_bits: memory_text
+            .lines()
+            .find_map(|l| l.trim().strip_prefix("Number of memory bits:"))
+            .and_then(|n| n.trim().parse().ok())
+            .context("yosys printed no memory bit count")?,
+        memories: last_count(&counts, |t| t == kind),
+    })
+}
+
+/// The value of the last `label N` line.
+fn last_number(text: &str, label: &str) -> Option<u32> {
+    text.lines()
+        .rev()
+        .find_map(|l| l.trim().strip_prefix(label))
+        .and_then(|n| n.trim().parse().ok())
+}
+
+/// Every `TYPE N` line of `stat` output, in order.
+fn cell_counts(text: &str) -> Vec<(String, u32)> {
+    text.lines()
+        .filter_map(|l| {
+            let mut w = l.split_whitespace();
+            let (t, n) = (w.next()?, w.next()?);
+            (w.next().is_none())
+                .then(|| n.parse().ok().map(|n| (t.to_string(), n)))
+                .flatten()
+        })
+        .collect()
+}
+
+/// The last count of a cell type `is` accepts (0 if none): stat prints the top module last.
+fn last_count(counts: &[(String, u32)], is: impl Fn(&str) -> bool) -> u32 {
+    counts.iter().rev().find(|(t, _)| is(t)).map_or(0, |c| c.1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn statistics_are_read_as_yosys_prints_them() {
+        let text = "=== rmap_top ===\n\n   Number of memory bits:        37120\n   Number of cells:               2478\n     SB_CARRY                      376\n     SB_DFF                        825\n     SB_DFFR                        25\n     SB_LUT4                      1182\n     SB_RAM40_4K                    11\n";
+        let c = cell_counts(text);
+        assert_eq!(last_number(text, "Number of cells:"), Some(2478));
+        assert_eq!(last_count(&c, |t| t == "SB_RAM40_4K"), 11);
+        assert_eq!(last_count(&c, |t| t == "$mem_v2"), 0);
+        let ffs: u32 = c
+            .iter()
+            .filter(|x| x.0.starts_with("SB_DFF"))
+            .map(|x| x.1)
+            .sum();
+        assert_eq!(ffs, 850);
+    }
+}
