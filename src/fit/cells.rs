@@ -16,7 +16,7 @@ pub fn cells(cfg: &Config, scene: &Scene) -> Result<u64> {
     let dir = out.commit()?;
     let files: Vec<String> = manifest.modules.iter().map(|m| m.file.clone()).collect();
     let yosys = fpga::Options::default().yosys;
-    let stat = fpga::synth_ice40(&dir, "rmap_top", &files, tmp.path(), &yosys)
+    let stat = fpga::synth_ice40(&dir, &manifest.top, &files, tmp.path(), &yosys)
         .with_context(|| format!("--cost cells: synthesis of {}", cfg.summary()))?;
     Ok(stat.cells as u64)
 }

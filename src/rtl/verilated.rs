@@ -6,6 +6,7 @@ use crate::config::Config;
 use crate::model::IntensitySource;
 use crate::output::StagedDir;
 use crate::scene::Scene;
+use crate::stages::TOP;
 use crate::vectors::inputs::enc_grad;
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
@@ -76,7 +77,15 @@ impl VerilatedTop {
             "fast",
             "--noassert",
         ])
-        .args(["-Wno-fatal", "--top-module", "rmap_top", "--Mdir"])
+        // The harness includes Vrmap_top.h whatever the configuration's prefix.
+        .args([
+            "-Wno-fatal",
+            "--top-module",
+            &TOP.module(cfg),
+            "--prefix",
+            "Vrmap_top",
+        ])
+        .arg("--Mdir")
         .arg(&mdir)
         .args(["-o", "top_apply"])
         .args(&sources)

@@ -167,7 +167,7 @@ pub fn write_all(design: &Design, out: &StagedDir, random: usize, seed: u64) -> 
     check_stage_vectors(random, "--vectors")?;
     for stage in stages::checked(design.cfg()) {
         out.write_text(
-            &stage.vector_file(),
+            &stage.vector_file(design.cfg()),
             &stage_text(stage, &design.model, &design.maps, random, seed),
         )?;
     }
