@@ -189,8 +189,14 @@ pub fn assert_passed(what: &str, (code, out): &(Option<i32>, String), n: usize) 
 
 /// `verilator --lint-only -Wall` over the design: it must exit 0 and print nothing.
 pub fn assert_lint_clean(what: &str, dir: &Path) {
+    assert_lint_clean_top(what, dir, "rmap_top")
+}
+
+/// `verilator --lint-only -Wall --top-module top` over every .v file of `dir`: it must exit 0
+/// and print nothing.
+pub fn assert_lint_clean_top(what: &str, dir: &Path, top: &str) {
     let o = Command::new("verilator")
-        .args(["--lint-only", "-Wall", "--top-module", "rmap_top"])
+        .args(["--lint-only", "-Wall", "--top-module", top])
         .args(design_files(dir))
         .current_dir(dir)
         .output()
