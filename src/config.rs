@@ -40,6 +40,41 @@ pub struct Config {
     /// sample is accepted, `ready_i` low stalls the whole pipeline. Off: a plain valid
     /// stream that accepts a sample every clock `valid_i` is high.
     pub handshake: bool,
+    /// Prepended to every generated module name and to every file named after a module or
+    /// holding memory contents (`<prefix>rmap_top.v`, `<prefix>recip_rom.hex`, the
+    /// testbenches and vector files), and part of the FuseSoC core's name, so that two
+    /// generated designs can live in one project. Empty (the default) or a Verilog identifier
+    /// prefix: [`check_prefix`]. [`Config::prefixed`] applies it. Left out of the TOML and
+    /// JSON when empty, so a design without one is written as before it existed.
+    #[serde(skip_serializing_if = "String::is_empty")]
+    pub prefix: String,
+}
+
+/// Longest [`Config::prefix`].
+pub const PREFIX_MAX_LEN: usize = 32;
+
+/// Why `p` is not a valid [`Config::prefix`], or `Ok` when it is: empty, or at most
+/// [`PREFIX_MAX_LEN`] ASCII letters, digits and `_`, not starting with a digit (so
+/// `<prefix><module>` is a plain Verilog identifier and a portable file name).
+pub fn check_prefix(p: &str) -> Result<(), String> {
+    let what = "a letter or _ then letters, digits and _";
+    let n = p.chars().count();
+    if n > PREFIX_MAX_LEN {
+        return Err(format!(
+            "is {n} characters long; allowed {what}, at most {PREFIX_MAX_LEN} characters"
+        ));
+    }
+    match p.chars().next() {
+        None => Ok(()),
+        Some(c) if c.is_ascii_digit() => Err(format!("starts with a digit; allowed {what}")),
+        Some(_) => match p
+            .chars()
+            .find(|c| !(c.is_ascii_alphanumeric() || *c == '_'))
+        {
+            Some(c) => Err(format!("has {c:?}; allowed {what}")),
+            None => Ok(()),
+        },
+    }
 }
 
 /// Allowed values of [`Config::pipeline_depth`].
@@ -73,6 +108,9 @@ pub enum ConfigError {
         min: u32,
         max: u32,
     },
+    /// A prefix that is not a Verilog identifier prefix ([`check_prefix`]).
+    #[error("prefix = {value:?} {why}")]
+    BadPrefix { value: String, why: String },
     /// Two or more fields that do not go together: the fields, and what to do.
     #[error("{message}")]
     Conflict {
@@ -86,6 +124,7 @@ impl ConfigError {
     pub fn fields(&self) -> Vec<&'static str> {
         match self {
             ConfigError::OutOfRange { field, .. } => vec![field],
+            ConfigError::BadPrefix { .. } => vec!["prefix"],
             ConfigError::Conflict { fields, .. } => fields.clone(),
         }
     }
@@ -121,6 +160,7 @@ impl Default for Config {
             // Not the paper's: the depth that meets 125 MHz on an iCE40 HX8K.
             pipeline_depth: 2,
             handshake: false,
+            prefix: String::new(),
         }
     }
 }
@@ -159,6 +199,12 @@ impl Config {
                 value: self.pipeline_depth,
                 min,
                 max,
+            });
+        }
+        if let Err(why) = check_prefix(&self.prefix) {
+            return Err(ConfigError::BadPrefix {
+                value: self.prefix.clone(),
+                why,
             });
         }
         let c = |fields: &[&'static str], message: String| {
@@ -211,6 +257,12 @@ impl Config {
             )
         })?;
         Ok(cfg)
+    }
+
+    /// `name` with the [`Config::prefix`]: every generated module name and every generated
+    /// file named after a module or holding memory contents is made here, and nowhere else.
+    pub fn prefixed(&self, name: &str) -> String {
+        format!("{}{name}", self.prefix)
     }
 
     /// Magnitude width: |-(2^(G-1))| needs all G bits.
@@ -376,6 +428,40 @@ mod tests {
         };
         let e = c.validate().unwrap_err().to_string();
         assert!(e.contains("grad_bits = 20") && e.contains("8..=16"), "{e}");
+    }
+
+    #[test]
+    fn prefixes_are_verilog_identifier_prefixes() {
+        for ok in ["", "a_", "_", "Shader2_", "x", &"a".repeat(PREFIX_MAX_LEN)] {
+            assert_eq!(check_prefix(ok), Ok(()), "{ok:?}");
+            let c = Config {
+                prefix: ok.to_string(),
+                ..Config::default()
+            };
+            c.validate().unwrap();
+            assert_eq!(c.prefixed("rmap_top"), format!("{ok}rmap_top"));
+        }
+        for (bad, why) in [
+            ("9a_", "starts with a digit"),
+            ("a-b", "has '-'"),
+            ("a b", "has ' '"),
+            ("a/", "has '/'"),
+            ("a$", "has '$'"),
+            ("é", "has 'é'"),
+            (&"a".repeat(PREFIX_MAX_LEN + 1), "33 characters long"),
+        ] {
+            let c = Config {
+                prefix: bad.to_string(),
+                ..Config::default()
+            };
+            let e = c.validate().unwrap_err();
+            assert_eq!(e.fields(), ["prefix"]);
+            let e = e.to_string();
+            assert!(
+                e.starts_with("prefix = ") && e.contains(why),
+                "{bad:?}: {e}"
+            );
+        }
     }
 
     #[test]

@@ -38,6 +38,7 @@ macro_rules! grid {
                     index_bits: $i, interp_bits: $p, map_bits: $m,
                     compensation: $comp == 1, interpolation: $interp == 1, color: $color == 1,
                     pipeline_depth: $depth, handshake: $hs == 1,
+                    prefix: String::new(),
                 },
                 icarus: $icarus == 1,
                 covers: $covers,

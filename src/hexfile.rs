@@ -2,6 +2,7 @@
 //! configuration (Icarus, Verilator and Yosys all accept them), then one entry per line.
 
 use crate::config::Config;
+use crate::model::map_set::{map_file, AXES};
 use crate::model::{Maps, Model};
 use crate::stages;
 
@@ -29,12 +30,12 @@ pub fn format(cfg: &Config, what: &str, bits: u32, entries: &[u32]) -> String {
 pub fn all(model: &Model, maps: &Maps) -> Vec<(String, String)> {
     let cfg = &model.cfg;
     let mut v = vec![(
-        stages::recip_rom::INIT_FILE.to_string(),
+        stages::recip_rom::init_file(cfg),
         format(cfg, "reciprocal ROM", cfg.recip_bits, &model.recip),
     )];
     if let Some(atan) = &model.atan {
         v.push((
-            stages::atan_rom::INIT_FILE.to_string(),
+            stages::atan_rom::init_file(cfg),
             format(
                 cfg,
                 "distortion compensation (atan) ROM",
@@ -43,9 +44,9 @@ pub fn all(model: &Model, maps: &Maps) -> Vec<(String, String)> {
             ),
         ));
     }
-    for (axis, name) in ["x", "y", "z"].iter().enumerate() {
+    for (axis, name) in AXES.iter().enumerate() {
         v.push((
-            format!("map_{name}.hex"),
+            map_file(cfg, 0, name),
             format(
                 cfg,
                 &format!("reflectance map, max axis {name}, address {{s_max, s_u, i_u, s_v, i_v}}"),

@@ -42,6 +42,8 @@ pub struct ConfigArgs {
     /// plain valid stream.
     #[arg(long)]
     pub handshake: bool,
+    #[arg(long, value_name = "P", value_parser = parse::prefix(), help = parse::prefix_help())]
+    pub prefix: Option<String>,
 }
 
 impl ConfigArgs {
@@ -134,6 +136,10 @@ impl ConfigArgs {
         if self.handshake {
             c.handshake = true;
             flags.push(("handshake", "--handshake".into()));
+        }
+        if let Some(p) = &self.prefix {
+            c.prefix = p.clone();
+            flags.push(("prefix", format!("--prefix {p}")));
         }
         let Err(e) = c.validate() else {
             return Ok(c);

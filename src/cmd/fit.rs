@@ -188,7 +188,7 @@ pub fn run(a: &FitArgs) -> Result<()> {
         ),
     }
     print!("{}", d.table());
-    let modules: Vec<&str> = manifest.modules.iter().map(|m| m.name).collect();
+    let modules: Vec<&str> = manifest.modules.iter().map(|m| m.name.as_str()).collect();
     println!(
         "fit: wrote {} ({} memory bits; modules {}) to {}",
         cfg.summary(),

@@ -138,6 +138,44 @@ where
     }
 }
 
+/// A [`crate::config::Config::prefix`], checked by [`crate::config::check_prefix`]:
+/// `--prefix 9a` says `--prefix "9a" starts with a digit; allowed ...`.
+#[derive(Clone)]
+pub struct Prefix;
+
+pub fn prefix() -> Prefix {
+    Prefix
+}
+
+/// The help of `--prefix`.
+pub fn prefix_help() -> String {
+    format!(
+        "Prefix of every generated module, file, hex file and of the FuseSoC core's name, so two \
+         designs can share a project: a letter or _, then letters, digits and _, at most {} \
+         [default: none]",
+        crate::config::PREFIX_MAX_LEN
+    )
+}
+
+impl TypedValueParser for Prefix {
+    type Value = String;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &OsStr,
+    ) -> Result<String, clap::Error> {
+        let name = flag_name(arg);
+        let s = value
+            .to_str()
+            .ok_or_else(|| fail(cmd, format!("{name} {value:?} is not UTF-8")))?;
+        crate::config::check_prefix(s)
+            .map(|()| s.to_string())
+            .map_err(|why| fail(cmd, format!("{name} {s:?} {why}")))
+    }
+}
+
 /// A finite number above `min` (or at least `min` when `inclusive`).
 #[derive(Clone)]
 pub struct Real {

@@ -15,7 +15,7 @@ pub fn cells(cfg: &Config, scene: &Scene) -> Result<u64> {
     let manifest = crate::rtl::write_design(&crate::design::Design::for_scene(cfg, scene)?, &out)?;
     let dir = out.commit()?;
     let files: Vec<String> = manifest.modules.iter().map(|m| m.file.clone()).collect();
-    let stat = crate::toolchain::yosys::synth_ice40(&dir, "rmap_top", &files, tmp.path())
+    let stat = crate::toolchain::yosys::synth_ice40(&dir, &manifest.top, &files, tmp.path())
         .with_context(|| format!("--cost cells: synthesis of {}", cfg.summary()))?;
     Ok(stat.cells as u64)
 }

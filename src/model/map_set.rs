@@ -29,12 +29,13 @@ impl MapSet {
         }
     }
 
-    /// Reads `map_{x,y,z}.hex` and `map2_{x,y,z}.hex` from a generated design directory, so
-    /// the vectors match whatever scene the design was generated with.
+    /// Reads `map_{x,y,z}.hex` and `map2_{x,y,z}.hex` ([`map_file`], with the
+    /// configuration's prefix) from a generated design directory, so the vectors match
+    /// whatever scene the design was generated with.
     pub fn from_dir(cfg: &Config, dir: &Path) -> Result<MapSet> {
         Ok(MapSet {
-            scene: read_maps(cfg, dir, "map")?,
-            second: read_maps(cfg, dir, "map2")?,
+            scene: read_maps(cfg, dir, 0)?,
+            second: read_maps(cfg, dir, 1)?,
         })
     }
 
@@ -52,11 +53,22 @@ impl MapSet {
 /// 32 768 entries of a few bytes each; a file far beyond that is not a map.
 pub const MAX_MAP_FILE_BYTES: u64 = 16 << 20;
 
-/// Reads the three `$readmemh` files `<prefix>_{x,y,z}.hex` (logical address order).
-pub fn read_maps(cfg: &Config, dir: &Path, prefix: &str) -> Result<Maps> {
+/// The axes' names in map file names, in axis order.
+pub const AXES: [&str; 3] = ["x", "y", "z"];
+
+/// The logical map file (`$readmemh`, logical address order) of buffer `buf` (0 the scene's
+/// map, 1 the second map) and axis `axis` (one of [`AXES`], or a pattern such as `*` or
+/// `<axis>` in messages): `<prefix>map_<axis>.hex` and `<prefix>map2_<axis>.hex`.
+pub fn map_file(cfg: &Config, buf: u32, axis: &str) -> String {
+    let map = if buf == 0 { "map" } else { "map2" };
+    cfg.prefixed(&format!("{map}_{axis}.hex"))
+}
+
+/// Reads the three `$readmemh` files of buffer `buf`, [`map_file`] (logical address order).
+pub fn read_maps(cfg: &Config, dir: &Path, buf: u32) -> Result<Maps> {
     let mut data = Vec::with_capacity(3 * cfg.map_entries() as usize);
-    for axis in ["x", "y", "z"] {
-        let p = dir.join(format!("{prefix}_{axis}.hex"));
+    for axis in AXES {
+        let p = dir.join(map_file(cfg, buf, axis));
         if p.is_dir() {
             bail!("map {} is a directory, not a map file", p.display());
         }

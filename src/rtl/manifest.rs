@@ -16,7 +16,8 @@ pub struct Manifest {
     pub rmapgen_version: &'static str,
     pub config: Config,
     pub config_summary: String,
-    pub top: &'static str,
+    /// The top's module name (with the configuration's prefix, as every name here).
+    pub top: String,
     /// Clock cycles from accepting a sample to its result at the top's outputs.
     pub latency: u32,
     pub sideband_delays: SidebandDelays,
@@ -30,10 +31,11 @@ pub struct Manifest {
 
 #[derive(Clone, Debug, Serialize)]
 pub struct ModuleInfo {
-    pub name: &'static str,
+    /// The module name, [`crate::stages::Unit::module`].
+    pub name: String,
     pub file: String,
     /// The module that instantiates it; null for the top.
-    pub parent: Option<&'static str>,
+    pub parent: Option<String>,
     /// Input to registered output in clock cycles; null for pipe_delay (its DEPTH parameter).
     pub latency: Option<u32>,
     pub ports: Vec<ports::Port>,
@@ -50,12 +52,13 @@ impl Manifest {
         let modules = stages::modules(cfg)
             .into_iter()
             .map(|m| ModuleInfo {
-                name: m.name(),
-                file: m.file(),
+                name: m.module(cfg),
+                file: m.file(cfg),
                 parent: parents
                     .iter()
                     .find(|(n, _)| *n == m.name())
-                    .and_then(|(_, p)| *p),
+                    .and_then(|(_, p)| *p)
+                    .map(|p| cfg.prefixed(p)),
                 latency: m.latency(cfg),
                 ports: m.ports(cfg),
             })
@@ -65,7 +68,7 @@ impl Manifest {
             rmapgen_version: env!("CARGO_PKG_VERSION"),
             config: cfg.clone(),
             config_summary: cfg.summary(),
-            top: TOP.name(),
+            top: TOP.module(cfg),
             latency: rmap_top::top_latency(cfg),
             sideband_delays: rmap_top::sideband_delays(cfg),
             modules,

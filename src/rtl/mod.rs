@@ -13,6 +13,7 @@ pub mod verilated;
 
 use crate::design::Design;
 use crate::hexfile;
+use crate::model::map_set::{map_file, AXES};
 use crate::output::StagedDir;
 use crate::stages::map_bank::banks;
 use crate::stages::{self, Head};
@@ -22,19 +23,19 @@ pub use ports::{Dir, Port, Width};
 
 /// Every `$readmemh` file of a design: recip_rom.hex, atan_rom.hex (with compensation), the
 /// scene's logical maps map_<axis>.hex, the second map map2_<axis>.hex (the alternate scene's,
-/// which testbenches load through the host port) and the map banks' init files. `generate`
-/// and `roms` both write exactly these.
+/// which testbenches load through the host port) and the map banks' init files, each name
+/// with the configuration's prefix. `generate` and `roms` both write exactly these.
 pub fn hex_files(design: &Design) -> Vec<(String, String)> {
     let cfg = design.cfg();
     let maps = &design.maps;
     let mut v = hexfile::all(&design.model, &maps.scene);
     let alt = &maps.second;
-    for (axis, name) in ["x", "y", "z"].iter().enumerate() {
+    for (axis, name) in AXES.iter().enumerate() {
         let what = format!(
             "second reflectance map (scene two_lights), max axis {name}, address {{s_max, s_u, i_u, s_v, i_v}}"
         );
         v.push((
-            format!("map2_{name}.hex"),
+            map_file(cfg, 1, name),
             hexfile::format(cfg, &what, cfg.map_bits, alt.axis(axis as u32)),
         ));
     }
@@ -59,14 +60,12 @@ pub fn write_design(design: &Design, out: &StagedDir) -> Result<Manifest> {
         let text = m
             .render(cfg, Head::new(cfg, m))
             .with_context(|| format!("cannot render src/stages/{0}/{0}.v", m.name()))?;
-        write(m.file(), &text)?;
+        write(m.file(cfg), &text)?;
     }
-    let mut hex = Vec::new();
     for (name, text) in hex_files(design) {
-        hex.push(name.clone());
         write(name, &text)?;
     }
-    write(package::CORE_FILE.into(), &package::core(cfg, &hex)?)?;
+    write(package::core_file(cfg), &package::core(cfg)?)?;
     write(package::README_FILE.into(), &package::readme(cfg)?)?;
     files.push(manifest::FILE.to_string());
     let manifest = Manifest::new(cfg, files);

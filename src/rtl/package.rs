@@ -1,17 +1,26 @@
-//! The generated directory as a piece of IP: a FuseSoC core (`rmap_top.core`, CAPI2, file
-//! sets with the `.v` and `.hex` files, targets, the testbench's plusargs as parameters) and
-//! a `README.md` with the port table and the timing notes (latency, flow control, reset,
+//! The generated directory as a piece of IP: a FuseSoC core (`<prefix>rmap_top.core`, CAPI2,
+//! file sets with the `.v` and `.hex` files, targets, the testbench's plusargs as parameters)
+//! and a `README.md` with the port table and the timing notes (latency, flow control, reset,
 //! buffer swap and write rules), both from the same tables as the Verilog.
+//!
+//! The core's name ([`vlnv`]) differs between configurations: it carries the top's module
+//! name (with the prefix) and a hash of the configuration.
 
 use super::{manifest, Dir, Width};
 use crate::config::Config;
+use crate::model::map_set::{map_file, AXES};
+use crate::stages::map_bank::MapBank;
 use crate::stages::rmap_top::{latency_list, top_latency};
-use crate::stages::{self, TOP};
+use crate::stages::{self, Unit, TOP};
 use anyhow::{Context, Result};
 use askama::Template;
 
-pub const CORE_FILE: &str = "rmap_top.core";
 pub const README_FILE: &str = "README.md";
+
+/// The FuseSoC core file, `<top module>.core`.
+pub fn core_file(cfg: &Config) -> String {
+    format!("{}.core", TOP.module(cfg))
+}
 
 #[derive(Template)]
 #[template(path = "pkg/rmap_top.core")]
@@ -19,6 +28,10 @@ struct Core {
     version: &'static str,
     summary: String,
     vlnv: String,
+    core_file: String,
+    top: String,
+    tb_file: String,
+    vector_file: String,
     latency: u32,
     rtl_files: Vec<String>,
     mem_files: Vec<String>,
@@ -30,6 +43,13 @@ struct Core {
 struct Readme {
     version: &'static str,
     summary: String,
+    prefix: String,
+    top: String,
+    core_file: String,
+    vlnv: String,
+    tb_file: String,
+    map2: String,
+    bank_glob: String,
     config_rows: Vec<(String, String)>,
     ports: Vec<(String, String, String, String)>,
     handshake: bool,
@@ -39,27 +59,53 @@ struct Readme {
     memories: Vec<(String, String, String)>,
 }
 
-/// The core's VLNV name: rmapgen:ip:rmap_top:<version>.
-pub fn vlnv() -> String {
-    format!("rmapgen:ip:rmap_top:{}", env!("CARGO_PKG_VERSION"))
+/// The core's VLNV name, `rmapgen:ip:<top module>_<hash>:<version>`: the top's module name
+/// (with the prefix) and [`config_hash`], so that two configurations never share a name,
+/// with or without a prefix, and one configuration always has the same one.
+pub fn vlnv(cfg: &Config) -> String {
+    format!(
+        "rmapgen:ip:{}_{}:{}",
+        TOP.module(cfg),
+        config_hash(cfg),
+        env!("CARGO_PKG_VERSION")
+    )
 }
 
-/// `rmap_top.core` for `cfg`; `hex` are the `$readmemh` and map2 files of the directory.
-pub fn core(cfg: &Config, hex: &[String]) -> Result<String> {
-    let (tb, mem): (Vec<String>, Vec<String>) =
-        hex.iter().cloned().partition(|f| f.starts_with("map2_"));
+/// Eight hex digits naming a configuration: the low 32 bits of the 64-bit FNV-1a hash of
+/// its TOML (what `tb/config.toml` holds, prefix included). Stable across runs, machines
+/// and rmapgen versions as long as the configuration's fields are; the scene (the maps'
+/// initial contents) is data, not configuration, and is not part of it.
+pub fn config_hash(cfg: &Config) -> String {
+    let text = toml::to_string(cfg).expect("a Config serialises");
+    let h = text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
+    });
+    format!("{:08x}", h as u32)
+}
+
+/// `<top module>.core` for `cfg`: the design's modules and the init files they read, and
+/// the top's testbench with its vectors and the second map it loads.
+pub fn core(cfg: &Config) -> Result<String> {
+    let top = TOP.vectors().expect("the top has vectors");
+    let mut mem_files: Vec<String> = Vec::new();
+    for m in TOP.memories(cfg) {
+        if !mem_files.contains(&m.init_file) {
+            mem_files.push(m.init_file);
+        }
+    }
     let text = Core {
         version: env!("CARGO_PKG_VERSION"),
         summary: cfg.summary(),
-        vlnv: vlnv(),
+        vlnv: vlnv(cfg),
+        core_file: core_file(cfg),
+        top: TOP.module(cfg),
+        tb_file: top.testbench_file(cfg),
+        vector_file: top.vector_file(cfg),
         latency: top_latency(cfg),
-        rtl_files: stages::modules(cfg).iter().map(|m| m.file()).collect(),
-        // The logical maps map_<axis>.hex are for people and tools, not the design.
-        mem_files: mem
-            .into_iter()
-            .filter(|f| !["map_x.hex", "map_y.hex", "map_z.hex"].contains(&f.as_str()))
-            .collect(),
-        tb_files: tb,
+        rtl_files: stages::modules(cfg).iter().map(|m| m.file(cfg)).collect(),
+        // Not the logical maps map_<axis>.hex: they are for people and tools.
+        mem_files,
+        tb_files: AXES.iter().map(|a| map_file(cfg, 1, a)).collect(),
     }
     .render()
     .context("cannot render templates/pkg/rmap_top.core")?;
@@ -106,6 +152,16 @@ pub fn readme(cfg: &Config) -> Result<String> {
     let text = Readme {
         version: env!("CARGO_PKG_VERSION"),
         summary: cfg.summary(),
+        prefix: cfg.prefix.clone(),
+        top: TOP.module(cfg),
+        core_file: core_file(cfg),
+        vlnv: vlnv(cfg),
+        tb_file: TOP
+            .vectors()
+            .expect("the top has vectors")
+            .testbench_file(cfg),
+        map2: map_file(cfg, 1, "<axis>"),
+        bank_glob: format!("{}*.hex", MapBank.module(cfg)),
         config_rows,
         ports,
         handshake: cfg.handshake,

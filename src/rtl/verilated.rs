@@ -6,6 +6,7 @@ use crate::config::Config;
 use crate::model::IntensitySource;
 use crate::output::StagedDir;
 use crate::scene::Scene;
+use crate::stages::TOP;
 use crate::toolchain::{run_tool, verilator};
 use crate::vectors::inputs::enc_grad;
 use anyhow::{bail, Result};
@@ -42,7 +43,7 @@ impl VerilatedTop {
         let mdir = dir.path().join("obj");
         run_tool(
             &mut verilator::harness(
-                "rmap_top",
+                &TOP.module(cfg),
                 &mdir,
                 "top_apply",
                 &sources,

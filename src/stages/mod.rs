@@ -20,7 +20,8 @@
 //! | `pipe_delay` | sideband delay line | rmap_top | — |
 //!
 //! The rest of the generator walks [`modules`] and [`checked`]; only the top, which wires
-//! the stages together, names them.
+//! the stages together, names them. A folder's name is its stage's [`Unit::name`]; the
+//! generated module is [`Unit::module`], the name with the configuration's prefix.
 
 pub mod atan_rom;
 pub mod color_mul;

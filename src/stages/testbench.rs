@@ -26,7 +26,10 @@ pub struct FieldView {
 /// Everything the testbench templates read.
 pub struct TbData {
     pub header: String,
-    pub module: &'static str,
+    /// The module under test ([`crate::stages::Unit::module`]); the testbench is `<module>_tb`.
+    pub module: String,
+    /// `tb/<module>_tb.v`.
+    pub tb_file: String,
     pub summary: String,
     pub vector_file: String,
     pub field_list: String,
@@ -61,6 +64,8 @@ pub struct TbData {
     pub hex_files: Vec<String>,
     /// The second map, loaded through the host port (map_lookup and the top).
     pub map2_files: Vec<String>,
+    /// `map2_*.hex` with the prefix, for messages.
+    pub map2_pattern: String,
     pub map_entries: u32,
     pub map_addr_bits: u32,
     pub map_bits: u32,

@@ -74,7 +74,8 @@ pub fn harness(
             "fast",
             "--noassert",
         ])
-        .args(["--top-module", top])
+        // The C++ harnesses include Vrmap_top.h whatever the design's prefix.
+        .args(["--top-module", top, "--prefix", "Vrmap_top"])
         .arg("--Mdir")
         .arg(mdir)
         .args(["-o", exe])

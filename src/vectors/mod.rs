@@ -160,14 +160,14 @@ pub fn stage_text(
     s
 }
 
-/// Writes `vectors/<stage>.hex` for every stage present in the design, and
-/// `vectors/rmap_top.hex`, expecting buffer 0 to hold the design's scene map and buffer 1 its
+/// Writes `vectors/<module>.hex` ([`Vectors::vector_file`]) for every stage present in the
+/// design, and `vectors/rmap_top.hex` (each with the configuration's prefix), expecting buffer 0 to hold the design's scene map and buffer 1 its
 /// second map.
 pub fn write_all(design: &Design, out: &StagedDir, random: usize, seed: u64) -> Result<()> {
     check_stage_vectors(random, "--vectors")?;
     for stage in stages::checked(design.cfg()) {
         out.write_text(
-            &stage.vector_file(),
+            &stage.vector_file(design.cfg()),
             &stage_text(stage, &design.model, &design.maps, random, seed),
         )?;
     }

@@ -4,7 +4,7 @@
 {%- block description %}{% endblock %}
 //
 // Run from the generated directory, which holds vectors/ and the .hex files:
-//   iverilog -g2005 -Wall -Wno-timescale -s {= t.module =}_tb -o {= t.module =}_tb.vvp tb/{= t.module =}_tb.v *.v
+//   iverilog -g2005 -Wall -Wno-timescale -s {= t.module =}_tb -o {= t.module =}_tb.vvp {= t.tb_file =} *.v
 //   vvp -N {= t.module =}_tb.vvp      (-N: a failing run exits 1)
 // It reads {= t.vector_file =} (or the file of +vectors=FILE), one vector per line:
 //   {= t.field_list =}

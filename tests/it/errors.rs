@@ -249,6 +249,11 @@ fn toml_errors_name_the_key_and_line() {
         &run(&["render", "--config", c_, "--out", o_]),
         &format!("config {c_}:1:13: grad_bits: invalid type: string \"lots\", expected u32"),
     );
+    std::fs::write(&c, "index_bits = 3\nprefix = \"my core\"\n").unwrap();
+    assert_error(
+        &run(&["generate", "--config", c_, "--out", o_]),
+        &format!("config {c_}:2:10: prefix = \"my core\" has ' '"),
+    );
     std::fs::write(&c, "index_bits = 3\ngrad_bits = 30\n").unwrap();
     assert_error(
         &run(&["render", "--config", c_, "--out", o_]),
@@ -364,6 +369,14 @@ fn usage_errors_are_one_line_naming_the_flag() {
             "the following required arguments were not provided: --out <DIR>",
         ),
         (&[], "give a command: generate, roms, render"),
+        (
+            &["generate", "--prefix", "9a_", "--out", o_],
+            "--prefix \"9a_\" starts with a digit; allowed a letter or _ then letters, digits and _",
+        ),
+        (
+            &["render", "--prefix", "a-b", "--out", o_],
+            "--prefix \"a-b\" has '-'",
+        ),
     ];
     for (args, needle) in cases {
         assert_error(&run(args), needle);
@@ -385,6 +398,37 @@ fn usage_errors_are_one_line_naming_the_flag() {
     let v = run(&["--version"]);
     assert_eq!(v.status.code(), Some(0));
     assert!(String::from_utf8_lossy(&v.stdout).starts_with("rmapgen "));
+}
+
+/// Issue 14 §1: every command that takes the configuration flags refuses a prefix that is
+/// not a Verilog identifier prefix, in one line, and writes nothing.
+#[test]
+fn a_bad_prefix_is_refused_by_every_command() {
+    let t = tempdir();
+    let o = t.path().join("o");
+    let o_ = o.to_str().unwrap();
+    let long = "a".repeat(rmapgen::config::PREFIX_MAX_LEN + 1);
+    for (p, why) in [
+        ("1x", "starts with a digit"),
+        ("a.b", "has '.'"),
+        ("a/b", "has '/'"),
+        (long.as_str(), "is 33 characters long"),
+    ] {
+        for cmd in [
+            &["generate", "--out", o_][..],
+            &["roms", "--out", o_],
+            &["render", "--out", o_],
+            &["vectors", "--out", o_],
+            &["volume", "--synthetic", "--out", o_],
+            &["stress"],
+            &["fpga", "--logs", o_],
+        ] {
+            let mut args = cmd.to_vec();
+            args.extend(["--prefix", p]);
+            assert_error(&run(&args), &format!("--prefix {p:?} {why}"));
+        }
+    }
+    assert!(!o.exists());
 }
 
 #[test]

@@ -183,7 +183,13 @@ pub fn assert_passed(what: &str, (code, out): &(Option<i32>, String), n: usize) 
 
 /// `verilator --lint-only -Wall` over the design: it must exit 0 and print nothing.
 pub fn assert_lint_clean(what: &str, dir: &Path) {
-    let o = verilator::lint(dir, "rmap_top", &design_files(dir))
+    assert_lint_clean_top(what, dir, "rmap_top")
+}
+
+/// `verilator --lint-only -Wall --top-module top` over every .v file of `dir`: it must exit 0
+/// and print nothing.
+pub fn assert_lint_clean_top(what: &str, dir: &Path, top: &str) {
+    let o = verilator::lint(dir, top, &design_files(dir))
         .output()
         .expect("verilator runs");
     let said = format!(

@@ -16,6 +16,7 @@ mod limits;
 mod map_fit;
 mod model_stages;
 mod output_safety;
+mod prefix;
 mod render;
 mod rtl_generate;
 mod rtl_in_loop;

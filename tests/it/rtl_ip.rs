@@ -117,6 +117,7 @@ fn handshake_passes_under_backpressure_and_catches_a_broken_queue() {
 #[test]
 fn core_and_readme_describe_the_directory() {
     let tmp = helpers::tempdir();
+    let mut names = Vec::new();
     for flags in [&[][..], &["--handshake", "--color"][..]] {
         let dir = tmp
             .path()
@@ -125,17 +126,20 @@ fn core_and_readme_describe_the_directory() {
         let cfg = config_of(&dir);
         let core = std::fs::read_to_string(dir.join("rmap_top.core")).unwrap();
         assert!(core.starts_with("CAPI=2:\n"), "{core}");
+        // Named after the top and the configuration, so the two cores differ.
         assert!(core.contains(&format!(
-            "name: rmapgen:ip:rmap_top:{}",
+            "name: rmapgen:ip:rmap_top_{}:{}\n",
+            rtl::package::config_hash(&cfg),
             env!("CARGO_PKG_VERSION")
         )));
+        names.push(rtl::package::vlnv(&cfg));
         assert!(core.contains("toplevel: rmap_top\n") && core.contains("toplevel: rmap_top_tb"));
         // Every module file and every memory's init file, each of which exists.
         for m in stages::modules(&cfg) {
             assert!(
-                core.contains(&format!("      - {}\n", m.file())),
+                core.contains(&format!("      - {}\n", m.file(&cfg))),
                 "{}",
-                m.file()
+                m.file(&cfg)
             );
         }
         for mem in rtl::manifest::memories(&cfg) {
@@ -167,6 +171,7 @@ fn core_and_readme_describe_the_directory() {
         let m = std::fs::read_to_string(dir.join("manifest.json")).unwrap();
         assert!(m.contains("\"rmap_top.core\"") && m.contains("\"README.md\""));
     }
+    assert_ne!(names[0], names[1]);
 }
 
 #[test]

@@ -76,8 +76,9 @@ fn write(cfg: &Config, random: usize, seed: u64) -> (tempfile::TempDir, std::pat
     (tmp, target)
 }
 
+/// The stage's vector file in `dir` (written without a prefix).
 fn read(dir: &Path, stage: &dyn Vectors) -> String {
-    std::fs::read_to_string(dir.join(stage.vector_file())).unwrap()
+    std::fs::read_to_string(dir.join(stage.vector_file(&Config::default()))).unwrap()
 }
 
 /// One line as field name -> value.
@@ -420,7 +421,7 @@ fn maps_read_back_from_a_generated_directory() {
     );
     // The generated top vectors use that scene's map.
     let model = Model::new(&cfg);
-    for line in std::fs::read_to_string(out.join(by("rmap_top").vector_file()))
+    for line in std::fs::read_to_string(out.join(by("rmap_top").vector_file(&cfg)))
         .unwrap()
         .lines()
     {

@@ -7,7 +7,7 @@
 // (contents: rmapgen's model, atan_rom::contents). u and v each read their own copy of the
 // table, so each is a single-port synchronous ROM that maps to its own block RAM.{% if out_reg %} A fabric
 // register follows the block RAM's output register (pipeline_depth >= 1).{% endif %} Latency {= latency =}.
-module atan_rom #(
+module {= h.module =} #(
   parameter INIT_FILE = "{= init_file =}"  // $readmemh file, one POS-bit entry per line
 ) (
 {= h.ports =}

@@ -1,5 +1,5 @@
 //! The distortion-compensation (atan) ROM: the position stage with compensation on. Each
-//! fraction reads the ROM [`INIT_FILE`]; the ROM is instantiated twice (u and v), so each
+//! fraction reads the ROM [`init_file`]; the ROM is instantiated twice (u and v), so each
 //! copy is a single-port synchronous ROM in its own block RAM.
 
 pub mod model;
@@ -14,10 +14,12 @@ use crate::rtl::ports::Port;
 use crate::vectors::field::Field;
 use askama::Template;
 
-/// Its `$readmemh` file.
-pub const INIT_FILE: &str = "atan_rom.hex";
-
 pub struct AtanRom;
+
+/// Its `$readmemh` file, `<module>.hex`.
+pub fn init_file(cfg: &Config) -> String {
+    format!("{}.hex", AtanRom.module(cfg))
+}
 
 /// A fabric register after the ROM's block-RAM output register (pipeline_depth >= 1).
 fn out_reg(cfg: &Config) -> bool {
@@ -30,7 +32,7 @@ struct Verilog {
     h: Head,
     latency: u32,
     out_reg: bool,
-    init_file: &'static str,
+    init_file: String,
     pos: u32,
     entries: u32,
 }
@@ -57,8 +59,8 @@ impl Unit for AtanRom {
             .map(|rom| {
                 Memory::new(
                     rom,
-                    self.name(),
-                    INIT_FILE.into(),
+                    self.module(cfg),
+                    init_file(cfg),
                     cfg.atan_entries(),
                     cfg.pos_bits(),
                     false,
@@ -72,7 +74,7 @@ impl Unit for AtanRom {
             h,
             latency: self.latency(cfg).expect("fixed"),
             out_reg: out_reg(cfg),
-            init_file: INIT_FILE,
+            init_file: init_file(cfg),
             pos: cfg.pos_bits(),
             entries: cfg.atan_entries(),
         }

@@ -9,7 +9,7 @@
 // (c[j] ? i << (j+1) : 0) plus D; the product by K a tree of shifted copies of the numerator,
 // one per set bit of K. One LUT level and one carry chain per level, registered as
 // pipeline_depth = {= depth =} places them (rmapgen::stages::color_mul::Plan). Latency {= latency =}.
-module color_mul (
+module {= h.module =} (
 {= h.ports =}
 );
 

@@ -9,7 +9,7 @@
 // tree of weight-gated partial products (w[j] ? e << j : 0), all unsigned, one LUT level and
 // one carry chain per level, registered as pipeline_depth = {= depth =} places them
 // (rmapgen::stages::interpolate::Plan). Latency {= latency =}.
-module interpolate (
+module {= h.module =} (
 {= h.ports =}
 );
 

@@ -7,7 +7,7 @@
 // p = POS_MAX. The constant POS_MAX = (2^I - 1) * 2^P makes u' * POS_MAX a sum of I shifted
 // copies of u', an adder tree registered as pipeline_depth = {= depth =} places it
 // (rmapgen::stages::linear_index::Plan). Latency {= latency =}.
-module linear_index (
+module {= h.module =} (
 {= h.ports =}
 );
 

@@ -6,10 +6,12 @@
 //! {buf, axis[1:0], s_max, s_u, i_u >> 1, s_v, i_v >> 1}. Without interpolation one bank
 //! holds {buf, axis[1:0], s_max, s_u, i_u, s_v, i_v}. Axis slot 3 is unused and holds 0.
 
+use super::MapBank;
 use crate::config::Config;
 use crate::hexfile;
 use crate::model::map_addr::MapAddr;
 use crate::model::Maps;
+use crate::stages::Unit;
 
 /// Where one logical map entry lives: which bank (index into [`bank_names`]) and where in it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -36,13 +38,15 @@ pub fn bank_names(cfg: &Config) -> Vec<String> {
     }
 }
 
-/// The `$readmemh` file of bank `k`.
+/// The `$readmemh` file of bank `k`: `<module>.hex` for the only bank, `<module>_<name>.hex`
+/// for one of four.
 pub fn bank_file(cfg: &Config, k: usize) -> String {
+    let module = MapBank.module(cfg);
     let name = &bank_names(cfg)[k];
     if name.is_empty() {
-        "map_bank.hex".to_string()
+        format!("{module}.hex")
     } else {
-        format!("map_bank_{name}.hex")
+        format!("{module}_{name}.hex")
     }
 }
 

@@ -6,7 +6,7 @@
 // (both buffers hold the scene's map), so the design shades out of reset. A read and a write
 // of the same address in one cycle return undefined data; the top never issues one, because
 // samples read the front buffer and the host writes the back one. Latency 1.
-module map_bank #(
+module {= h.module =} #(
   parameter INIT_FILE = "{= init_file =}"  // $readmemh file, one M-bit entry per line
 ) (
 {= h.ports =}

@@ -48,7 +48,7 @@ impl Unit for MapBank {
     fn memories(&self, cfg: &Config) -> Vec<Memory> {
         vec![Memory::new(
             "mem",
-            self.name(),
+            self.module(cfg),
             banks::bank_file(cfg, 0),
             cfg.bank_entries(),
             cfg.map_bits,

@@ -19,7 +19,7 @@
 // Stage 1 forms the bank address; stage 2 reads the bank;{% if bank_reg %} stage 3 registers the bank's
 // output in the fabric (pipeline_depth >= 1);{% endif %} stage {= out =} registers the entry. Latency {= latency =}.
 {%- endif %}
-module map_lookup (
+module {= h.module =} (
 {= h.ports =}
 );
 
@@ -87,7 +87,7 @@ module map_lookup (
   // ---------------------------------------------------------------- stage 2
   wire [M-1:0] d00_q2, d10_q2, d01_q2, d11_q2;  // registered inside the banks
 {% for b in banks %}
-  map_bank #(
+  {= bank =} #(
     .INIT_FILE ("{= b.file =}")
   ) {= b.inst =} (
     .clk_i     (clk_i),
@@ -187,7 +187,7 @@ module map_lookup (
   // ---------------------------------------------------------------- stage 2
   wire [M-1:0] d_q2;  // registered inside the bank
 {% for b in banks %}
-  map_bank #(
+  {= bank =} #(
     .INIT_FILE ("{= b.file =}")
   ) {= b.inst =} (
     .clk_i     (clk_i),

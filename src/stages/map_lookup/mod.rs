@@ -52,6 +52,8 @@ struct BankInst {
 #[template(path = "map_lookup/map_lookup.v", syntax = "verilog")]
 struct Verilog {
     h: Head,
+    /// The map bank's module.
+    bank: String,
     latency: u32,
     bank_reg: bool,
     /// Stage number of the reorder (output) stage, and the suffixes of its inputs and outputs.
@@ -140,6 +142,7 @@ impl Unit for MapLookup {
         let out = plan.out_stage();
         Verilog {
             h,
+            bank: MapBank.module(cfg),
             latency: out,
             bank_reg: plan.bank_reg,
             out,

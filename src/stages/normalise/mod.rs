@@ -26,6 +26,8 @@ const ROM_INSTANCE: &str = "u_recip_rom";
 #[template(path = "normalise/normalise.v", syntax = "verilog")]
 struct Verilog {
     h: Head,
+    /// The reciprocal ROM's module.
+    rom: String,
     depth: u32,
     latency: u32,
     r: u32,
@@ -83,6 +85,7 @@ impl Unit for Normalise {
         let sw = p.sum_a.width();
         Verilog {
             h,
+            rom: RecipRom.module(cfg),
             depth: cfg.pipeline_depth,
             latency: p.latency,
             r: cfg.red_bits,

@@ -3,7 +3,7 @@
 
 // Delay line for sideband signals: q_o is d_i of DEPTH enabled clocks ago. Data only, no
 // reset (valid bits travel through the stages themselves).
-module pipe_delay #(
+module {= h.module =} #(
   parameter WIDTH = 1,  // bits carried
   parameter DEPTH = 1   // clocks of delay, >= 1
 ) (

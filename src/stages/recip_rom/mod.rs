@@ -1,5 +1,5 @@
 //! The reciprocal ROM that normalise reads: 1/m for every reduced max m, one synchronous
-//! read port, initialised from [`INIT_FILE`].
+//! read port, initialised from [`init_file`].
 
 pub mod model;
 
@@ -8,16 +8,18 @@ use crate::config::Config;
 use crate::rtl::ports::{i, o, Port};
 use askama::Template;
 
-/// Its `$readmemh` file.
-pub const INIT_FILE: &str = "recip_rom.hex";
-
 pub struct RecipRom;
+
+/// Its `$readmemh` file, `<module>.hex`.
+pub fn init_file(cfg: &Config) -> String {
+    format!("{}.hex", RecipRom.module(cfg))
+}
 
 #[derive(Template)]
 #[template(path = "recip_rom/recip_rom.v", syntax = "verilog")]
 struct Verilog {
     h: Head,
-    init_file: &'static str,
+    init_file: String,
     w: u32,
     entries: u32,
 }
@@ -48,8 +50,8 @@ impl Unit for RecipRom {
     fn memories(&self, cfg: &Config) -> Vec<Memory> {
         vec![Memory::new(
             "rom",
-            self.name(),
-            INIT_FILE.into(),
+            self.module(cfg),
+            init_file(cfg),
             cfg.recip_entries(),
             cfg.recip_bits,
             false,
@@ -59,7 +61,7 @@ impl Unit for RecipRom {
     fn render(&self, cfg: &Config, h: Head) -> askama::Result<String> {
         Verilog {
             h,
-            init_file: INIT_FILE,
+            init_file: init_file(cfg),
             w: cfg.recip_bits,
             entries: cfg.recip_entries(),
         }

@@ -5,7 +5,7 @@
 // (contents: rmapgen's model, recip_rom::contents). The reduced max always has its MSB set,
 // so the address is the R-1 bits below it. Read through a register so that it maps to block
 // RAM. Latency 1.
-module recip_rom #(
+module {= h.module =} #(
   parameter INIT_FILE = "{= init_file =}"  // $readmemh file, one W-bit entry per line
 ) (
 {= h.ports =}

@@ -24,14 +24,43 @@ pub use vectors::{corners_for_map, random_for_map, stream_lines};
 
 pub struct RmapTop;
 
+/// The module names ([`Unit::module`]) the top instantiates; a stage the configuration
+/// leaves out is named all the same and not instantiated.
+struct Modules {
+    zero_detect: String,
+    sort_shift: String,
+    normalise: String,
+    position: String,
+    map_lookup: String,
+    interpolate: String,
+    color_mul: String,
+    pipe_delay: String,
+}
+
+impl Modules {
+    fn new(cfg: &Config) -> Modules {
+        Modules {
+            zero_detect: ZeroDetect.module(cfg),
+            sort_shift: SortShift.module(cfg),
+            normalise: Normalise.module(cfg),
+            position: position(cfg).module(cfg),
+            map_lookup: MapLookup.module(cfg),
+            interpolate: Interpolate.module(cfg),
+            color_mul: ColorMul.module(cfg),
+            pipe_delay: PipeDelay.module(cfg),
+        }
+    }
+}
+
 #[derive(Template)]
 #[template(path = "rmap_top/rmap_top.v", syntax = "verilog")]
 struct Verilog {
     h: Head,
+    mods: Modules,
     handshake: bool,
     interpolation: bool,
     color: bool,
-    /// The position stage's module name.
+    /// The position stage's name (its instance is `u_<name>`).
     position: &'static str,
     r: u32,
     f: u32,
@@ -170,6 +199,7 @@ impl Unit for RmapTop {
         let d = sideband_delays(cfg);
         Verilog {
             h,
+            mods: Modules::new(cfg),
             handshake: cfg.handshake,
             interpolation: cfg.interpolation,
             color: cfg.color,

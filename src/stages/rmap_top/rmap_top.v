@@ -18,7 +18,7 @@
 // Map buffers: a sample accepted in the cycle of swap_i or later reads the new front buffer;
 // host writes go to the back buffer. After a swap, let the samples accepted before it leave
 // ({% if handshake %}the last of them leaves with valid_o && ready_i{% else %}LATENCY clocks{% endif %}) before writing into the old front buffer.
-module rmap_top (
+module {= h.module =} (
 {= h.ports =}
 );
 
@@ -68,7 +68,7 @@ module rmap_top (
   wire unused_zd_valid;  // the valid bit travels through sort_shift
   wire zd_zero;
 
-  zero_detect u_zero_detect (
+  {= mods.zero_detect =} u_zero_detect (
     .clk_i   (clk_i),
     .rst_ni  (rst_ni),
     .en_i    (en),
@@ -86,7 +86,7 @@ module rmap_top (
   wire         ss_s_max, ss_s_u, ss_s_v;
   wire [R-1:0] ss_m, ss_a, ss_b;
 
-  sort_shift u_sort_shift (
+  {= mods.sort_shift =} u_sort_shift (
     .clk_i   (clk_i),
     .rst_ni  (rst_ni),
     .en_i    (en),
@@ -108,7 +108,7 @@ module rmap_top (
   wire         nm_valid;
   wire [F-1:0] nm_u, nm_v;
 
-  normalise u_normalise (
+  {= mods.normalise =} u_normalise (
     .clk_i   (clk_i),
     .rst_ni  (rst_ni),
     .en_i    (en),
@@ -125,7 +125,7 @@ module rmap_top (
   wire           ps_valid;
   wire [POS-1:0] ps_u, ps_v;
 
-  {= position =} u_{= position =} (
+  {= mods.position =} u_{= position =} (
     .clk_i   (clk_i),
     .rst_ni  (rst_ni),
     .en_i    (en),
@@ -142,7 +142,7 @@ module rmap_top (
   wire       ml_s_max, ml_s_u, ml_s_v;
   wire       ml_rd_buf;
 
-  pipe_delay #(
+  {= mods.pipe_delay =} #(
     .WIDTH (5),
     .DEPTH (SIGN_DELAY)
   ) u_sign_delay (
@@ -152,7 +152,7 @@ module rmap_top (
     .q_o   ({ml_axis, ml_s_max, ml_s_u, ml_s_v})
   );
 
-  pipe_delay #(
+  {= mods.pipe_delay =} #(
     .WIDTH (1),
     .DEPTH (BUF_DELAY)
   ) u_buf_delay (
@@ -169,7 +169,7 @@ module rmap_top (
   wire [P:0]   ml_wu, ml_wv;
 {%- endif %}
 
-  map_lookup u_map_lookup (
+  {= mods.map_lookup =} u_map_lookup (
     .clk_i     (clk_i),
     .rst_ni    (rst_ni),
     .en_i      (en),
@@ -204,7 +204,7 @@ module rmap_top (
   wire         ip_valid;
   wire [M-1:0] ip_i;
 
-  interpolate u_interpolate (
+  {= mods.interpolate =} u_interpolate (
     .clk_i   (clk_i),
     .rst_ni  (rst_ni),
     .en_i    (en),
@@ -239,7 +239,7 @@ module rmap_top (
   wire [C-1:0] out_r, out_g, out_b;
   wire [C-1:0] cm_r, cm_g, cm_b;  // the sample's colour, delayed to color_mul
 
-  pipe_delay #(
+  {= mods.pipe_delay =} #(
     .WIDTH (3 * C),
     .DEPTH (RGB_DELAY)
   ) u_rgb_delay (
@@ -251,7 +251,7 @@ module rmap_top (
 
   // Colour times the intensity before zeroing: for a zero gradient the output register
   // forces the colour to 0, which is also what the intensity 0 would give.
-  color_mul u_color_mul (
+  {= mods.color_mul =} u_color_mul (
     .clk_i   (clk_i),
     .rst_ni  (rst_ni),
     .en_i    (en),
@@ -266,7 +266,7 @@ module rmap_top (
     .b_o     (out_b)
   );
 
-  pipe_delay #(
+  {= mods.pipe_delay =} #(
     .WIDTH (M),
     .DEPTH (I_DELAY)
   ) u_i_delay (
@@ -280,7 +280,7 @@ module rmap_top (
   assign out_i     = lk_i;
 {%- endif %}
 
-  pipe_delay #(
+  {= mods.pipe_delay =} #(
     .WIDTH (1),
     .DEPTH (ZERO_DELAY)
   ) u_zero_delay (

@@ -8,7 +8,7 @@
 // {% if mag_reg %}Stage 0 takes magnitudes; stage 1 compares{% else %}Stage 1 takes magnitudes, compares{% endif %} them and counts leading zeros (all three in
 // parallel, so the count does not wait for the compare){% if cmp_reg %}, registers that, and selects{% else %} and selects{% endif %};
 // stage 2 shifts. Latency {= latency =}.
-module sort_shift (
+module {= h.module =} (
 {= h.ports =}
 );
 

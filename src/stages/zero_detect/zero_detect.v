@@ -4,7 +4,7 @@
 // Zero detect: flags a gradient whose three components are all zero. Such a gradient has no
 // direction; the top forces its intensity (and colour) to zero and raises zero_o.
 // Latency 1.
-module zero_detect (
+module {= h.module =} (
 {= h.ports =}
 );
 
