@@ -11,7 +11,9 @@
 // table, so each is a single-port synchronous ROM that maps to its own block RAM. A fabric
 // register follows the block RAM's output register (pipeline_depth >= 1). Latency 2.
 module atan_rom #(
-  parameter INIT_FILE = "atan_rom.hex"  // $readmemh file, one POS-bit entry per line
+  // $readmemh files, one hex entry per line; a relative path resolves against the
+  // working directory of the simulator or synthesis tool.
+  parameter ATAN_ROM_FILE = "atan_rom.hex"   // rom_u, rom_v: 256 x 6 bits
 ) (
   input  wire       clk_i,
   input  wire       rst_ni,   // asynchronous, active low: clears valid bits only
@@ -34,8 +36,8 @@ module atan_rom #(
   (* ram_style = "block" *)
   reg [POS-1:0] rom_v [0:ENTRIES-1];
   initial begin
-    $readmemh(INIT_FILE, rom_u);
-    $readmemh(INIT_FILE, rom_v);
+    $readmemh(ATAN_ROM_FILE, rom_u);
+    $readmemh(ATAN_ROM_FILE, rom_v);
   end
 
   reg [POS-1:0] pu_q, pv_q;

@@ -9,7 +9,9 @@
 // of the same address in one cycle return undefined data; the top never issues one, because
 // samples read the front buffer and the host writes the back one. Latency 1.
 module map_bank #(
-  parameter INIT_FILE = "map_bank_00.hex"  // $readmemh file, one M-bit entry per line
+  // $readmemh files, one hex entry per line; a relative path resolves against the
+  // working directory of the simulator or synthesis tool.
+  parameter INIT_FILE = "map_bank_00.hex"   // mem: 1024 x 8 bits
 ) (
   input  wire       clk_i,
   input  wire       en_i,       // read enable: low holds rd_data_o

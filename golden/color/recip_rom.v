@@ -8,7 +8,9 @@
 // so the address is the R-1 bits below it. Read through a register so that it maps to block
 // RAM. Latency 1.
 module recip_rom #(
-  parameter INIT_FILE = "recip_rom.hex"  // $readmemh file, one W-bit entry per line
+  // $readmemh files, one hex entry per line; a relative path resolves against the
+  // working directory of the simulator or synthesis tool.
+  parameter RECIP_ROM_FILE = "recip_rom.hex"   // rom: 128 x 10 bits
 ) (
   input  wire       clk_i,
   input  wire       en_i,    // read enable: low holds data_o
@@ -24,7 +26,7 @@ module recip_rom #(
   (* ram_style = "block" *)
   reg [W-1:0] rom [0:ENTRIES-1];
   initial begin
-    $readmemh(INIT_FILE, rom);
+    $readmemh(RECIP_ROM_FILE, rom);
   end
 
   reg [W-1:0] data_q;

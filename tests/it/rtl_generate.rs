@@ -365,6 +365,7 @@ fn verilator_lint_is_silent_and_icarus_compiles() {
             "rmap_top",
             Path::new("/dev/null"),
             &crate::hdl::design_files(&dir),
+            &[],
         )
         .current_dir(&dir)
         .output()

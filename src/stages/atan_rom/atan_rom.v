@@ -7,9 +7,7 @@
 // (contents: rmapgen's model, atan_rom::contents). u and v each read their own copy of the
 // table, so each is a single-port synchronous ROM that maps to its own block RAM.{% if out_reg %} A fabric
 // register follows the block RAM's output register (pipeline_depth >= 1).{% endif %} Latency {= latency =}.
-module {= h.module =} #(
-  parameter INIT_FILE = "{= init_file =}"  // $readmemh file, one POS-bit entry per line
-) (
+module {= h.module =}{= h.params =} (
 {= h.ports =}
 );
 
@@ -23,8 +21,8 @@ module {= h.module =} #(
   (* ram_style = "block" *)
   reg [POS-1:0] rom_v [0:ENTRIES-1];
   initial begin
-    $readmemh(INIT_FILE, rom_u);
-    $readmemh(INIT_FILE, rom_v);
+    $readmemh({= param =}, rom_u);
+    $readmemh({= param =}, rom_v);
   end
 
   reg [POS-1:0] pu_q, pv_q;

@@ -6,7 +6,7 @@ pub mod model;
 
 use super::position;
 use super::testbench::TbData;
-use super::unit::{Head, Memory, Unit, Vectors};
+use super::unit::{file_param, Head, Memory, Unit, Vectors};
 use crate::config::Config;
 use crate::model::{MapSet, Model};
 use crate::rng::SplitMix64;
@@ -32,7 +32,7 @@ struct Verilog {
     h: Head,
     latency: u32,
     out_reg: bool,
-    init_file: String,
+    param: String,
     pos: u32,
     entries: u32,
 }
@@ -60,6 +60,7 @@ impl Unit for AtanRom {
                 Memory::new(
                     rom,
                     self.module(cfg),
+                    file_param(self.name()),
                     init_file(cfg),
                     cfg.atan_entries(),
                     cfg.pos_bits(),
@@ -74,7 +75,7 @@ impl Unit for AtanRom {
             h,
             latency: self.latency(cfg).expect("fixed"),
             out_reg: out_reg(cfg),
-            init_file: init_file(cfg),
+            param: file_param(self.name()),
             pos: cfg.pos_bits(),
             entries: cfg.atan_entries(),
         }

@@ -6,9 +6,7 @@
 // (both buffers hold the scene's map), so the design shades out of reset. A read and a write
 // of the same address in one cycle return undefined data; the top never issues one, because
 // samples read the front buffer and the host writes the back one. Latency 1.
-module {= h.module =} #(
-  parameter INIT_FILE = "{= init_file =}"  // $readmemh file, one M-bit entry per line
-) (
+module {= h.module =}{= h.params =} (
 {= h.ports =}
 );
 
@@ -20,7 +18,7 @@ module {= h.module =} #(
   (* no_rw_check, ram_style = "block" *)
   reg [M-1:0] mem [0:ENTRIES-1];
   initial begin
-    $readmemh(INIT_FILE, mem);
+    $readmemh({= param =}, mem);
   end
 
   always @(posedge clk_i) begin

@@ -12,11 +12,15 @@ use askama::Template;
 
 pub struct MapBank;
 
+/// Its init-file parameter: generic, because map_lookup instantiates it up to four times, each
+/// with its own file (map_lookup passes `banks::bank_param` down as it).
+pub const INIT_PARAM: &str = "INIT_FILE";
+
 #[derive(Template)]
 #[template(path = "map_bank/map_bank.v", syntax = "verilog")]
 struct Verilog {
     h: Head,
-    init_file: String,
+    param: &'static str,
     m: u32,
     entries: u32,
 }
@@ -49,6 +53,7 @@ impl Unit for MapBank {
         vec![Memory::new(
             "mem",
             self.module(cfg),
+            INIT_PARAM.to_string(),
             banks::bank_file(cfg, 0),
             cfg.bank_entries(),
             cfg.map_bits,
@@ -59,7 +64,7 @@ impl Unit for MapBank {
     fn render(&self, cfg: &Config, h: Head) -> askama::Result<String> {
         Verilog {
             h,
-            init_file: banks::bank_file(cfg, 0),
+            param: INIT_PARAM,
             m: cfg.map_bits,
             entries: cfg.bank_entries(),
         }

@@ -5,9 +5,7 @@
 // (contents: rmapgen's model, recip_rom::contents). The reduced max always has its MSB set,
 // so the address is the R-1 bits below it. Read through a register so that it maps to block
 // RAM. Latency 1.
-module {= h.module =} #(
-  parameter INIT_FILE = "{= init_file =}"  // $readmemh file, one W-bit entry per line
-) (
+module {= h.module =}{= h.params =} (
 {= h.ports =}
 );
 
@@ -19,7 +17,7 @@ module {= h.module =} #(
   (* ram_style = "block" *)
   reg [W-1:0] rom [0:ENTRIES-1];
   initial begin
-    $readmemh(INIT_FILE, rom);
+    $readmemh({= param =}, rom);
   end
 
   reg [W-1:0] data_q;
