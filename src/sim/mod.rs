@@ -238,7 +238,8 @@ pub fn run(
             .is_some()
         {
             let exe = sdir.join("top_stream");
-            let run = executable(&sdir, &exe, &[vec.display().to_string()]);
+            // The harness reads map2_<axis>.hex from its working directory (tb/top_stream.cpp).
+            let run = executable(design.path(), &exe, &[vec.display().to_string()]);
             r.simulation("verilator top_stream (C++)", run, &sdir.join("run.log"))?;
         }
     }
