@@ -22,7 +22,7 @@ module rmap_top #(
   // $readmemh files, one hex entry per line; a relative path resolves against the
   // working directory of the simulator or synthesis tool.
   parameter RECIP_ROM_FILE   = "recip_rom.hex",    // u_normalise.u_recip_rom.rom: 128 x 10 bits
-  parameter ATAN_ROM_FILE    = "atan_rom.hex",     // u_atan_rom.rom_u, u_atan_rom.rom_v: 256 x 6 bits
+  parameter ATAN_ROM_FILE    = "atan_rom.hex",     // u_atan_rom.rom: 256 x 6 bits
   parameter MAP_BANK_00_FILE = "map_bank_00.hex",  // u_map_lookup.u_bank_00.mem: 1024 x 8 bits
   parameter MAP_BANK_10_FILE = "map_bank_10.hex",  // u_map_lookup.u_bank_10.mem: 1024 x 8 bits
   parameter MAP_BANK_01_FILE = "map_bank_01.hex",  // u_map_lookup.u_bank_01.mem: 1024 x 8 bits

@@ -25,10 +25,6 @@ module map_bank #(
 
   localparam M       = 8;  // entry width
   localparam ENTRIES = 4096;  // 2^BA
-
-  // no_rw_check: a same-address read and write never happen (see above), so Yosys need not
-  // add logic to define their result. ram_style: block RAM at every size.
-  (* no_rw_check, ram_style = "block" *)
   reg [M-1:0] mem [0:ENTRIES-1];
   initial begin
     $readmemh(INIT_FILE, mem);

@@ -21,10 +21,6 @@ module recip_rom #(
 
   localparam W       = 10;  // entry width
   localparam ENTRIES = 128;  // 2^(R-1)
-
-  // ram_style: block RAM even where Yosys would build a small table from LUTs, so that every
-  // configuration has its ROM where rmapgen fpga checks for it.
-  (* ram_style = "block" *)
   reg [W-1:0] rom [0:ENTRIES-1];
   initial begin
     $readmemh(RECIP_ROM_FILE, rom);

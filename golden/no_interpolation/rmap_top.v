@@ -16,7 +16,7 @@ module rmap_top #(
   // $readmemh files, one hex entry per line; a relative path resolves against the
   // working directory of the simulator or synthesis tool.
   parameter RECIP_ROM_FILE = "recip_rom.hex",  // u_normalise.u_recip_rom.rom: 128 x 10 bits
-  parameter ATAN_ROM_FILE  = "atan_rom.hex",   // u_atan_rom.rom_u, u_atan_rom.rom_v: 256 x 3 bits
+  parameter ATAN_ROM_FILE  = "atan_rom.hex",   // u_atan_rom.rom: 256 x 3 bits
   parameter MAP_BANK_FILE  = "map_bank.hex"    // u_map_lookup.u_bank.mem: 4096 x 8 bits
 ) (
   input  wire        clk_i,

@@ -63,6 +63,8 @@ struct Readme {
     depth: u32,
     latency_list: String,
     memories: Vec<(String, String, String, String)>,
+    /// [`crate::config::Target::name`].
+    target: &'static str,
 }
 
 /// The core's VLNV name, `rmapgen:ip:<top module>_<hash>:<version>`: the top's module name
@@ -179,6 +181,7 @@ pub fn readme(cfg: &Config) -> Result<String> {
         depth: cfg.pipeline_depth,
         latency_list,
         memories,
+        target: cfg.target.name(),
     }
     .render()
     .context("cannot render templates/pkg/README.md")?;

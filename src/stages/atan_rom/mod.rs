@@ -17,6 +17,16 @@ use askama::Template;
 pub struct AtanRom;
 
 /// Its `$readmemh` file, `<module>.hex`.
+/// The ROM's arrays: one copy per read port (u, v) for the iCE40, whose block RAM has one read
+/// port; one array read through two ports otherwise.
+fn arrays(cfg: &Config) -> Vec<&'static str> {
+    if cfg.target.ice40() {
+        vec!["rom_u", "rom_v"]
+    } else {
+        vec!["rom"]
+    }
+}
+
 pub fn init_file(cfg: &Config) -> String {
     format!("{}.hex", AtanRom.module(cfg))
 }
@@ -33,6 +43,10 @@ struct Verilog {
     latency: u32,
     out_reg: bool,
     param: String,
+    ice40: bool,
+    /// The arrays the u and v ports read: [`arrays`].
+    rom_u: &'static str,
+    rom_v: &'static str,
     pos: u32,
     entries: u32,
 }
@@ -54,7 +68,7 @@ impl Unit for AtanRom {
     }
 
     fn memories(&self, cfg: &Config) -> Vec<Memory> {
-        ["rom_u", "rom_v"]
+        arrays(cfg)
             .into_iter()
             .map(|rom| {
                 Memory::new(
@@ -76,6 +90,9 @@ impl Unit for AtanRom {
             latency: self.latency(cfg).expect("fixed"),
             out_reg: out_reg(cfg),
             param: file_param(self.name()),
+            ice40: cfg.target.ice40(),
+            rom_u: arrays(cfg)[0],
+            rom_v: arrays(cfg)[arrays(cfg).len() - 1],
             pos: cfg.pos_bits(),
             entries: cfg.atan_entries(),
         }

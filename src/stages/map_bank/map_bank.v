@@ -13,9 +13,11 @@ module {= h.module =}{= h.params =} (
   localparam M       = {= m =};  // entry width
   localparam ENTRIES = {= entries =};  // 2^BA
 
-  // no_rw_check: a same-address read and write never happen (see above), so Yosys need not
-  // add logic to define their result. ram_style: block RAM at every size.
+{%- if ice40 %}
+  // no_rw_check (--target ice40): a same-address read and write never happen (see above), so
+  // Yosys need not add logic to define their result. ram_style: block RAM at every size.
   (* no_rw_check, ram_style = "block" *)
+{%- endif %}
   reg [M-1:0] mem [0:ENTRIES-1];
   initial begin
     $readmemh({= param =}, mem);

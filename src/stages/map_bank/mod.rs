@@ -21,6 +21,7 @@ pub const INIT_PARAM: &str = "INIT_FILE";
 struct Verilog {
     h: Head,
     param: &'static str,
+    ice40: bool,
     m: u32,
     entries: u32,
 }
@@ -65,6 +66,7 @@ impl Unit for MapBank {
         Verilog {
             h,
             param: INIT_PARAM,
+            ice40: cfg.target.ice40(),
             m: cfg.map_bits,
             entries: cfg.bank_entries(),
         }

@@ -20,6 +20,7 @@ pub fn init_file(cfg: &Config) -> String {
 struct Verilog {
     h: Head,
     param: String,
+    ice40: bool,
     w: u32,
     entries: u32,
 }
@@ -63,6 +64,7 @@ impl Unit for RecipRom {
         Verilog {
             h,
             param: file_param(self.name()),
+            ice40: cfg.target.ice40(),
             w: cfg.recip_bits,
             entries: cfg.recip_entries(),
         }

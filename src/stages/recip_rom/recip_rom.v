@@ -12,9 +12,11 @@ module {= h.module =}{= h.params =} (
   localparam W       = {= w =};  // entry width
   localparam ENTRIES = {= entries =};  // 2^(R-1)
 
-  // ram_style: block RAM even where Yosys would build a small table from LUTs, so that every
-  // configuration has its ROM where rmapgen fpga checks for it.
+{%- if ice40 %}
+  // ram_style (--target ice40): block RAM even where Yosys would build a small table from
+  // LUTs, so that every configuration has its ROM where rmapgen fpga checks for it.
   (* ram_style = "block" *)
+{%- endif %}
   reg [W-1:0] rom [0:ENTRIES-1];
   initial begin
     $readmemh({= param =}, rom);
