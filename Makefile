@@ -108,7 +108,8 @@ sim-handshake: build
 	$(RMAPGEN) generate --out $(HS_OUT) --handshake $(GEN_FLAGS)
 	$(SIM) --icarus --verilator --only rmap_top --stream $(SIM_STREAM) --tb-stream $(SIM_TB_STREAM) $(HS_OUT)
 
-# ---- FPGA (src/rtl/fpga.rs): Yosys synth_ice40 and nextpnr-ice40 on $(OUT): post-route Fmax,
+# ---- FPGA (src/rtl/fpga.rs): Yosys synth_ice40 and nextpnr-ice40 on the default design built
+# for the iCE40 (--target ice40; rtl_out/ is the portable --target generic): post-route Fmax,
 # logic cells, block RAMs, critical path; fails if a ROM or map bank is not in block RAM (a
 # missed timing target is only reported). fpga-check also fails below $(FPGA_FREQ) MHz.
 # Installs yosys, nextpnr-ice40 and fpga-icestorm when missing. Logs in $(FPGA_DIR).
@@ -117,7 +118,7 @@ FPGA_PACKAGE ?= ct256
 FPGA_FREQ    ?= 125
 FPGA_SEED    ?= 1
 FPGA_DIR     ?= build/fpga
-FPGA_ARGS     = --dir $(OUT) --device $(FPGA_DEVICE) --package $(FPGA_PACKAGE) --freq $(FPGA_FREQ) --seed $(FPGA_SEED) --logs $(FPGA_DIR)
+FPGA_ARGS     = --device $(FPGA_DEVICE) --package $(FPGA_PACKAGE) --freq $(FPGA_FREQ) --seed $(FPGA_SEED) --logs $(FPGA_DIR)
 
 .PHONY: fpga fpga-check
 

@@ -48,6 +48,49 @@ pub struct Config {
     /// JSON when empty, so a design without one is written as before it existed.
     #[serde(skip_serializing_if = "String::is_empty")]
     pub prefix: String,
+    /// The tools the memories are written for: [`Target`]. Left out of the TOML and JSON when
+    /// `generic` (the default).
+    #[serde(skip_serializing_if = "Target::is_generic")]
+    pub target: Target,
+}
+
+/// How the memories are written (docs/ARCHITECTURE.md, "Targets"). The arithmetic, the ports
+/// and the behaviour are the same for every target; only the memories' attributes and the
+/// compensation ROM's read ports differ.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum Target {
+    /// Plain Verilog-2005 memories any tool infers: no vendor attributes, and one compensation
+    /// ROM array with two synchronous read ports (a true dual-port block RAM where the device
+    /// has one).
+    #[default]
+    Generic,
+    /// Lattice iCE40 with Yosys: `ram_style = "block"` on every memory (block RAM even for a
+    /// ROM Yosys would build from LUTs), `no_rw_check` on the map banks (no logic to define a
+    /// same-address read and write, which the top never issues), and one copy of the
+    /// compensation ROM per read port (an SB_RAM40_4K has one read port).
+    Ice40,
+}
+
+impl Target {
+    pub fn is_generic(&self) -> bool {
+        *self == Target::Generic
+    }
+
+    /// `generic` or `ice40`, as the flag and the TOML spell it.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Target::Generic => "generic",
+            Target::Ice40 => "ice40",
+        }
+    }
+
+    /// Whether memories carry the iCE40/Yosys attributes and ROMs get one copy per read port.
+    pub fn ice40(&self) -> bool {
+        *self == Target::Ice40
+    }
 }
 
 /// Longest [`Config::prefix`].
@@ -161,6 +204,7 @@ impl Default for Config {
             pipeline_depth: 2,
             handshake: false,
             prefix: String::new(),
+            target: Target::Generic,
         }
     }
 }
@@ -387,9 +431,24 @@ impl Config {
         (1 << self.frac_bits) - 1
     }
     /// A short, stable description used in headers and file names.
+    /// The same configuration with its memories written for `target`.
+    pub fn for_target(&self, target: Target) -> Config {
+        Config {
+            target,
+            ..self.clone()
+        }
+    }
+
+    /// One line naming every field but the prefix; the target only when it is not generic
+    /// (the default), so a default design's summary reads as before the field existed.
     pub fn summary(&self) -> String {
+        let target = if self.target.is_generic() {
+            String::new()
+        } else {
+            format!(" target={}", self.target.name())
+        };
         format!(
-            "G{} R{} W{} F{} I{} P{} M{} comp={} interp={} color={} depth={} handshake={}",
+            "G{} R{} W{} F{} I{} P{} M{} comp={} interp={} color={} depth={} handshake={}{target}",
             self.grad_bits,
             self.red_bits,
             self.recip_bits,

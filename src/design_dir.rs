@@ -93,6 +93,36 @@ impl DesignDir {
         self.files.iter().map(|f| self.path.join(f)).collect()
     }
 
+    /// The file parameters of testbench `tb` (`<module>_tb`) set to absolute paths in this
+    /// directory, and its vector file: what a simulator run from elsewhere needs.
+    pub fn testbench_files(&self, tb: &str) -> Result<(Vec<(String, String)>, PathBuf)> {
+        let (files, vectors) = crate::rtl::tb::testbench_files(&self.config, tb)?;
+        let params = files.into_iter().map(|f| (f.param, f.default)).collect();
+        Ok((self.absolute(params)?, self.path.join(vectors)))
+    }
+
+    /// The top's init-file parameters set to absolute paths in this directory.
+    pub fn top_files(&self) -> Result<Vec<(String, String)>> {
+        let params = crate::rtl::tb::top_files(&self.config)
+            .into_iter()
+            .map(|f| (f.param, f.default))
+            .collect();
+        self.absolute(params)
+    }
+
+    fn absolute(&self, params: Vec<(String, String)>) -> Result<Vec<(String, String)>> {
+        params
+            .into_iter()
+            .map(|(name, rel)| {
+                let path = self.path.join(&rel).to_string_lossy().into_owned();
+                if !crate::toolchain::verilog_string_ok(&path) {
+                    bail!("{path}: a file path with a quote, backslash or newline cannot be a Verilog parameter; move the design");
+                }
+                Ok((name, path))
+            })
+            .collect()
+    }
+
     /// The testbench file of module `module`: `tb/<module>_tb.v`.
     pub fn testbench(&self, module: &str) -> PathBuf {
         self.path.join("tb").join(format!("{module}_tb.v"))

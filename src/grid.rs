@@ -7,9 +7,10 @@
 //! The rows are chosen for coverage, and `tests/it/grid.rs` holds them to it: each width at
 //! both ends of its range (recip_bits at its smallest legal value, frac_bits + 1), each of the
 //! eight combinations of compensation, interpolation and colour, every pipeline depth, and the
-//! handshake on and off, mixed so that the ends meet each other and the optional stages.
+//! handshake on and off, both memory targets, mixed so that the ends meet each other and the
+//! optional stages.
 
-use crate::config::{Config, RANGES};
+use crate::config::{Config, Target, RANGES};
 
 /// One configuration of the grid.
 #[derive(Clone, Debug, PartialEq)]
@@ -28,6 +29,7 @@ pub struct GridRow {
 macro_rules! grid {
     ($( $name:ident: $g:literal $r:literal $w:literal $f:literal $i:literal $p:literal $m:literal
         $comp:literal $interp:literal $color:literal $depth:literal $hs:literal $icarus:literal
+        $ice40:literal
         $covers:literal; )*) => {
         /// Every row, in the order below.
         pub fn rows() -> Vec<GridRow> {
@@ -39,6 +41,7 @@ macro_rules! grid {
                     compensation: $comp == 1, interpolation: $interp == 1, color: $color == 1,
                     pipeline_depth: $depth, handshake: $hs == 1,
                     prefix: String::new(),
+                    target: if $ice40 == 1 { Target::Ice40 } else { Target::Generic },
                 },
                 icarus: $icarus == 1,
                 covers: $covers,
@@ -48,58 +51,59 @@ macro_rules! grid {
 }
 
 // G grad, R reduced, W reciprocal entry, F fraction, I index, P interpolation fraction, M map
-// entry bits; comp(ensation), interp(olation), color, pipeline depth, handshake, run in Icarus.
+// entry bits; comp(ensation), interp(olation), color, pipeline depth, handshake, run in Icarus,
+// --target ice40 (else generic).
 grid! {
-//                  G  R  W  F  I  P  M  comp interp color depth hs icarus
-    paper:          12 8  10 8  3  3  8  1    1      0     2     0  1
+//                  G  R  W  F  I  P  M  comp interp color depth hs icarus ice40
+    paper:          12 8  10 8  3  3  8  1    1      0     2     0  1  0
         "the paper's widths at the default depth: the committed rtl_out/ design";
-    paper_depth0:   12 8  10 8  3  3  8  1    1      0     0     0  1
+    paper_depth0:   12 8  10 8  3  3  8  1    1      0     0     0  1  0
         "the paper's design with the fewest registers (latency 12)";
-    paper_depth1:   12 8  10 8  3  3  8  1    1      0     1     0  0
+    paper_depth1:   12 8  10 8  3  3  8  1    1      0     1     0  0  1
         "the paper's design at the middle depth";
-    paper_hs:       12 8  10 8  3  3  8  1    1      0     2     1  1
+    paper_hs:       12 8  10 8  3  3  8  1    1      0     2     1  1  0
         "the paper's design with the valid/ready handshake (golden/handshake)";
-    color:          12 8  10 8  3  3  8  1    1      1     2     0  0
+    color:          12 8  10 8  3  3  8  1    1      1     2     0  0  0
         "the colour multiplier on the paper's design (golden/color)";
-    no_comp:        12 8  10 8  3  3  8  0    1      0     2     0  0
+    no_comp:        12 8  10 8  3  3  8  0    1      0     2     0  0  0
         "the linear index in place of the atan ROM";
-    no_interp:      12 8  10 8  3  0  8  1    0      0     1     0  0
+    no_interp:      12 8  10 8  3  0  8  1    0      0     1     0  0  1
         "nearest entry: one map bank, no interpolator";
-    bare:           12 8  10 8  3  0  8  0    0      0     0     0  1
+    bare:           12 8  10 8  3  0  8  0    0      0     0     0  1  0
         "neither optional stage, compact registers";
-    no_comp_color:  12 8  10 8  3  3  8  0    1      1     1     1  0
+    no_comp_color:  12 8  10 8  3  3  8  0    1      1     1     1  0  1
         "linear index with colour, under backpressure";
-    no_interp_color:12 8  10 8  3  0  8  1    0      1     0     1  1
+    no_interp_color:12 8  10 8  3  0  8  1    0      1     0     1  1  0
         "nearest entry with colour, under backpressure, compact registers";
-    bare_color:     12 8  10 8  3  0  8  0    0      1     2     0  0
+    bare_color:     12 8  10 8  3  0  8  0    0      1     2     0  0  0
         "colour alone: neither optional stage";
-    narrowest:       8 6   5 4  2  1  6  1    1      0     0     0  1
+    narrowest:       8 6   5 4  2  1  6  1    1      0     0     0  1  0
         "every width at the low end of its range (interpolation on: 1 bit)";
-    narrowest_bare:  8 6   5 4  2  0  6  0    0      1     2     1  0
+    narrowest_bare:  8 6   5 4  2  0  6  0    0      1     2     1  0  0
         "the narrowest widths with neither optional stage, colour and the handshake";
-    widest:         16 12 20 12 6  5  12 1    1      1     2     1  0
+    widest:         16 12 20 12 6  5  12 1    1      1     2     1  0  1
         "every width at the high end of its range, every stage, the handshake";
-    widest_depth0:  16 12 13 12 6  5  12 0    1      0     0     0  0
+    widest_depth0:  16 12 13 12 6  5  12 0    1      0     0     0  0  0
         "the widest widths with the smallest legal reciprocal (F + 1), compact registers";
-    grad16_red6:    16 6   9 8  3  3  8  1    1      0     1     0  1
+    grad16_red6:    16 6   9 8  3  3  8  1    1      0     1     0  1  0
         "the widest gradient truncated to the narrowest magnitude after the shift";
-    grad8_red8:      8 8  10 8  3  3  8  1    1      0     2     0  0
+    grad8_red8:      8 8  10 8  3  3  8  1    1      0     2     0  0  0
         "reduced width equal to the gradient width: nothing truncated after the shift";
-    no_truncation:   8 8  20 7  3  3  8  1    1      0     2     0  0
+    no_truncation:   8 8  20 7  3  3  8  1    1      0     2     0  0  0
         "nothing truncated, with the widest reciprocal over a 7-bit fraction (normalise's longest shift)";
-    frac4_recip20:  12 8  20 4  3  2  8  1    1      0     0     1  0
+    frac4_recip20:  12 8  20 4  3  2  8  1    1      0     0     1  0  0
         "the narrowest fraction with the widest reciprocal, under backpressure";
-    frac12_recip13: 12 12 13 12 4  4  10 1    1      0     1     0  0
+    frac12_recip13: 12 12 13 12 4  4  10 1    1      0     1     0  0  0
         "the widest fraction with its smallest legal reciprocal (F + 1)";
-    index6_interp1: 12 8  10 8  6  1  8  1    1      0     2     0  0
+    index6_interp1: 12 8  10 8  6  1  8  1    1      0     2     0  0  0
         "the largest map with the coarsest interpolation";
-    index2_interp5: 12 8  10 8  2  5  8  1    1      1     1     0  1
+    index2_interp5: 12 8  10 8  2  5  8  1    1      1     1     0  1  1
         "the smallest map with the finest interpolation, with colour";
-    map12:          12 8  10 8  3  3  12 1    1      0     2     0  0
+    map12:          12 8  10 8  3  3  12 1    1      0     2     0  0  0
         "the widest map entries and output";
-    map6_nearest:   12 8  10 8  4  0  6  1    0      0     2     0  0
+    map6_nearest:   12 8  10 8  4  0  6  1    0      0     2     0  0  0
         "the narrowest map entries, nearest entry";
-    index6_nearest: 14 10 12 10 6  0  10 0    0      0     1     1  0
+    index6_nearest: 14 10 12 10 6  0  10 0    0      0     1     1  0  0
         "the largest map without interpolation (the widest bank address), under backpressure";
 }
 

@@ -11,7 +11,16 @@
 // Map buffers: a sample accepted in the cycle of swap_i or later reads the new front buffer;
 // host writes go to the back buffer. After a swap, let the samples accepted before it leave
 // (LATENCY clocks) before writing into the old front buffer.
-module rmap_top (
+module rmap_top #(
+  // $readmemh files, one hex entry per line; a relative path resolves against the
+  // working directory of the simulator or synthesis tool.
+  parameter RECIP_ROM_FILE   = "recip_rom.hex",    // u_normalise.u_recip_rom.rom: 128 x 10 bits
+  parameter ATAN_ROM_FILE    = "atan_rom.hex",     // u_atan_rom.rom: 256 x 6 bits
+  parameter MAP_BANK_00_FILE = "map_bank_00.hex",  // u_map_lookup.u_bank_00.mem: 1024 x 8 bits
+  parameter MAP_BANK_10_FILE = "map_bank_10.hex",  // u_map_lookup.u_bank_10.mem: 1024 x 8 bits
+  parameter MAP_BANK_01_FILE = "map_bank_01.hex",  // u_map_lookup.u_bank_01.mem: 1024 x 8 bits
+  parameter MAP_BANK_11_FILE = "map_bank_11.hex"   // u_map_lookup.u_bank_11.mem: 1024 x 8 bits
+) (
   input  wire        clk_i,
   input  wire        rst_ni,     // asynchronous, active low
   input  wire        valid_i,    // a sample is accepted every cycle valid_i is high
@@ -108,7 +117,9 @@ module rmap_top (
   wire         nm_valid;
   wire [F-1:0] nm_u, nm_v;
 
-  normalise u_normalise (
+  normalise #(
+    .RECIP_ROM_FILE (RECIP_ROM_FILE)
+  ) u_normalise (
     .clk_i   (clk_i),
     .rst_ni  (rst_ni),
     .en_i    (en),
@@ -125,7 +136,9 @@ module rmap_top (
   wire           ps_valid;
   wire [POS-1:0] ps_u, ps_v;
 
-  atan_rom u_atan_rom (
+  atan_rom #(
+    .ATAN_ROM_FILE (ATAN_ROM_FILE)
+  ) u_atan_rom (
     .clk_i   (clk_i),
     .rst_ni  (rst_ni),
     .en_i    (en),
@@ -167,7 +180,12 @@ module rmap_top (
   wire [M-1:0] ml_e10, ml_e01, ml_e11;
   wire [P:0]   ml_wu, ml_wv;
 
-  map_lookup u_map_lookup (
+  map_lookup #(
+    .MAP_BANK_00_FILE (MAP_BANK_00_FILE),
+    .MAP_BANK_10_FILE (MAP_BANK_10_FILE),
+    .MAP_BANK_01_FILE (MAP_BANK_01_FILE),
+    .MAP_BANK_11_FILE (MAP_BANK_11_FILE)
+  ) u_map_lookup (
     .clk_i     (clk_i),
     .rst_ni    (rst_ni),
     .en_i      (en),

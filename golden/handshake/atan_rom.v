@@ -6,11 +6,13 @@
 // Distortion compensation (atan) ROM: turns a normalised fraction u = tan(angle) into a map
 // position, so that equal position steps are equal steps in angle: entry u holds
 // round(atan(u / 2^F) / (pi/4) * POS_MAX), the all-ones code standing for tan = 1
-// (contents: rmapgen's model, atan_rom::contents). u and v each read their own copy of the
-// table, so each is a single-port synchronous ROM that maps to its own block RAM. A fabric
+// (contents: rmapgen's model, atan_rom::contents). u and v read one table through two synchronous read ports
+// (a true dual-port block RAM where the device has one). A fabric
 // register follows the block RAM's output register (pipeline_depth >= 1). Latency 2.
 module atan_rom #(
-  parameter INIT_FILE = "atan_rom.hex"  // $readmemh file, one POS-bit entry per line
+  // $readmemh files, one hex entry per line; a relative path resolves against the
+  // working directory of the simulator or synthesis tool.
+  parameter ATAN_ROM_FILE = "atan_rom.hex"   // rom: 256 x 6 bits
 ) (
   input  wire       clk_i,
   input  wire       rst_ni,   // asynchronous, active low: clears valid bits only
@@ -26,28 +28,22 @@ module atan_rom #(
   localparam POS     = 6;  // position width, index and interpolation bits
   localparam ENTRIES = 256;  // 2^F, one per fraction code
   localparam LATENCY = 2;
-
-  // ram_style: block RAM even where Yosys would build a small table from LUTs.
-  (* ram_style = "block" *)
-  reg [POS-1:0] rom_u [0:ENTRIES-1];
-  (* ram_style = "block" *)
-  reg [POS-1:0] rom_v [0:ENTRIES-1];
+  reg [POS-1:0] rom [0:ENTRIES-1];
   initial begin
-    $readmemh(INIT_FILE, rom_u);
-    $readmemh(INIT_FILE, rom_v);
+    $readmemh(ATAN_ROM_FILE, rom);
   end
 
   reg [POS-1:0] pu_q, pv_q;
 
   always @(posedge clk_i) begin
     if (en_i) begin
-      pu_q <= rom_u[u_i];
+      pu_q <= rom[u_i];
     end
   end
 
   always @(posedge clk_i) begin
     if (en_i) begin
-      pv_q <= rom_v[v_i];
+      pv_q <= rom[v_i];
     end
   end
 

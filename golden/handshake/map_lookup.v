@@ -12,7 +12,14 @@
 // Stage 1 splits and forms the bank addresses; stage 2 reads the banks; stage 3 registers
 // the banks' outputs in the fabric (pipeline_depth >= 1); stage 4 puts the bank outputs
 // back in neighbour order. Latency 4.
-module map_lookup (
+module map_lookup #(
+  // $readmemh files, one hex entry per line; a relative path resolves against the
+  // working directory of the simulator or synthesis tool.
+  parameter MAP_BANK_00_FILE = "map_bank_00.hex",  // u_bank_00.mem: 1024 x 8 bits
+  parameter MAP_BANK_10_FILE = "map_bank_10.hex",  // u_bank_10.mem: 1024 x 8 bits
+  parameter MAP_BANK_01_FILE = "map_bank_01.hex",  // u_bank_01.mem: 1024 x 8 bits
+  parameter MAP_BANK_11_FILE = "map_bank_11.hex"   // u_bank_11.mem: 1024 x 8 bits
+) (
   input  wire       clk_i,
   input  wire       rst_ni,     // asynchronous, active low: clears valid bits only
   input  wire       en_i,       // clock enable: low holds every register
@@ -99,7 +106,7 @@ module map_lookup (
   wire [M-1:0] d00_q2, d10_q2, d01_q2, d11_q2;  // registered inside the banks
 
   map_bank #(
-    .INIT_FILE ("map_bank_00.hex")
+    .INIT_FILE (MAP_BANK_00_FILE)
   ) u_bank_00 (
     .clk_i     (clk_i),
     .en_i      (en_i),
@@ -111,7 +118,7 @@ module map_lookup (
   );
 
   map_bank #(
-    .INIT_FILE ("map_bank_10.hex")
+    .INIT_FILE (MAP_BANK_10_FILE)
   ) u_bank_10 (
     .clk_i     (clk_i),
     .en_i      (en_i),
@@ -123,7 +130,7 @@ module map_lookup (
   );
 
   map_bank #(
-    .INIT_FILE ("map_bank_01.hex")
+    .INIT_FILE (MAP_BANK_01_FILE)
   ) u_bank_01 (
     .clk_i     (clk_i),
     .en_i      (en_i),
@@ -135,7 +142,7 @@ module map_lookup (
   );
 
   map_bank #(
-    .INIT_FILE ("map_bank_11.hex")
+    .INIT_FILE (MAP_BANK_11_FILE)
   ) u_bank_11 (
     .clk_i     (clk_i),
     .en_i      (en_i),

@@ -8,7 +8,9 @@
 // so the address is the R-1 bits below it. Read through a register so that it maps to block
 // RAM. Latency 1.
 module recip_rom #(
-  parameter INIT_FILE = "recip_rom.hex"  // $readmemh file, one W-bit entry per line
+  // $readmemh files, one hex entry per line; a relative path resolves against the
+  // working directory of the simulator or synthesis tool.
+  parameter RECIP_ROM_FILE = "recip_rom.hex"   // rom: 128 x 10 bits
 ) (
   input  wire       clk_i,
   input  wire       en_i,    // read enable: low holds data_o
@@ -18,13 +20,9 @@ module recip_rom #(
 
   localparam W       = 10;  // entry width
   localparam ENTRIES = 128;  // 2^(R-1)
-
-  // ram_style: block RAM even where Yosys would build a small table from LUTs, so that every
-  // configuration has its ROM where rmapgen fpga checks for it.
-  (* ram_style = "block" *)
   reg [W-1:0] rom [0:ENTRIES-1];
   initial begin
-    $readmemh(INIT_FILE, rom);
+    $readmemh(RECIP_ROM_FILE, rom);
   end
 
   reg [W-1:0] data_q;

@@ -10,7 +10,9 @@
 // of the same address in one cycle return undefined data; the top never issues one, because
 // samples read the front buffer and the host writes the back one. Latency 1.
 module map_bank #(
-  parameter INIT_FILE = "map_bank.hex"  // $readmemh file, one M-bit entry per line
+  // $readmemh files, one hex entry per line; a relative path resolves against the
+  // working directory of the simulator or synthesis tool.
+  parameter INIT_FILE = "map_bank.hex"   // mem: 4096 x 8 bits
 ) (
   input  wire        clk_i,
   input  wire        en_i,       // read enable: low holds rd_data_o
@@ -23,10 +25,6 @@ module map_bank #(
 
   localparam M       = 8;  // entry width
   localparam ENTRIES = 4096;  // 2^BA
-
-  // no_rw_check: a same-address read and write never happen (see above), so Yosys need not
-  // add logic to define their result. ram_style: block RAM at every size.
-  (* no_rw_check, ram_style = "block" *)
   reg [M-1:0] mem [0:ENTRIES-1];
   initial begin
     $readmemh(INIT_FILE, mem);

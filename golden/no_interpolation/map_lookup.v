@@ -10,7 +10,11 @@
 // buffer) independently of en_i.
 // Stage 1 forms the bank address; stage 2 reads the bank; stage 3 registers the bank's
 // output in the fabric (pipeline_depth >= 1); stage 4 registers the entry. Latency 4.
-module map_lookup (
+module map_lookup #(
+  // $readmemh files, one hex entry per line; a relative path resolves against the
+  // working directory of the simulator or synthesis tool.
+  parameter MAP_BANK_FILE = "map_bank.hex"   // u_bank.mem: 4096 x 8 bits
+) (
   input  wire       clk_i,
   input  wire       rst_ni,     // asynchronous, active low: clears valid bits only
   input  wire       en_i,       // clock enable: low holds every register
@@ -47,7 +51,7 @@ module map_lookup (
   wire [M-1:0] d_q2;  // registered inside the bank
 
   map_bank #(
-    .INIT_FILE ("map_bank.hex")
+    .INIT_FILE (MAP_BANK_FILE)
   ) u_bank (
     .clk_i     (clk_i),
     .en_i      (en_i),

@@ -12,7 +12,11 @@
 // a * recip + HALF is an adder tree of the partial products (a[j] ? recip << j : 0), one LUT
 // level and one carry chain per level, registered as pipeline_depth = 2 places them
 // (rmapgen::stages::normalise::Plan); the last clock rounds and saturates. Latency 6.
-module normalise (
+module normalise #(
+  // $readmemh files, one hex entry per line; a relative path resolves against the
+  // working directory of the simulator or synthesis tool.
+  parameter RECIP_ROM_FILE = "recip_rom.hex"   // u_recip_rom.rom: 128 x 10 bits
+) (
   input  wire       clk_i,
   input  wire       rst_ni,   // asynchronous, active low: clears valid bits only
   input  wire       en_i,     // clock enable: low holds every register
@@ -35,7 +39,9 @@ module normalise (
 
   // ---------------------------------------------------------------- ROM read and compare
   wire [W-1:0] recip_q1;  // registered inside the ROM
-  recip_rom u_recip_rom (
+  recip_rom #(
+    .RECIP_ROM_FILE (RECIP_ROM_FILE)
+  ) u_recip_rom (
     .clk_i  (clk_i),
     .en_i   (en_i),
     .addr_i (m_i[RA-1:0]),

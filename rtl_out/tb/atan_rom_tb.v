@@ -10,6 +10,8 @@
 // Run from the generated directory, which holds vectors/ and the .hex files:
 //   iverilog -g2005 -Wall -Wno-timescale -s atan_rom_tb -o atan_rom_tb.vvp tb/atan_rom_tb.v *.v
 //   vvp -N atan_rom_tb.vvp      (-N: a failing run exits 1)
+// or from anywhere, with every file parameter below set to its path (iverilog
+// -Patan_rom_tb.NAME='"path"', verilator -GNAME='"path"') and +vectors=FILE.
 // It reads vectors/atan_rom.hex (or the file of +vectors=FILE), one vector per line:
 //   u v pu pv
 // (inputs, then expected outputs, hex); +vcd=FILE writes a VCD. Inputs are driven and outputs sampled on the falling
@@ -34,6 +36,11 @@ module atan_rom_tb;
   localparam SHOW       = 10;  // mismatches printed in full; later ones by line only
   localparam GIVE_UP    = 100;  // failures after which the run stops (a broken design floods)
 
+  // ---------------------------------------------------------------- files
+  // Every file the design or the testbench reads with $readmemh; a relative path resolves
+  // against the simulator's working directory.
+  parameter ATAN_ROM_FILE = "atan_rom.hex";
+
   // ---------------------------------------------------------------- the design
   reg        clk_i = 1'd0;
   reg        rst_ni = 1'd0;
@@ -45,7 +52,9 @@ module atan_rom_tb;
   wire [5:0] pu_o;
   wire [5:0] pv_o;
 
-  atan_rom dut (
+  atan_rom #(
+    .ATAN_ROM_FILE (ATAN_ROM_FILE)
+  ) dut (
     .clk_i   (clk_i),
     .rst_ni  (rst_ni),
     .en_i    (en_i),
@@ -188,8 +197,8 @@ module atan_rom_tb;
     if (!$value$plusargs("vectors=%s", vector_file)) vector_file = "vectors/atan_rom.hex";
     fd = $fopen(vector_file, "r");
     if (fd == 0) $fatal(1, "cannot open %0s: run from the generated directory", vector_file);
-    fh = $fopen("atan_rom.hex", "r");
-    if (fh == 0) $fatal(1, "cannot open atan_rom.hex: run from the generated directory");
+    fh = $fopen(ATAN_ROM_FILE, "r");
+    if (fh == 0) $fatal(1, "cannot open %0s (ATAN_ROM_FILE): run from the generated directory or set it", ATAN_ROM_FILE);
     $fclose(fh);
     $display("atan_rom_tb: G12 R8 W10 F8 I3 P3 M8 comp=1 interp=1 color=0 depth=2 handshake=0, latency %0d, vectors %0s", LATENCY, vector_file);
     // +vcd=FILE: every signal of the testbench and the design into a VCD (make wave); a

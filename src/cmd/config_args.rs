@@ -44,6 +44,11 @@ pub struct ConfigArgs {
     pub handshake: bool,
     #[arg(long, value_name = "P", value_parser = parse::prefix(), help = parse::prefix_help())]
     pub prefix: Option<String>,
+    /// Memories for these tools: generic (plain inferred memories, no vendor attributes) or
+    /// ice40 (Yosys block-RAM attributes, one compensation ROM copy per read port)
+    /// [default: generic].
+    #[arg(long, value_enum, value_name = "T")]
+    pub target: Option<crate::config::Target>,
 }
 
 impl ConfigArgs {
@@ -78,6 +83,12 @@ impl ConfigArgs {
             if on {
                 f.push(flag.into());
             }
+        }
+        if !cfg.prefix.is_empty() {
+            f.extend(["--prefix".into(), cfg.prefix.clone()]);
+        }
+        if !cfg.target.is_generic() {
+            f.extend(["--target".into(), cfg.target.name().into()]);
         }
         f
     }
@@ -140,6 +151,10 @@ impl ConfigArgs {
         if let Some(p) = &self.prefix {
             c.prefix = p.clone();
             flags.push(("prefix", format!("--prefix {p}")));
+        }
+        if let Some(t) = self.target {
+            c.target = t;
+            flags.push(("target", format!("--target {}", t.name())));
         }
         let Err(e) = c.validate() else {
             return Ok(c);

@@ -11,8 +11,9 @@ use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
 pub struct FpgaArgs {
-    /// An already generated design directory (e.g. rtl_out); without it, the configuration
-    /// given by the flags below is generated into a temporary directory.
+    /// An already generated design directory (best generated with --target ice40); without
+    /// it, the configuration given by the flags below is generated for the iCE40 (--target
+    /// ice40) into a temporary directory.
     #[arg(long, value_name = "DIR")]
     pub dir: Option<PathBuf>,
     #[command(flatten)]
@@ -96,7 +97,8 @@ fn flow(a: &FpgaArgs, logs: &Path) -> Result<fpga::FpgaReport> {
     let (what, report) = match &a.dir {
         Some(d) => (d.display().to_string(), fpga::run_dir(d, &opts)?),
         None => {
-            let cfg = a.cfg.resolve()?;
+            // The iCE40 flow builds the design for the iCE40 whatever --target says.
+            let cfg = a.cfg.resolve()?.for_target(crate::config::Target::Ice40);
             (cfg.summary(), fpga::ice40_report(&cfg, &opts)?)
         }
     };

@@ -6,10 +6,11 @@ use crate::scene::Scene;
 use anyhow::{Context, Result};
 
 /// Cells of Yosys synthesis for the iCE40 (`synth_ice40` through
-/// [`crate::toolchain::yosys::synth_ice40`], as `rmapgen fpga` runs it: memories in block RAM,
+/// [`crate::toolchain::yosys::synth_ice40`], as `rmapgen fpga` runs it: `--target ice40`, memories in block RAM,
 /// each SB_RAM40_4K one cell) of a configuration's design with the scene's maps. `YOSYS` names
 /// the tool.
 pub fn cells(cfg: &Config, scene: &Scene) -> Result<u64> {
+    let cfg = &cfg.for_target(crate::config::Target::Ice40);
     let tmp = crate::output::Scratch::new()?;
     let out = crate::output::StagedDir::new(&tmp.path().join("design"), &Default::default())?;
     let manifest = crate::rtl::write_design(&crate::design::Design::for_scene(cfg, scene)?, &out)?;

@@ -14,7 +14,7 @@
 //! call [`ice40_report`].
 
 use super::manifest;
-use crate::config::Config;
+use crate::config::{Config, Target};
 use crate::output::StagedDir;
 use crate::toolchain::{self, complaint, nextpnr, yosys};
 use anyhow::{bail, Context, Result};
@@ -145,10 +145,11 @@ pub fn tools_available(_opts: &Options) -> bool {
     yosys::available() && nextpnr::available()
 }
 
-/// Generates `cfg`'s design (the standard scene's maps) into a temporary directory and runs
-/// the flow on it.
+/// Generates `cfg`'s design for the iCE40 (`--target ice40`, whatever `cfg.target` says; the
+/// standard scene's maps) into a temporary directory and runs the flow on it.
 pub fn ice40_report(cfg: &Config, opts: &Options) -> Result<FpgaReport> {
     cfg.validate()?;
+    let cfg = &cfg.for_target(Target::Ice40);
     let tmp = crate::output::Scratch::new()?;
     let out = StagedDir::new(&tmp.path().join("rtl"), &Default::default())?;
     super::write_design(&crate::design::Design::standard(cfg)?, &out)?;
@@ -202,6 +203,11 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
         .filter_map(|x| x["file"].as_str().map(String::from))
         .collect();
     let top = m["top"].as_str().unwrap_or("rmap_top").to_string();
+    // Absent from the JSON when generic (the default).
+    let target = m["config"]["target"]
+        .as_str()
+        .unwrap_or("generic")
+        .to_string();
     let mems: Vec<(String, u64)> = m["memories"]
         .as_array()
         .context("the manifest lists no memories")?
@@ -216,7 +222,7 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
 
     // nextpnr checks the device and package without a design, in milliseconds: a name it
     // does not know fails here, before the synthesis.
-    let target = nextpnr::Target {
+    let pnr = nextpnr::Target {
         device: &opts.device,
         package: &opts.package,
         freq_mhz: opts.freq_mhz,
@@ -228,7 +234,7 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
         opts.device,
         opts.package
     );
-    let check = toolchain::capture(&mut nextpnr::check_part(&target))?;
+    let check = toolchain::capture(&mut nextpnr::check_part(&pnr))?;
     if !check.success() {
         bail!("{part}: {}", complaint(&check.output));
     }
@@ -275,8 +281,15 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
         .map(|x| x.instance.as_str())
         .collect();
     if !lost.is_empty() {
+        let hint = if target == Target::Ice40.name() {
+            String::new()
+        } else {
+            format!(
+                "; the design was generated for --target {target}: generate it with --target ice40 for block-RAM attributes and one ROM copy per read port"
+            )
+        };
         bail!(
-            "memories fell back to logic instead of SB_RAM40_4K block RAM: {} (log: {})",
+            "memories fell back to logic instead of SB_RAM40_4K block RAM: {} (log: {}){hint}",
             lost.join(", "),
             logs.join("yosys.log").display()
         );
@@ -286,7 +299,7 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
     let report = logs.join("nextpnr_report.json");
     let log = logs.join("nextpnr.log");
     let run = toolchain::capture(&mut nextpnr::place_and_route(
-        &target,
+        &pnr,
         &json,
         &logs.join(format!("{top}.asc")),
         &report,

@@ -8,9 +8,11 @@
 
 use super::{manifest, Dir, Width};
 use crate::config::Config;
-use crate::model::map_set::{map_file, AXES};
+use crate::model::map_set::map_file;
 use crate::stages::map_bank::MapBank;
 use crate::stages::rmap_top::{latency_list, top_latency};
+use crate::stages::testbench::TbFile;
+use crate::stages::unit::{file_params, FileParam};
 use crate::stages::{self, Unit, TOP};
 use anyhow::{Context, Result};
 use askama::Template;
@@ -36,6 +38,10 @@ struct Core {
     rtl_files: Vec<String>,
     mem_files: Vec<String>,
     tb_files: Vec<String>,
+    /// The top's init-file parameters; the testbench has the same ones and passes them down.
+    file_params: Vec<FileParam>,
+    /// The testbench's own file parameters (the second map).
+    tb_params: Vec<TbFile>,
 }
 
 #[derive(Template)]
@@ -56,7 +62,9 @@ struct Readme {
     latency: u32,
     depth: u32,
     latency_list: String,
-    memories: Vec<(String, String, String)>,
+    memories: Vec<(String, String, String, String)>,
+    /// [`crate::config::Target::name`].
+    target: &'static str,
 }
 
 /// The core's VLNV name, `rmapgen:ip:<top module>_<hash>:<version>`: the top's module name
@@ -87,12 +95,13 @@ pub fn config_hash(cfg: &Config) -> String {
 /// the top's testbench with its vectors and the second map it loads.
 pub fn core(cfg: &Config) -> Result<String> {
     let top = TOP.vectors().expect("the top has vectors");
-    let mut mem_files: Vec<String> = Vec::new();
-    for m in TOP.memories(cfg) {
-        if !mem_files.contains(&m.init_file) {
-            mem_files.push(m.init_file);
-        }
-    }
+    let file_params = file_params(&TOP.memories(cfg));
+    let mem_files = file_params.iter().map(|p| p.default.clone()).collect();
+    let (tb_files, _) = super::tb::testbench_files(cfg, &format!("{}_tb", TOP.module(cfg)))?;
+    let tb_params: Vec<TbFile> = tb_files
+        .into_iter()
+        .filter(|f| !file_params.iter().any(|p| p.name == f.param))
+        .collect();
     let text = Core {
         version: env!("CARGO_PKG_VERSION"),
         summary: cfg.summary(),
@@ -105,7 +114,9 @@ pub fn core(cfg: &Config) -> Result<String> {
         rtl_files: stages::modules(cfg).iter().map(|m| m.file(cfg)).collect(),
         // Not the logical maps map_<axis>.hex: they are for people and tools.
         mem_files,
-        tb_files: AXES.iter().map(|a| map_file(cfg, 1, a)).collect(),
+        tb_files: tb_params.iter().map(|f| f.default.clone()).collect(),
+        file_params,
+        tb_params,
     }
     .render()
     .context("cannot render templates/pkg/rmap_top.core")?;
@@ -145,6 +156,7 @@ pub fn readme(cfg: &Config) -> Result<String> {
             (
                 m.instance,
                 format!("{} x {}", m.entries, m.width),
+                m.param,
                 m.init_file,
             )
         })
@@ -169,6 +181,7 @@ pub fn readme(cfg: &Config) -> Result<String> {
         depth: cfg.pipeline_depth,
         latency_list,
         memories,
+        target: cfg.target.name(),
     }
     .render()
     .context("cannot render templates/pkg/README.md")?;

@@ -18,8 +18,9 @@ use crate::model::map_set::{map_file, AXES};
 use crate::output::StagedDir;
 use crate::rtl::ports::{self, Width};
 use crate::stages::rmap_top::top_latency;
-use crate::stages::testbench::{FieldView, Sig, TbData};
-use crate::stages::{self, Unit, Vectors, TOP};
+use crate::stages::testbench::{FieldView, Sig, TbData, TbFile};
+use crate::stages::unit::{file_param, file_params, param_overrides};
+use crate::stages::{self, Vectors, TOP};
 use crate::vectors::Dir;
 use anyhow::{bail, Context, Result};
 
@@ -34,15 +35,9 @@ fn range(bits: u32) -> String {
     }
 }
 
-/// The `$readmemh` files the design under `m` reads.
-fn memory_files(cfg: &Config, m: &dyn Unit) -> Vec<String> {
-    let mut v: Vec<String> = m
-        .memories(cfg)
-        .into_iter()
-        .map(|mem| mem.init_file)
-        .collect();
-    v.dedup();
-    v
+/// The parameter naming the second map's file of `axis` in a testbench: `MAP2_X_FILE`.
+fn map2_param(axis: &str) -> String {
+    file_param(&format!("map2_{axis}"))
 }
 
 /// The testbench data of one stage.
@@ -166,14 +161,20 @@ pub fn data(cfg: &Config, stage: &dyn Vectors) -> Result<TbData> {
 
     // A design with writable memories (the map banks) gets the second map through its host
     // port.
-    let map2 = stage.memories(cfg).iter().any(|m| m.writable);
-    let map2_files: Vec<String> = if map2 {
-        AXES.iter().map(|a| map_file(cfg, 1, a)).collect()
-    } else {
-        Vec::new()
-    };
-    let mut hex_files = memory_files(cfg, stage);
-    hex_files.extend(map2_files.iter().cloned());
+    let memories = stage.memories(cfg);
+    let map2 = memories.iter().any(|m| m.writable);
+    let map2_axes: &[&str] = if map2 { &AXES } else { &[] };
+    let mut files: Vec<TbFile> = file_params(&memories)
+        .into_iter()
+        .map(|p| TbFile {
+            param: p.name,
+            default: p.default,
+        })
+        .collect();
+    files.extend(map2_axes.iter().map(|a| TbFile {
+        param: map2_param(a),
+        default: map_file(cfg, 1, a),
+    }));
 
     // The ring must hold every sample in flight plus the one being read.
     let depth = (latency + 4).next_power_of_two().max(16);
@@ -222,14 +223,39 @@ pub fn data(cfg: &Config, stage: &dyn Vectors) -> Result<TbData> {
         fields,
         in_fields,
         out_fields,
-        hex_files,
-        map2_files,
+        files,
+        dut_params: param_overrides(cfg, stage),
+        map2_params: map2_axes.iter().map(|a| map2_param(a)).collect(),
         map2_pattern: map_file(cfg, 1, "*"),
         map_entries: cfg.map_entries(),
         map_addr_bits: cfg.map_addr_bits(),
         map_bits: cfg.map_bits,
         nwrites: 3 * cfg.map_entries(),
     })
+}
+
+/// The files testbench `<module>_tb` of a design reads: its file parameters (defaults relative
+/// to the design directory) and its vector file (`+vectors=`), so that a simulator can run it
+/// from anywhere.
+pub fn testbench_files(cfg: &Config, tb_module: &str) -> Result<(Vec<TbFile>, String)> {
+    let stage = stages::checked(cfg)
+        .into_iter()
+        .find(|s| format!("{}_tb", s.module(cfg)) == tb_module)
+        .with_context(|| format!("{tb_module} is not a testbench of this configuration"))?;
+    let t = data(cfg, stage)?;
+    Ok((t.files, t.vector_file))
+}
+
+/// The top's init-file parameters (defaults relative to the design directory), which a
+/// simulation of the top without its testbench (the C++ harness) sets.
+pub fn top_files(cfg: &Config) -> Vec<TbFile> {
+    file_params(&TOP.memories(cfg))
+        .into_iter()
+        .map(|p| TbFile {
+            param: p.name,
+            default: p.default,
+        })
+        .collect()
 }
 
 /// The Verilog text of one stage's testbench.
@@ -320,20 +346,29 @@ mod tests {
             data(&cfg, stage).unwrap()
         };
         let top = of("rmap_top");
-        for f in [
-            "recip_rom.hex",
-            "atan_rom.hex",
-            "map_bank_00.hex",
-            "map_bank_11.hex",
-            "map2_z.hex",
+        let files = |t: &TbData| -> Vec<(String, String)> {
+            t.files
+                .iter()
+                .map(|f| (f.param.clone(), f.default.clone()))
+                .collect()
+        };
+        for (p, f) in [
+            ("RECIP_ROM_FILE", "recip_rom.hex"),
+            ("ATAN_ROM_FILE", "atan_rom.hex"),
+            ("MAP_BANK_00_FILE", "map_bank_00.hex"),
+            ("MAP_BANK_11_FILE", "map_bank_11.hex"),
+            ("MAP2_Z_FILE", "map2_z.hex"),
         ] {
-            assert!(
-                top.hex_files.iter().any(|h| h == f),
-                "{f} in {:?}",
-                top.hex_files
-            );
+            let want = (p.to_string(), f.to_string());
+            assert!(files(&top).contains(&want), "{want:?} in {:?}", files(&top));
         }
-        assert_eq!(of("normalise").hex_files, vec!["recip_rom.hex"]);
-        assert!(of("sort_shift").hex_files.is_empty());
+        // The ROM is read twice but named once.
+        assert_eq!(
+            files(&of("normalise")),
+            vec![("RECIP_ROM_FILE".to_string(), "recip_rom.hex".to_string())]
+        );
+        assert_eq!(files(&of("atan_rom")).len(), 1);
+        assert!(of("sort_shift").files.is_empty());
+        assert!(of("sort_shift").dut_params.is_empty());
     }
 }

@@ -49,6 +49,8 @@ impl VerilatedTop {
                 &sources,
                 &harness,
                 &design.join("tb"),
+                // Run from the design directory, where the default init files are.
+                &[],
             ),
             "verilator",
         )?;

@@ -2,8 +2,10 @@
 //! Verilator, and the Verilator C++ harness `tb/top_stream.cpp` on a long random stream of
 //! top vectors (`rmapgen sim`, the Makefile's sim targets).
 //!
-//! Simulations run with the design directory as the working directory, so `vectors/` and the
-//! `$readmemh` files resolve. A run passes when the simulator exits 0 and its last line is `N
+//! Simulations run in the build directory, never in the design directory: every file a
+//! testbench or the design reads is passed as an absolute path (the testbench's file
+//! parameters, which it hands to the top's init-file parameters, and `+vectors=`), as an
+//! integrator's simulation from another directory would. A run passes when the simulator exits 0 and its last line is `N
 //! passed, 0 failed` with N > 0: the testbenches print that verdict last, and both simulators
 //! exit 1 on `$stop` and `$fatal`, so either check alone could be fooled by a crash or by a
 //! testbench that ran nothing. A failure is reported with the command and the last lines of
@@ -168,24 +170,25 @@ pub fn run(
     for m in &tbs {
         let mut files = vec![design.path().join("tb").join(format!("{m}.v"))];
         files.extend(design.files());
+        let (strings, vectors) = design.testbench_files(m)?;
         if opts.icarus {
             let dir = r.dir("icarus")?;
             let vvp = dir.join(format!("{m}.vvp"));
             let log = dir.join(format!("{m}.compile.log"));
             if let Some(ran) = r.step(
                 &format!("icarus {m} (compile)"),
-                &mut icarus::compile(m, &vvp, &files),
+                &mut icarus::compile(m, &vvp, &files, &strings),
                 &log,
             )? {
                 for l in ran.output.lines() {
                     r.say(&format!("  iverilog: {l}"));
                 }
-                let mut args = Vec::new();
+                let mut args = vec![stream_arg(&vectors)];
                 let vcd = dir.join(format!("{m}.vcd"));
                 if opts.vcd {
                     args.push(format!("+vcd={}", vcd.display()));
                 }
-                let run = icarus::simulate(design.path(), &vvp, &args);
+                let run = icarus::simulate(&dir, &vvp, &args);
                 if r.simulation(&format!("icarus {m}"), run, &dir.join(format!("{m}.log")))?
                     && opts.vcd
                 {
@@ -193,7 +196,7 @@ pub fn run(
                     r.say(&format!("  vcd: {vcd}"));
                 }
                 if let (true, Some(s)) = (m == &top_tb, &tb_stream) {
-                    let run = icarus::simulate(design.path(), &vvp, &[stream_arg(s)]);
+                    let run = icarus::simulate(&dir, &vvp, &[stream_arg(s)]);
                     let log = dir.join(format!("{m}.stream.log"));
                     r.simulation(&format!("icarus {m} (stream)"), run, &log)?;
                 }
@@ -201,14 +204,14 @@ pub fn run(
         }
         if opts.verilator {
             let mdir = r.dir(&format!("verilator/{m}"))?;
-            let build_cmd = &mut verilator::binary(m, &mdir, &files)?;
+            let build_cmd = &mut verilator::binary(m, &mdir, &files, &strings)?;
             let name = format!("verilator {m} (build)");
             if r.step(&name, build_cmd, &mdir.join("build.log"))?.is_some() {
                 let exe = mdir.join(verilator::BINARY_EXE);
-                let run = executable(design.path(), &exe, &[]);
+                let run = executable(&mdir, &exe, &[stream_arg(&vectors)]);
                 r.simulation(&format!("verilator {m}"), run, &mdir.join("run.log"))?;
                 if let (true, Some(s)) = (m == &top_tb, &tb_stream) {
-                    let run = executable(design.path(), &exe, &[stream_arg(s)]);
+                    let run = executable(&mdir, &exe, &[stream_arg(s)]);
                     let log = mdir.join("stream.log");
                     r.simulation(&format!("verilator {m} (stream)"), run, &log)?;
                 }
@@ -228,12 +231,14 @@ pub fn run(
             &design.files(),
             &harness,
             &design.path().join("tb"),
+            &design.top_files()?,
         );
         let name = "verilator top_stream (build)";
         if r.step(name, &mut build_cmd, &sdir.join("build.log"))?
             .is_some()
         {
             let exe = sdir.join("top_stream");
+            // The harness reads map2_<axis>.hex from its working directory (tb/top_stream.cpp).
             let run = executable(design.path(), &exe, &[vec.display().to_string()]);
             r.simulation("verilator top_stream (C++)", run, &sdir.join("run.log"))?;
         }

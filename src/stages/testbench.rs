@@ -23,6 +23,12 @@ pub struct FieldView {
     pub port: String,
 }
 
+/// A file the testbench reads or passes to the design: its parameter and default path.
+pub struct TbFile {
+    pub param: String,
+    pub default: String,
+}
+
 /// Everything the testbench templates read.
 pub struct TbData {
     pub header: String,
@@ -60,10 +66,14 @@ pub struct TbData {
     pub out_format: String,
     pub exp_args: String,
     pub got_args: String,
-    /// Files the design reads with `$readmemh` (and the testbench itself, for `map2_*`).
-    pub hex_files: Vec<String>,
-    /// The second map, loaded through the host port (map_lookup and the top).
-    pub map2_files: Vec<String>,
+    /// Files the design reads with `$readmemh` and the testbench itself (`map2_*`): one string
+    /// parameter of the testbench each, so a run from another directory sets their paths.
+    pub files: Vec<TbFile>,
+    /// ` #(...)` passing the design's init-file parameters to the instance under test.
+    pub dut_params: String,
+    /// The parameters naming the second map's files, loaded through the host port (map_lookup
+    /// and the top), one per axis.
+    pub map2_params: Vec<String>,
     /// `map2_*.hex` with the prefix, for messages.
     pub map2_pattern: String,
     pub map_entries: u32,

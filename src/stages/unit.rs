@@ -22,6 +22,9 @@ pub struct Head {
     /// [`Unit::module`]: what the template's `module` line declares.
     pub module: String,
     pub ports: String,
+    /// ` #(...)`: one `parameter <NAME>_FILE` per init file of its memories ([`file_params`]),
+    /// or nothing for a module without memories; the template puts it after the name.
+    pub params: String,
 }
 
 impl Head {
@@ -30,6 +33,7 @@ impl Head {
             header: header(cfg, &unit.file(cfg)),
             module: unit.module(cfg),
             ports: ports::render(&unit.ports(cfg)),
+            params: param_list(&file_params(&unit.memories(cfg))),
         }
     }
 }
@@ -69,6 +73,11 @@ pub struct Memory {
     pub instance: String,
     /// The module that declares the array ([`Unit::module`]).
     pub module: String,
+    /// The string parameter, of the module that reports it, that names its `$readmemh` file
+    /// ([`file_param`]). Every module above it declares a parameter of the same name and passes
+    /// it down, so the top sets every init file.
+    pub param: String,
+    /// The parameter's default: the file `rmapgen generate` writes beside the design.
     pub init_file: String,
     pub entries: u32,
     pub width: u32,
@@ -80,6 +89,7 @@ impl Memory {
     pub fn new(
         instance: &str,
         module: String,
+        param: String,
         init_file: String,
         entries: u32,
         width: u32,
@@ -88,6 +98,7 @@ impl Memory {
         Memory {
             instance: instance.to_string(),
             module,
+            param,
             init_file,
             entries,
             width,
@@ -101,6 +112,88 @@ impl Memory {
         self.instance = format!("{instance}.{}", self.instance);
         self
     }
+}
+
+/// The init-file parameter of the memory whose file is `<prefix><stem>.hex`: `<STEM>_FILE`
+/// (`recip_rom` gives `RECIP_ROM_FILE`). Parameter names live inside a module, so they carry
+/// no prefix.
+pub fn file_param(stem: &str) -> String {
+    format!("{}_FILE", stem.to_uppercase())
+}
+
+/// One init-file parameter of a module: its name, its default file and the arrays it loads.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct FileParam {
+    pub name: String,
+    pub default: String,
+    /// `rom_u, rom_v`: the arrays (below the module) that `$readmemh` this file.
+    pub arrays: String,
+    pub entries: u32,
+    pub width: u32,
+}
+
+/// The init-file parameters of a module with these memories: one per distinct parameter, in
+/// memory order.
+pub fn file_params(memories: &[Memory]) -> Vec<FileParam> {
+    let mut v: Vec<FileParam> = Vec::new();
+    for m in memories {
+        match v.iter_mut().find(|p| p.name == m.param) {
+            Some(p) => {
+                p.arrays.push_str(", ");
+                p.arrays.push_str(&m.instance);
+            }
+            None => v.push(FileParam {
+                name: m.param.clone(),
+                default: m.init_file.clone(),
+                arrays: m.instance.clone(),
+                entries: m.entries,
+                width: m.width,
+            }),
+        }
+    }
+    v
+}
+
+/// The ` #(...)` parameter list of a module header, names and defaults aligned.
+fn param_list(params: &[FileParam]) -> String {
+    if params.is_empty() {
+        return String::new();
+    }
+    let name_w = params.iter().map(|p| p.name.len()).max().unwrap_or(0);
+    // The quoted default and its comma, so that the comments line up.
+    let def_w = params
+        .iter()
+        .map(|p| p.default.len() + 3)
+        .max()
+        .unwrap_or(0);
+    let mut s = String::from(
+        " #(\n  // $readmemh files, one hex entry per line; a relative path resolves against the\n  // working directory of the simulator or synthesis tool.",
+    );
+    for (k, p) in params.iter().enumerate() {
+        let comma = if k + 1 < params.len() { "," } else { "" };
+        let def = format!("\"{}\"{comma}", p.default);
+        s.push_str(&format!(
+            "\n  parameter {:name_w$} = {def:def_w$}  // {}: {} x {} bits",
+            p.name, p.arrays, p.entries, p.width
+        ));
+    }
+    s.push_str("\n)");
+    s
+}
+
+/// The ` #(...)` that passes a child's init-file parameters down under the same names, or
+/// nothing when it has no memories.
+pub fn param_overrides(cfg: &Config, child: &dyn Unit) -> String {
+    let params = file_params(&child.memories(cfg));
+    if params.is_empty() {
+        return String::new();
+    }
+    let w = params.iter().map(|p| p.name.len()).max().unwrap_or(0);
+    let pins: Vec<String> = params
+        .iter()
+        .map(|p| format!("    .{:w$} ({})", p.name, p.name))
+        .collect();
+    format!(" #(\n{}\n  )", pins.join(",\n"))
 }
 
 /// The port a vector field names by convention: `<name>_i` for an input, `<name>_o` for an

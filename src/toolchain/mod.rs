@@ -30,6 +30,18 @@ pub fn program(var: &str, default: &str) -> String {
         .unwrap_or_else(|| default.to_string())
 }
 
+/// A Verilog string literal of `value`, for a string parameter set on a tool's command line
+/// (`"path"`). A path holding a `"` or a `\` has no such literal that both simulators read
+/// alike; callers pass paths they checked with [`verilog_string_ok`].
+pub fn quoted(value: &str) -> String {
+    format!("\"{value}\"")
+}
+
+/// Whether `value` can be passed as a Verilog string parameter by [`quoted`].
+pub fn verilog_string_ok(value: &str) -> bool {
+    !value.contains(['"', '\\', '\n'])
+}
+
 /// Whether `program` can be started: a path that is a file, or a name found on PATH.
 pub fn installed(program: &str) -> bool {
     if program.contains('/') {

@@ -9,6 +9,11 @@ use std::process::Command;
 /// verdict stays the last line, and `$stop` (and `$fatal`) exiting 1 as vvp -N does.
 const VL_USER: &str = include_str!("../../tb/vl_user.cpp");
 
+/// `-GNAME="VALUE"`: a string parameter of the top module.
+fn param(name: &str, value: &str) -> String {
+    format!("-G{name}={}", super::quoted(value))
+}
+
 /// The executable [`binary`] builds in its Mdir.
 pub const BINARY_EXE: &str = "sim";
 
@@ -31,7 +36,13 @@ pub fn lint(dir: &Path, top: &str, files: &[PathBuf]) -> Command {
 /// `MDIR/`[`BINARY_EXE`]: `verilator --binary -j JOBS --top-module TOP --Mdir MDIR -o sim
 /// FILES MDIR/vl_user.cpp -CFLAGS -DVL_USER_FINISH -CFLAGS -DVL_USER_STOP`. Writes
 /// vl_user.cpp into `mdir` (made if missing) first.
-pub fn binary(top: &str, mdir: &Path, files: &[PathBuf]) -> Result<Command> {
+/// `strings` sets string parameters of the top (`-GNAME="VALUE"`, the file paths).
+pub fn binary(
+    top: &str,
+    mdir: &Path,
+    files: &[PathBuf],
+    strings: &[(String, String)],
+) -> Result<Command> {
     std::fs::create_dir_all(mdir).with_context(|| format!("cannot create {}", mdir.display()))?;
     let user = mdir.join("vl_user.cpp");
     std::fs::write(&user, VL_USER).with_context(|| format!("cannot write {}", user.display()))?;
@@ -46,6 +57,7 @@ pub fn binary(top: &str, mdir: &Path, files: &[PathBuf]) -> Result<Command> {
     .arg("--Mdir")
     .arg(mdir)
     .args(["-o", BINARY_EXE])
+    .args(strings.iter().map(|(n, v)| param(n, v)))
     .args(files)
     .arg(&user)
     .args(["-CFLAGS", "-DVL_USER_FINISH", "-CFLAGS", "-DVL_USER_STOP"]);
@@ -63,6 +75,7 @@ pub fn harness(
     files: &[PathBuf],
     harness: &Path,
     include: &Path,
+    strings: &[(String, String)],
 ) -> Command {
     let mut c = Command::new(verilator());
     c.args(["--cc", "--exe", "--build", "-j", &super::jobs().to_string()])
@@ -79,6 +92,7 @@ pub fn harness(
         .arg("--Mdir")
         .arg(mdir)
         .args(["-o", exe])
+        .args(strings.iter().map(|(n, v)| param(n, v)))
         .args(files)
         .arg(harness)
         .arg("-CFLAGS")

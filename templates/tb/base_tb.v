@@ -6,6 +6,10 @@
 // Run from the generated directory, which holds vectors/ and the .hex files:
 //   iverilog -g2005 -Wall -Wno-timescale -s {= t.module =}_tb -o {= t.module =}_tb.vvp {= t.tb_file =} *.v
 //   vvp -N {= t.module =}_tb.vvp      (-N: a failing run exits 1)
+{%- if !t.files.is_empty() %}
+// or from anywhere, with every file parameter below set to its path (iverilog
+// -P{= t.module =}_tb.NAME='"path"', verilator -GNAME='"path"') and +vectors=FILE.
+{%- endif %}
 // It reads {= t.vector_file =} (or the file of +vectors=FILE), one vector per line:
 //   {= t.field_list =}
 // (inputs, then expected outputs, hex); +vcd=FILE writes a VCD. Inputs are driven and outputs sampled on the falling
@@ -39,6 +43,16 @@ module {= t.module =}_tb;
   localparam SHOW       = 10;  // mismatches printed in full; later ones by line only
   localparam GIVE_UP    = 100;  // failures after which the run stops (a broken design floods)
 
+{%- if !t.files.is_empty() %}
+
+  // ---------------------------------------------------------------- files
+  // Every file the design or the testbench reads with $readmemh; a relative path resolves
+  // against the simulator's working directory.
+{%- for f in t.files %}
+  parameter {= f.param =} = "{= f.default =}";
+{%- endfor %}
+{%- endif %}
+
   // ---------------------------------------------------------------- the design
 {%- for p in t.inputs %}
   reg  {= p.range =} {= p.name =} = {= p.init =};
@@ -47,7 +61,7 @@ module {= t.module =}_tb;
   wire {= p.range =} {= p.name =};
 {%- endfor %}
 
-  {= t.module =} dut (
+  {= t.module =}{= t.dut_params =} dut (
 {%- for p in t.ports %}
     {= p.pin =}{% if !loop.last %},{% endif %}
 {%- endfor %}
@@ -67,13 +81,13 @@ module {= t.module =}_tb;
 
   reg [8*512-1:0] vector_file;
   reg [8*512-1:0] vcd_file;
-  integer fd, {% if !t.hex_files.is_empty() %}fh, {% endif %}r;
+  integer fd, {% if !t.files.is_empty() %}fh, {% endif %}r;
   integer nread, nin, nout;  // vectors read, accepted, checked
   integer passed, failed, errors, shown;
   integer edges;  // enabled rising edges since the stream began
   integer idle;  // clocks since the last output while samples are in flight
   integer refused;  // clocks the presented sample has waited to be accepted
-  integer seed;{% if !t.map2_files.is_empty() %}
+  integer seed;{% if !t.map2_params.is_empty() %}
   integer k;{% endif %}
   reg [31:0]   rnd;
   reg          eof, en_next, present, ok, did_reset;
@@ -207,9 +221,9 @@ module {= t.module =}_tb;
     if (!$value$plusargs("vectors=%s", vector_file)) vector_file = "{= t.vector_file =}";
     fd = $fopen(vector_file, "r");
     if (fd == 0) $fatal(1, "cannot open %0s: run from the generated directory", vector_file);
-{%- for h in t.hex_files %}
-    fh = $fopen("{= h =}", "r");
-    if (fh == 0) $fatal(1, "cannot open {= h =}: run from the generated directory");
+{%- for f in t.files %}
+    fh = $fopen({= f.param =}, "r");
+    if (fh == 0) $fatal(1, "cannot open %0s ({= f.param =}): run from the generated directory or set it", {= f.param =});
     $fclose(fh);
 {%- endfor %}
     $display("{= t.module =}_tb: {= t.summary =}, latency %0d, vectors %0s", LATENCY, vector_file);

@@ -125,8 +125,12 @@ fn sim_passes_every_testbench_under_icarus_and_fails_on_a_planted_rom_fault() {
     assert!(out.contains("  | MISMATCH line "), "{out}");
     let bad_canonical = bad.canonicalize().unwrap();
     assert!(
+        // Run from the build directory, the vectors (and the init files) named absolutely.
         out.contains(&format!(
             "  command: (cd {} && vvp -N ",
+            build.join("bad/icarus").display()
+        )) && out.contains(&format!(
+            "+vectors={}/vectors/normalise.hex)",
             bad_canonical.display()
         )),
         "{out}"

@@ -12,7 +12,7 @@
 
 use crate::hdl::{self, require};
 use crate::helpers;
-use rmapgen::config::{PIPELINE_DEPTHS, RANGES};
+use rmapgen::config::{Target, PIPELINE_DEPTHS, RANGES};
 use rmapgen::grid::{self, GridRow};
 use std::path::Path;
 
@@ -163,9 +163,21 @@ fn grid_covers_every_range_end_and_switch() {
             );
         }
     }
+    // Both memory targets, each with and without the compensation ROM (whose read ports are
+    // what differs most between them).
+    for target in [Target::Generic, Target::Ice40] {
+        for comp in [false, true] {
+            assert!(
+                rows.iter()
+                    .any(|r| r.config.target == target && r.config.compensation == comp),
+                "no row with target {target:?} and compensation {comp}"
+            );
+        }
+    }
     // Icarus runs a subset that still has every optional stage and both interfaces.
     let ic: Vec<&GridRow> = rows.iter().filter(|r| r.icarus).collect();
     assert!(ic.len() >= 5);
     assert!(ic.iter().any(|r| r.config.color) && ic.iter().any(|r| !r.config.compensation));
     assert!(ic.iter().any(|r| r.config.handshake) && ic.iter().any(|r| !r.config.interpolation));
+    assert!(ic.iter().any(|r| r.config.target == Target::Ice40));
 }

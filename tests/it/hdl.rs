@@ -104,7 +104,7 @@ pub fn icarus(dir: &Path, module: &str, build: &Path) -> PathBuf {
     let vvp = build.join(format!("{module}_tb.vvp"));
     let mut files = vec![dir.join(format!("tb/{module}_tb.v"))];
     files.extend(design_files(dir));
-    let o = icarus::compile(&format!("{module}_tb"), &vvp, &files)
+    let o = icarus::compile(&format!("{module}_tb"), &vvp, &files, &[])
         .output()
         .expect("iverilog runs");
     assert!(
@@ -121,7 +121,7 @@ pub fn verilator(dir: &Path, module: &str, build: &Path) -> PathBuf {
     let mdir = build.join(format!("verilator_{module}"));
     let mut files = vec![dir.join(format!("tb/{module}_tb.v"))];
     files.extend(design_files(dir));
-    let o = verilator::binary(&format!("{module}_tb"), &mdir, &files)
+    let o = verilator::binary(&format!("{module}_tb"), &mdir, &files, &[])
         .expect("the build directory is writable")
         .output()
         .expect("verilator runs");

@@ -11,6 +11,7 @@ mod grid;
 mod hdl;
 mod helpers;
 mod hexfile;
+mod init_files;
 mod layout;
 mod limits;
 mod map_fit;

@@ -365,6 +365,7 @@ fn verilator_lint_is_silent_and_icarus_compiles() {
             "rmap_top",
             Path::new("/dev/null"),
             &crate::hdl::design_files(&dir),
+            &[],
         )
         .current_dir(&dir)
         .output()
@@ -382,13 +383,13 @@ fn verilator_lint_is_silent_and_icarus_compiles() {
 }
 
 #[test]
-fn default_synthesises_without_latches_into_block_ram() {
+fn default_for_the_ice40_synthesises_without_latches_into_block_ram() {
     if !require("yosys") {
         return;
     }
     let t = helpers::tempdir();
     let dir = t.path().join("rtl");
-    generate(&dir, &[], 1);
+    generate(&dir, &["--target", "ice40"], 1);
     let o = helpers::run(&[
         "synth",
         dir.to_str().unwrap(),
@@ -410,4 +411,98 @@ fn default_synthesises_without_latches_into_block_ram() {
         verdict.ends_with(&tail),
         "{verdict} should end with {tail:?}"
     );
+}
+
+/// `--target`: the portable default carries no vendor attribute and reads one compensation ROM
+/// through two ports; `ice40` puts Yosys's block-RAM attributes on every memory and gives
+/// each read port its own ROM copy. The behaviour is the same (the grid simulates both), and
+/// the memories the manifest lists are the arrays the Verilog declares.
+#[test]
+fn the_target_changes_only_the_memories() {
+    let t = helpers::tempdir();
+    let generic = t.path().join("generic");
+    let ice40 = t.path().join("ice40");
+    generate(&generic, &[], 0);
+    generate(&ice40, &["--target", "ice40"], 0);
+    let read = |d: &std::path::Path, f: &str| std::fs::read_to_string(d.join(f)).unwrap();
+    for f in ["recip_rom.v", "atan_rom.v", "map_bank.v"] {
+        let g = read(&generic, f);
+        assert!(!g.contains("(*"), "{f}: an attribute in the generic design");
+        let i = read(&ice40, f);
+        assert!(
+            i.contains("ram_style = \"block\" *)"),
+            "{f}: no ram_style for ice40"
+        );
+    }
+    assert!(read(&ice40, "map_bank.v").contains("(* no_rw_check, ram_style = \"block\" *)"));
+    let arrays = |d: &std::path::Path| -> Vec<String> {
+        manifest(d)["memories"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|m| m["module"] == "atan_rom")
+            .map(|m| m["instance"].as_str().unwrap().to_string())
+            .collect()
+    };
+    assert_eq!(arrays(&generic), ["u_atan_rom.rom"]);
+    assert_eq!(arrays(&ice40), ["u_atan_rom.rom_u", "u_atan_rom.rom_v"]);
+    let g = read(&generic, "atan_rom.v");
+    assert!(
+        g.contains("pu_q <= rom[u_i];") && g.contains("pv_q <= rom[v_i];"),
+        "{g}"
+    );
+    // Everything but the memories' modules is the same text, headers included (the target is
+    // a field of the configuration only when it is not the default).
+    for f in [
+        "sort_shift.v",
+        "normalise.v",
+        "map_lookup.v",
+        "interpolate.v",
+    ] {
+        let (g, i) = (read(&generic, f), read(&ice40, f));
+        let body = |s: &str| {
+            s.lines()
+                .skip_while(|l| l.starts_with("//"))
+                .collect::<Vec<_>>()
+                .join("\n")
+        };
+        assert_eq!(body(&g), body(&i), "{f}");
+    }
+    assert!(read(&ice40, "README.md").contains("**Target: `ice40`.**"));
+    assert!(read(&generic, "README.md").contains("**Target: `generic`.**"));
+}
+
+/// A bad `--target` is one line naming the allowed values, exit 2, nothing written.
+#[test]
+fn an_unknown_target_is_refused() {
+    let t = helpers::tempdir();
+    let out = t.path().join("o");
+    let o = helpers::run(&[
+        "generate",
+        "--out",
+        out.to_str().unwrap(),
+        "--target",
+        "xilinx",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("xilinx") && err.contains("generic") && err.contains("ice40"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let cfg = t.path().join("c.toml");
+    std::fs::write(&cfg, "target = \"xilinx\"\n").unwrap();
+    let o = helpers::run(&[
+        "generate",
+        "--out",
+        out.to_str().unwrap(),
+        "--config",
+        cfg.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("target"), "{err}");
+    assert!(!out.exists());
 }

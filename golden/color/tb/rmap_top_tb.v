@@ -14,6 +14,8 @@
 // Run from the generated directory, which holds vectors/ and the .hex files:
 //   iverilog -g2005 -Wall -Wno-timescale -s rmap_top_tb -o rmap_top_tb.vvp tb/rmap_top_tb.v *.v
 //   vvp -N rmap_top_tb.vvp      (-N: a failing run exits 1)
+// or from anywhere, with every file parameter below set to its path (iverilog
+// -Prmap_top_tb.NAME='"path"', verilator -GNAME='"path"') and +vectors=FILE.
 // It reads vectors/rmap_top.hex (or the file of +vectors=FILE), one vector per line:
 //   map gx gy gz r g b zero i r_o g_o b_o
 // (inputs, then expected outputs, hex); +vcd=FILE writes a VCD. Inputs are driven and outputs sampled on the falling
@@ -38,6 +40,19 @@ module rmap_top_tb;
   localparam SHOW       = 10;  // mismatches printed in full; later ones by line only
   localparam GIVE_UP    = 100;  // failures after which the run stops (a broken design floods)
 
+  // ---------------------------------------------------------------- files
+  // Every file the design or the testbench reads with $readmemh; a relative path resolves
+  // against the simulator's working directory.
+  parameter RECIP_ROM_FILE = "recip_rom.hex";
+  parameter ATAN_ROM_FILE = "atan_rom.hex";
+  parameter MAP_BANK_00_FILE = "map_bank_00.hex";
+  parameter MAP_BANK_10_FILE = "map_bank_10.hex";
+  parameter MAP_BANK_01_FILE = "map_bank_01.hex";
+  parameter MAP_BANK_11_FILE = "map_bank_11.hex";
+  parameter MAP2_X_FILE = "map2_x.hex";
+  parameter MAP2_Y_FILE = "map2_y.hex";
+  parameter MAP2_Z_FILE = "map2_z.hex";
+
   // ---------------------------------------------------------------- the design
   reg         clk_i = 1'd0;
   reg         rst_ni = 1'd0;
@@ -60,7 +75,14 @@ module rmap_top_tb;
   wire [7:0]  g_o;
   wire [7:0]  b_o;
 
-  rmap_top dut (
+  rmap_top #(
+    .RECIP_ROM_FILE   (RECIP_ROM_FILE),
+    .ATAN_ROM_FILE    (ATAN_ROM_FILE),
+    .MAP_BANK_00_FILE (MAP_BANK_00_FILE),
+    .MAP_BANK_10_FILE (MAP_BANK_10_FILE),
+    .MAP_BANK_01_FILE (MAP_BANK_01_FILE),
+    .MAP_BANK_11_FILE (MAP_BANK_11_FILE)
+  ) dut (
     .clk_i     (clk_i),
     .rst_ni    (rst_ni),
     .valid_i   (valid_i),
@@ -271,32 +293,32 @@ module rmap_top_tb;
     if (!$value$plusargs("vectors=%s", vector_file)) vector_file = "vectors/rmap_top.hex";
     fd = $fopen(vector_file, "r");
     if (fd == 0) $fatal(1, "cannot open %0s: run from the generated directory", vector_file);
-    fh = $fopen("recip_rom.hex", "r");
-    if (fh == 0) $fatal(1, "cannot open recip_rom.hex: run from the generated directory");
+    fh = $fopen(RECIP_ROM_FILE, "r");
+    if (fh == 0) $fatal(1, "cannot open %0s (RECIP_ROM_FILE): run from the generated directory or set it", RECIP_ROM_FILE);
     $fclose(fh);
-    fh = $fopen("atan_rom.hex", "r");
-    if (fh == 0) $fatal(1, "cannot open atan_rom.hex: run from the generated directory");
+    fh = $fopen(ATAN_ROM_FILE, "r");
+    if (fh == 0) $fatal(1, "cannot open %0s (ATAN_ROM_FILE): run from the generated directory or set it", ATAN_ROM_FILE);
     $fclose(fh);
-    fh = $fopen("map_bank_00.hex", "r");
-    if (fh == 0) $fatal(1, "cannot open map_bank_00.hex: run from the generated directory");
+    fh = $fopen(MAP_BANK_00_FILE, "r");
+    if (fh == 0) $fatal(1, "cannot open %0s (MAP_BANK_00_FILE): run from the generated directory or set it", MAP_BANK_00_FILE);
     $fclose(fh);
-    fh = $fopen("map_bank_10.hex", "r");
-    if (fh == 0) $fatal(1, "cannot open map_bank_10.hex: run from the generated directory");
+    fh = $fopen(MAP_BANK_10_FILE, "r");
+    if (fh == 0) $fatal(1, "cannot open %0s (MAP_BANK_10_FILE): run from the generated directory or set it", MAP_BANK_10_FILE);
     $fclose(fh);
-    fh = $fopen("map_bank_01.hex", "r");
-    if (fh == 0) $fatal(1, "cannot open map_bank_01.hex: run from the generated directory");
+    fh = $fopen(MAP_BANK_01_FILE, "r");
+    if (fh == 0) $fatal(1, "cannot open %0s (MAP_BANK_01_FILE): run from the generated directory or set it", MAP_BANK_01_FILE);
     $fclose(fh);
-    fh = $fopen("map_bank_11.hex", "r");
-    if (fh == 0) $fatal(1, "cannot open map_bank_11.hex: run from the generated directory");
+    fh = $fopen(MAP_BANK_11_FILE, "r");
+    if (fh == 0) $fatal(1, "cannot open %0s (MAP_BANK_11_FILE): run from the generated directory or set it", MAP_BANK_11_FILE);
     $fclose(fh);
-    fh = $fopen("map2_x.hex", "r");
-    if (fh == 0) $fatal(1, "cannot open map2_x.hex: run from the generated directory");
+    fh = $fopen(MAP2_X_FILE, "r");
+    if (fh == 0) $fatal(1, "cannot open %0s (MAP2_X_FILE): run from the generated directory or set it", MAP2_X_FILE);
     $fclose(fh);
-    fh = $fopen("map2_y.hex", "r");
-    if (fh == 0) $fatal(1, "cannot open map2_y.hex: run from the generated directory");
+    fh = $fopen(MAP2_Y_FILE, "r");
+    if (fh == 0) $fatal(1, "cannot open %0s (MAP2_Y_FILE): run from the generated directory or set it", MAP2_Y_FILE);
     $fclose(fh);
-    fh = $fopen("map2_z.hex", "r");
-    if (fh == 0) $fatal(1, "cannot open map2_z.hex: run from the generated directory");
+    fh = $fopen(MAP2_Z_FILE, "r");
+    if (fh == 0) $fatal(1, "cannot open %0s (MAP2_Z_FILE): run from the generated directory or set it", MAP2_Z_FILE);
     $fclose(fh);
     $display("rmap_top_tb: G12 R8 W10 F8 I3 P3 M8 comp=1 interp=1 color=1 depth=2 handshake=0, latency %0d, vectors %0s", LATENCY, vector_file);
     // +vcd=FILE: every signal of the testbench and the design into a VCD (make wave); a
@@ -305,9 +327,9 @@ module rmap_top_tb;
       $dumpfile(vcd_file);
       $dumpvars(0, rmap_top_tb);
     end
-    $readmemh("map2_x.hex", map2, 0, MAP_ENTRIES - 1);
-    $readmemh("map2_y.hex", map2, MAP_ENTRIES, 2 * MAP_ENTRIES - 1);
-    $readmemh("map2_z.hex", map2, 2 * MAP_ENTRIES, 3 * MAP_ENTRIES - 1);
+    $readmemh(MAP2_X_FILE, map2, 0, MAP_ENTRIES - 1);
+    $readmemh(MAP2_Y_FILE, map2, MAP_ENTRIES, 2 * MAP_ENTRIES - 1);
+    $readmemh(MAP2_Z_FILE, map2, 2 * MAP_ENTRIES, 3 * MAP_ENTRIES - 1);
     for (k = 0; k < NWRITES; k = k + 1) begin
       wi = k[A+1:0];
       if (^map2[wi] === 1'bx) $fatal(1, "map2_*.hex: entry %0d is missing or not hex", k);

@@ -11,6 +11,8 @@
 // Run from the generated directory, which holds vectors/ and the .hex files:
 //   iverilog -g2005 -Wall -Wno-timescale -s normalise_tb -o normalise_tb.vvp tb/normalise_tb.v *.v
 //   vvp -N normalise_tb.vvp      (-N: a failing run exits 1)
+// or from anywhere, with every file parameter below set to its path (iverilog
+// -Pnormalise_tb.NAME='"path"', verilator -GNAME='"path"') and +vectors=FILE.
 // It reads vectors/normalise.hex (or the file of +vectors=FILE), one vector per line:
 //   m a b u v
 // (inputs, then expected outputs, hex); +vcd=FILE writes a VCD. Inputs are driven and outputs sampled on the falling
@@ -35,6 +37,11 @@ module normalise_tb;
   localparam SHOW       = 10;  // mismatches printed in full; later ones by line only
   localparam GIVE_UP    = 100;  // failures after which the run stops (a broken design floods)
 
+  // ---------------------------------------------------------------- files
+  // Every file the design or the testbench reads with $readmemh; a relative path resolves
+  // against the simulator's working directory.
+  parameter RECIP_ROM_FILE = "recip_rom.hex";
+
   // ---------------------------------------------------------------- the design
   reg        clk_i = 1'd0;
   reg        rst_ni = 1'd0;
@@ -47,7 +54,9 @@ module normalise_tb;
   wire [7:0] u_o;
   wire [7:0] v_o;
 
-  normalise dut (
+  normalise #(
+    .RECIP_ROM_FILE (RECIP_ROM_FILE)
+  ) dut (
     .clk_i   (clk_i),
     .rst_ni  (rst_ni),
     .en_i    (en_i),
@@ -196,8 +205,8 @@ module normalise_tb;
     if (!$value$plusargs("vectors=%s", vector_file)) vector_file = "vectors/normalise.hex";
     fd = $fopen(vector_file, "r");
     if (fd == 0) $fatal(1, "cannot open %0s: run from the generated directory", vector_file);
-    fh = $fopen("recip_rom.hex", "r");
-    if (fh == 0) $fatal(1, "cannot open recip_rom.hex: run from the generated directory");
+    fh = $fopen(RECIP_ROM_FILE, "r");
+    if (fh == 0) $fatal(1, "cannot open %0s (RECIP_ROM_FILE): run from the generated directory or set it", RECIP_ROM_FILE);
     $fclose(fh);
     $display("normalise_tb: G12 R8 W10 F8 I3 P3 M8 comp=1 interp=1 color=0 depth=2 handshake=1, latency %0d, vectors %0s", LATENCY, vector_file);
     // +vcd=FILE: every signal of the testbench and the design into a VCD (make wave); a

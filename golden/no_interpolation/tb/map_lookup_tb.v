@@ -14,6 +14,8 @@
 // Run from the generated directory, which holds vectors/ and the .hex files:
 //   iverilog -g2005 -Wall -Wno-timescale -s map_lookup_tb -o map_lookup_tb.vvp tb/map_lookup_tb.v *.v
 //   vvp -N map_lookup_tb.vvp      (-N: a failing run exits 1)
+// or from anywhere, with every file parameter below set to its path (iverilog
+// -Pmap_lookup_tb.NAME='"path"', verilator -GNAME='"path"') and +vectors=FILE.
 // It reads vectors/map_lookup.hex (or the file of +vectors=FILE), one vector per line:
 //   axis s_max s_u s_v pu pv buf e00
 // (inputs, then expected outputs, hex); +vcd=FILE writes a VCD. Inputs are driven and outputs sampled on the falling
@@ -38,6 +40,14 @@ module map_lookup_tb;
   localparam SHOW       = 10;  // mismatches printed in full; later ones by line only
   localparam GIVE_UP    = 100;  // failures after which the run stops (a broken design floods)
 
+  // ---------------------------------------------------------------- files
+  // Every file the design or the testbench reads with $readmemh; a relative path resolves
+  // against the simulator's working directory.
+  parameter MAP_BANK_FILE = "map_bank.hex";
+  parameter MAP2_X_FILE = "map2_x.hex";
+  parameter MAP2_Y_FILE = "map2_y.hex";
+  parameter MAP2_Z_FILE = "map2_z.hex";
+
   // ---------------------------------------------------------------- the design
   reg        clk_i = 1'd0;
   reg        rst_ni = 1'd0;
@@ -58,7 +68,9 @@ module map_lookup_tb;
   wire       valid_o;
   wire [7:0] e00_o;
 
-  map_lookup dut (
+  map_lookup #(
+    .MAP_BANK_FILE (MAP_BANK_FILE)
+  ) dut (
     .clk_i     (clk_i),
     .rst_ni    (rst_ni),
     .en_i      (en_i),
@@ -252,17 +264,17 @@ module map_lookup_tb;
     if (!$value$plusargs("vectors=%s", vector_file)) vector_file = "vectors/map_lookup.hex";
     fd = $fopen(vector_file, "r");
     if (fd == 0) $fatal(1, "cannot open %0s: run from the generated directory", vector_file);
-    fh = $fopen("map_bank.hex", "r");
-    if (fh == 0) $fatal(1, "cannot open map_bank.hex: run from the generated directory");
+    fh = $fopen(MAP_BANK_FILE, "r");
+    if (fh == 0) $fatal(1, "cannot open %0s (MAP_BANK_FILE): run from the generated directory or set it", MAP_BANK_FILE);
     $fclose(fh);
-    fh = $fopen("map2_x.hex", "r");
-    if (fh == 0) $fatal(1, "cannot open map2_x.hex: run from the generated directory");
+    fh = $fopen(MAP2_X_FILE, "r");
+    if (fh == 0) $fatal(1, "cannot open %0s (MAP2_X_FILE): run from the generated directory or set it", MAP2_X_FILE);
     $fclose(fh);
-    fh = $fopen("map2_y.hex", "r");
-    if (fh == 0) $fatal(1, "cannot open map2_y.hex: run from the generated directory");
+    fh = $fopen(MAP2_Y_FILE, "r");
+    if (fh == 0) $fatal(1, "cannot open %0s (MAP2_Y_FILE): run from the generated directory or set it", MAP2_Y_FILE);
     $fclose(fh);
-    fh = $fopen("map2_z.hex", "r");
-    if (fh == 0) $fatal(1, "cannot open map2_z.hex: run from the generated directory");
+    fh = $fopen(MAP2_Z_FILE, "r");
+    if (fh == 0) $fatal(1, "cannot open %0s (MAP2_Z_FILE): run from the generated directory or set it", MAP2_Z_FILE);
     $fclose(fh);
     $display("map_lookup_tb: G12 R8 W10 F8 I3 P0 M8 comp=1 interp=0 color=0 depth=2 handshake=0, latency %0d, vectors %0s", LATENCY, vector_file);
     // +vcd=FILE: every signal of the testbench and the design into a VCD (make wave); a
@@ -271,9 +283,9 @@ module map_lookup_tb;
       $dumpfile(vcd_file);
       $dumpvars(0, map_lookup_tb);
     end
-    $readmemh("map2_x.hex", map2, 0, MAP_ENTRIES - 1);
-    $readmemh("map2_y.hex", map2, MAP_ENTRIES, 2 * MAP_ENTRIES - 1);
-    $readmemh("map2_z.hex", map2, 2 * MAP_ENTRIES, 3 * MAP_ENTRIES - 1);
+    $readmemh(MAP2_X_FILE, map2, 0, MAP_ENTRIES - 1);
+    $readmemh(MAP2_Y_FILE, map2, MAP_ENTRIES, 2 * MAP_ENTRIES - 1);
+    $readmemh(MAP2_Z_FILE, map2, 2 * MAP_ENTRIES, 3 * MAP_ENTRIES - 1);
     for (k = 0; k < NWRITES; k = k + 1) begin
       wi = k[A+1:0];
       if (^map2[wi] === 1'bx) $fatal(1, "map2_*.hex: entry %0d is missing or not hex", k);

@@ -6,7 +6,7 @@ pub mod model;
 
 use super::position;
 use super::testbench::TbData;
-use super::unit::{Head, Memory, Unit, Vectors};
+use super::unit::{file_param, Head, Memory, Unit, Vectors};
 use crate::config::Config;
 use crate::model::{MapSet, Model};
 use crate::rng::SplitMix64;
@@ -17,6 +17,16 @@ use askama::Template;
 pub struct AtanRom;
 
 /// Its `$readmemh` file, `<module>.hex`.
+/// The ROM's arrays: one copy per read port (u, v) for the iCE40, whose block RAM has one read
+/// port; one array read through two ports otherwise.
+fn arrays(cfg: &Config) -> Vec<&'static str> {
+    if cfg.target.ice40() {
+        vec!["rom_u", "rom_v"]
+    } else {
+        vec!["rom"]
+    }
+}
+
 pub fn init_file(cfg: &Config) -> String {
     format!("{}.hex", AtanRom.module(cfg))
 }
@@ -32,7 +42,11 @@ struct Verilog {
     h: Head,
     latency: u32,
     out_reg: bool,
-    init_file: String,
+    param: String,
+    ice40: bool,
+    /// The arrays the u and v ports read: [`arrays`].
+    rom_u: &'static str,
+    rom_v: &'static str,
     pos: u32,
     entries: u32,
 }
@@ -54,12 +68,13 @@ impl Unit for AtanRom {
     }
 
     fn memories(&self, cfg: &Config) -> Vec<Memory> {
-        ["rom_u", "rom_v"]
+        arrays(cfg)
             .into_iter()
             .map(|rom| {
                 Memory::new(
                     rom,
                     self.module(cfg),
+                    file_param(self.name()),
                     init_file(cfg),
                     cfg.atan_entries(),
                     cfg.pos_bits(),
@@ -74,7 +89,10 @@ impl Unit for AtanRom {
             h,
             latency: self.latency(cfg).expect("fixed"),
             out_reg: out_reg(cfg),
-            init_file: init_file(cfg),
+            param: file_param(self.name()),
+            ice40: cfg.target.ice40(),
+            rom_u: arrays(cfg)[0],
+            rom_v: arrays(cfg)[arrays(cfg).len() - 1],
             pos: cfg.pos_bits(),
             entries: cfg.atan_entries(),
         }

@@ -11,6 +11,7 @@ use crate::config::Config;
 use crate::hexfile;
 use crate::model::map_addr::MapAddr;
 use crate::model::Maps;
+use crate::stages::unit::file_param;
 use crate::stages::Unit;
 
 /// Where one logical map entry lives: which bank (index into [`bank_names`]) and where in it.
@@ -47,6 +48,17 @@ pub fn bank_file(cfg: &Config, k: usize) -> String {
         format!("{module}.hex")
     } else {
         format!("{module}_{name}.hex")
+    }
+}
+
+/// The init-file parameter of bank `k` in map_lookup and above it: `MAP_BANK_FILE` for the
+/// only bank, `MAP_BANK_<name>_FILE` for one of four.
+pub fn bank_param(cfg: &Config, k: usize) -> String {
+    let name = &bank_names(cfg)[k];
+    if name.is_empty() {
+        file_param(MapBank.name())
+    } else {
+        file_param(&format!("{}_{name}", MapBank.name()))
     }
 }
 

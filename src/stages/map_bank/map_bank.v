@@ -6,21 +6,21 @@
 // (both buffers hold the scene's map), so the design shades out of reset. A read and a write
 // of the same address in one cycle return undefined data; the top never issues one, because
 // samples read the front buffer and the host writes the back one. Latency 1.
-module {= h.module =} #(
-  parameter INIT_FILE = "{= init_file =}"  // $readmemh file, one M-bit entry per line
-) (
+module {= h.module =}{= h.params =} (
 {= h.ports =}
 );
 
   localparam M       = {= m =};  // entry width
   localparam ENTRIES = {= entries =};  // 2^BA
 
-  // no_rw_check: a same-address read and write never happen (see above), so Yosys need not
-  // add logic to define their result. ram_style: block RAM at every size.
+{%- if ice40 %}
+  // no_rw_check (--target ice40): a same-address read and write never happen (see above), so
+  // Yosys need not add logic to define their result. ram_style: block RAM at every size.
   (* no_rw_check, ram_style = "block" *)
+{%- endif %}
   reg [M-1:0] mem [0:ENTRIES-1];
   initial begin
-    $readmemh(INIT_FILE, mem);
+    $readmemh({= param =}, mem);
   end
 
   always @(posedge clk_i) begin

@@ -12,11 +12,16 @@ use askama::Template;
 
 pub struct MapBank;
 
+/// Its init-file parameter: generic, because map_lookup instantiates it up to four times, each
+/// with its own file (map_lookup passes `banks::bank_param` down as it).
+pub const INIT_PARAM: &str = "INIT_FILE";
+
 #[derive(Template)]
 #[template(path = "map_bank/map_bank.v", syntax = "verilog")]
 struct Verilog {
     h: Head,
-    init_file: String,
+    param: &'static str,
+    ice40: bool,
     m: u32,
     entries: u32,
 }
@@ -49,6 +54,7 @@ impl Unit for MapBank {
         vec![Memory::new(
             "mem",
             self.module(cfg),
+            INIT_PARAM.to_string(),
             banks::bank_file(cfg, 0),
             cfg.bank_entries(),
             cfg.map_bits,
@@ -59,7 +65,8 @@ impl Unit for MapBank {
     fn render(&self, cfg: &Config, h: Head) -> askama::Result<String> {
         Verilog {
             h,
-            init_file: banks::bank_file(cfg, 0),
+            param: INIT_PARAM,
+            ice40: cfg.target.ice40(),
             m: cfg.map_bits,
             entries: cfg.bank_entries(),
         }

@@ -19,7 +19,7 @@
 // Stage 1 forms the bank address; stage 2 reads the bank;{% if bank_reg %} stage 3 registers the bank's
 // output in the fabric (pipeline_depth >= 1);{% endif %} stage {= out =} registers the entry. Latency {= latency =}.
 {%- endif %}
-module {= h.module =} (
+module {= h.module =}{= h.params =} (
 {= h.ports =}
 );
 
@@ -88,7 +88,7 @@ module {= h.module =} (
   wire [M-1:0] d00_q2, d10_q2, d01_q2, d11_q2;  // registered inside the banks
 {% for b in banks %}
   {= bank =} #(
-    .INIT_FILE ("{= b.file =}")
+    .INIT_FILE ({= b.param =})
   ) {= b.inst =} (
     .clk_i     (clk_i),
     .en_i      (en_i),
@@ -188,7 +188,7 @@ module {= h.module =} (
   wire [M-1:0] d_q2;  // registered inside the bank
 {% for b in banks %}
   {= bank =} #(
-    .INIT_FILE ("{= b.file =}")
+    .INIT_FILE ({= b.param =})
   ) {= b.inst =} (
     .clk_i     (clk_i),
     .en_i      (en_i),

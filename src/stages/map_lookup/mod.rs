@@ -43,7 +43,8 @@ impl Plan {
 struct BankInst {
     name: String,
     inst: String,
-    file: String,
+    /// The init-file parameter map_lookup passes to the bank's INIT_FILE.
+    param: String,
     pu: usize,
     pv: usize,
 }
@@ -121,6 +122,7 @@ impl Unit for MapLookup {
             .flat_map(|k| {
                 MapBank.memories(cfg).into_iter().map(move |mut m| {
                     m.init_file = banks::bank_file(cfg, k);
+                    m.param = banks::bank_param(cfg, k);
                     m.under(&banks::bank_instance(cfg, k))
                 })
             })
@@ -133,7 +135,7 @@ impl Unit for MapLookup {
             .map(|k| BankInst {
                 name: names[k].clone(),
                 inst: banks::bank_instance(cfg, k),
-                file: banks::bank_file(cfg, k),
+                param: banks::bank_param(cfg, k),
                 pu: k & 1,
                 pv: k >> 1,
             })

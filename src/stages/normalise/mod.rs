@@ -7,7 +7,7 @@ mod plan;
 
 use super::recip_rom::RecipRom;
 use super::testbench::TbData;
-use super::unit::{Head, Memory, Unit, Vectors};
+use super::unit::{param_overrides, Head, Memory, Unit, Vectors};
 use crate::config::Config;
 use crate::model::{MapSet, Model};
 use crate::rng::SplitMix64;
@@ -28,6 +28,8 @@ struct Verilog {
     h: Head,
     /// The reciprocal ROM's module.
     rom: String,
+    /// Its init-file parameter, passed down to the ROM.
+    rom_params: String,
     depth: u32,
     latency: u32,
     r: u32,
@@ -86,6 +88,7 @@ impl Unit for Normalise {
         Verilog {
             h,
             rom: RecipRom.module(cfg),
+            rom_params: param_overrides(cfg, &RecipRom),
             depth: cfg.pipeline_depth,
             latency: p.latency,
             r: cfg.red_bits,

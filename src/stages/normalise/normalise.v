@@ -9,7 +9,7 @@
 // a * recip + HALF is an adder tree of the partial products (a[j] ? recip << j : 0), one LUT
 // level and one carry chain per level, registered as pipeline_depth = {= depth =} places them
 // (rmapgen::stages::normalise::Plan); the last clock rounds and saturates. Latency {= latency =}.
-module {= h.module =} (
+module {= h.module =}{= h.params =} (
 {= h.ports =}
 );
 
@@ -23,7 +23,7 @@ module {= h.module =} (
 
   // ---------------------------------------------------------------- ROM read and compare
   wire [W-1:0] recip_q1;  // registered inside the ROM
-  {= rom =} u_recip_rom (
+  {= rom =}{= rom_params =} u_recip_rom (
     .clk_i  (clk_i),
     .en_i   (en_i),
     .addr_i (m_i[RA-1:0]),

@@ -3,7 +3,7 @@
 
 pub mod model;
 
-use super::unit::{Head, Memory, Unit};
+use super::unit::{file_param, Head, Memory, Unit};
 use crate::config::Config;
 use crate::rtl::ports::{i, o, Port};
 use askama::Template;
@@ -19,7 +19,8 @@ pub fn init_file(cfg: &Config) -> String {
 #[template(path = "recip_rom/recip_rom.v", syntax = "verilog")]
 struct Verilog {
     h: Head,
-    init_file: String,
+    param: String,
+    ice40: bool,
     w: u32,
     entries: u32,
 }
@@ -51,6 +52,7 @@ impl Unit for RecipRom {
         vec![Memory::new(
             "rom",
             self.module(cfg),
+            file_param(self.name()),
             init_file(cfg),
             cfg.recip_entries(),
             cfg.recip_bits,
@@ -61,7 +63,8 @@ impl Unit for RecipRom {
     fn render(&self, cfg: &Config, h: Head) -> askama::Result<String> {
         Verilog {
             h,
-            init_file: init_file(cfg),
+            param: file_param(self.name()),
+            ice40: cfg.target.ice40(),
             w: cfg.recip_bits,
             entries: cfg.recip_entries(),
         }

@@ -5,21 +5,21 @@
 // (contents: rmapgen's model, recip_rom::contents). The reduced max always has its MSB set,
 // so the address is the R-1 bits below it. Read through a register so that it maps to block
 // RAM. Latency 1.
-module {= h.module =} #(
-  parameter INIT_FILE = "{= init_file =}"  // $readmemh file, one W-bit entry per line
-) (
+module {= h.module =}{= h.params =} (
 {= h.ports =}
 );
 
   localparam W       = {= w =};  // entry width
   localparam ENTRIES = {= entries =};  // 2^(R-1)
 
-  // ram_style: block RAM even where Yosys would build a small table from LUTs, so that every
-  // configuration has its ROM where rmapgen fpga checks for it.
+{%- if ice40 %}
+  // ram_style (--target ice40): block RAM even where Yosys would build a small table from
+  // LUTs, so that every configuration has its ROM where rmapgen fpga checks for it.
   (* ram_style = "block" *)
+{%- endif %}
   reg [W-1:0] rom [0:ENTRIES-1];
   initial begin
-    $readmemh(INIT_FILE, rom);
+    $readmemh({= param =}, rom);
   end
 
   reg [W-1:0] data_q;

@@ -12,7 +12,7 @@ use super::map_lookup::MapLookup;
 use super::normalise::Normalise;
 use super::pipe_delay::PipeDelay;
 use super::sort_shift::SortShift;
-use super::unit::{Head, Memory, Unit, Vectors};
+use super::unit::{param_overrides, Head, Memory, Unit, Vectors};
 use super::zero_detect::ZeroDetect;
 use crate::config::{Config, COLOR_BITS};
 use crate::rtl::ports::{i, o, Port};
@@ -52,11 +52,30 @@ impl Modules {
     }
 }
 
+/// The ` #(...)` passing each child with memories its init-file parameters
+/// ([`param_overrides`]), empty for the others.
+struct Overrides {
+    normalise: String,
+    position: String,
+    map_lookup: String,
+}
+
+impl Overrides {
+    fn new(cfg: &Config) -> Overrides {
+        Overrides {
+            normalise: param_overrides(cfg, &Normalise),
+            position: param_overrides(cfg, position(cfg)),
+            map_lookup: param_overrides(cfg, &MapLookup),
+        }
+    }
+}
+
 #[derive(Template)]
 #[template(path = "rmap_top/rmap_top.v", syntax = "verilog")]
 struct Verilog {
     h: Head,
     mods: Modules,
+    pars: Overrides,
     handshake: bool,
     interpolation: bool,
     color: bool,
@@ -200,6 +219,7 @@ impl Unit for RmapTop {
         Verilog {
             h,
             mods: Modules::new(cfg),
+            pars: Overrides::new(cfg),
             handshake: cfg.handshake,
             interpolation: cfg.interpolation,
             color: cfg.color,

@@ -18,7 +18,7 @@
 // Map buffers: a sample accepted in the cycle of swap_i or later reads the new front buffer;
 // host writes go to the back buffer. After a swap, let the samples accepted before it leave
 // ({% if handshake %}the last of them leaves with valid_o && ready_i{% else %}LATENCY clocks{% endif %}) before writing into the old front buffer.
-module {= h.module =} (
+module {= h.module =}{= h.params =} (
 {= h.ports =}
 );
 
@@ -108,7 +108,7 @@ module {= h.module =} (
   wire         nm_valid;
   wire [F-1:0] nm_u, nm_v;
 
-  {= mods.normalise =} u_normalise (
+  {= mods.normalise =}{= pars.normalise =} u_normalise (
     .clk_i   (clk_i),
     .rst_ni  (rst_ni),
     .en_i    (en),
@@ -125,7 +125,7 @@ module {= h.module =} (
   wire           ps_valid;
   wire [POS-1:0] ps_u, ps_v;
 
-  {= mods.position =} u_{= position =} (
+  {= mods.position =}{= pars.position =} u_{= position =} (
     .clk_i   (clk_i),
     .rst_ni  (rst_ni),
     .en_i    (en),
@@ -169,7 +169,7 @@ module {= h.module =} (
   wire [P:0]   ml_wu, ml_wv;
 {%- endif %}
 
-  {= mods.map_lookup =} u_map_lookup (
+  {= mods.map_lookup =}{= pars.map_lookup =} u_map_lookup (
     .clk_i     (clk_i),
     .rst_ni    (rst_ni),
     .en_i      (en),
