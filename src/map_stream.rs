@@ -68,7 +68,11 @@ pub fn to_maps(cfg: &Config, writes: &[Write]) -> Result<Maps> {
         }
         let slot = &mut data[(w.axis * n + w.addr) as usize];
         if slot.replace(w.data).is_some() {
-            bail!("write {k}: axis {} address {} written twice", w.axis, w.addr);
+            bail!(
+                "write {k}: axis {} address {} written twice",
+                w.axis,
+                w.addr
+            );
         }
     }
     let data: Option<Vec<u32>> = data.into_iter().collect();
@@ -218,10 +222,7 @@ pub fn decode_bin(bytes: &[u8]) -> Result<Vec<Write>> {
 
 /// Reads a C stream back: the rows `{a, b, c}` of its array.
 pub fn decode_c(text: &str) -> Result<Vec<Write>> {
-    let body = text
-        .split_once("] = {")
-        .context("no array initialiser")?
-        .1;
+    let body = text.split_once("] = {").context("no array initialiser")?.1;
     let mut v = Vec::new();
     for row in body.split('{').skip(1) {
         let row = row.split('}').next().unwrap_or("");
@@ -273,7 +274,10 @@ pub fn is_ours(format: Format, head: &[u8]) -> bool {
             head.len() >= n * RECORD_BYTES
                 && decode_bin(&head[..n * RECORD_BYTES]).is_ok_and(|ws| {
                     ws.iter().enumerate().all(|(k, w)| {
-                        w.axis == 0 && w.addr == k as u32 && w.data < 1 << crate::config::range_of("map_bits").expect("map_bits").1
+                        w.axis == 0
+                            && w.addr == k as u32
+                            && w.data
+                                < 1 << crate::config::range_of("map_bits").expect("map_bits").1
                     })
                 })
         }
@@ -341,7 +345,9 @@ mod tests {
         assert_eq!(last, format!("2 1ff {:02x}", maps.get(2, 511)));
         let c = String::from_utf8(encode(&cfg, &scene, &maps, Format::C)).unwrap();
         assert!(c.contains("#define RMAP_TOP_MAP_WRITES_COUNT 1536u"), "{c}");
-        assert!(c.contains("static const uint16_t rmap_top_map_writes[RMAP_TOP_MAP_WRITES_COUNT][3] = {"));
+        assert!(c.contains(
+            "static const uint16_t rmap_top_map_writes[RMAP_TOP_MAP_WRITES_COUNT][3] = {"
+        ));
         let bin = encode(&cfg, &scene, &maps, Format::Bin);
         assert_eq!(bin.len(), 1536 * RECORD_BYTES);
         assert_eq!(&bin[6..12], &[0, 0, 1, 0, maps.get(0, 1) as u8, 0]);

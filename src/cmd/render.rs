@@ -42,9 +42,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         shrink: a.shrink,
     };
     options.validate(&cfg)?;
-    let policy = a
-        .force
-        .policy(&[a.cfg.config.as_deref(), a.map.input()]);
+    let policy = a.force.policy(&[a.cfg.config.as_deref(), a.map.input()]);
     let out = StagedDir::new(&a.out, &policy)?;
     let rtl = if a.rtl {
         Some(crate::rtl::verilated::VerilatedTop::build(&cfg, &scene)?)

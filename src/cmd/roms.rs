@@ -39,9 +39,7 @@ pub fn run(a: &RomsArgs) -> Result<()> {
         .as_ref()
         .or(a.update.as_ref())
         .context("--out or --update")?;
-    let policy = a
-        .force
-        .policy(&[a.cfg.config.as_deref(), a.map.input()]);
+    let policy = a.force.policy(&[a.cfg.config.as_deref(), a.map.input()]);
     if a.update.is_some() && crate::output::stamp::read(target).is_none() {
         anyhow::bail!(
             "--update {}: not a directory rmapgen generated (it has no {})",

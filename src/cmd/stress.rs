@@ -44,8 +44,7 @@ pub fn run(a: &StressArgs) -> Result<()> {
     let json = match &a.json {
         Some(p) => Some(StagedFile::new(
             p,
-            &a.force
-                .policy(&[a.cfg.config.as_deref(), a.map.input()]),
+            &a.force.policy(&[a.cfg.config.as_deref(), a.map.input()]),
             stress::is_report_json,
         )?),
         None => None,

@@ -45,11 +45,9 @@ pub fn run(a: &VectorsArgs) -> Result<()> {
         Some(dir) => MapSet::from_dir(&cfg, dir)?,
         None => MapSet::from_scenes(&cfg, &a.map.scene()?, &Scene::alternate()),
     };
-    let policy = a.force.policy(&[
-        a.cfg.config.as_deref(),
-        a.map.input(),
-        a.maps.as_deref(),
-    ]);
+    let policy = a
+        .force
+        .policy(&[a.cfg.config.as_deref(), a.map.input(), a.maps.as_deref()]);
     let out = StagedFile::new(&a.out, &policy, vectors::is_vector_stream)?;
     // The whole file must fit before the first byte is written (its size is exact: every
     // line has the same length).

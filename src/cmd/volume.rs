@@ -325,11 +325,9 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
     let vol = volume(a)?;
     let load_ms = t.elapsed().as_secs_f64() * 1e3;
 
-    let policy = a.force.policy(&[
-        a.cfg.config.as_deref(),
-        a.map.input(),
-        a.input.as_deref(),
-    ]);
+    let policy = a
+        .force
+        .policy(&[a.cfg.config.as_deref(), a.map.input(), a.input.as_deref()]);
     let out = StagedDir::new(&a.out, &policy)?;
     let t = Instant::now();
     let p = Prepared::try_new(&vol, cfg.grad_bits, opts.brick)?;

@@ -112,7 +112,11 @@ mod tests {
             for (k, f) in fs.iter().enumerate() {
                 let mut v = [0u32; 5];
                 v[k] = (1 << f.width) - 1;
-                assert_eq!(addr(&cfg, v[0], v[1], v[2], v[3], v[4]), v[k] << f.lsb, "{f:?}");
+                assert_eq!(
+                    addr(&cfg, v[0], v[1], v[2], v[3], v[4]),
+                    v[k] << f.lsb,
+                    "{f:?}"
+                );
             }
         }
     }

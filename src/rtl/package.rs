@@ -229,7 +229,12 @@ pub fn readme(design: &Design) -> Result<String> {
             .map(|a| {
                 let [x, y, z] = place(a, 0, 1, 2);
                 let pos = |k: u32| AXES[[x, y, z].iter().position(|&c| c == k).expect("placed")];
-                (a, pos(0).to_string(), pos(1).to_string(), pos(2).to_string())
+                (
+                    a,
+                    pos(0).to_string(),
+                    pos(1).to_string(),
+                    pos(2).to_string(),
+                )
             })
             .collect(),
         entries: cfg.entries(),

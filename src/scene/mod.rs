@@ -162,9 +162,10 @@ impl Scene {
 
     pub fn from_toml_file(path: &Path) -> anyhow::Result<Scene> {
         let text = toml_input::read(path, "scene")?;
-        let name = path
-            .file_name()
-            .map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned());
+        let name = path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
         Ok(Scene::from_toml_named(&text, &format!("scene {}", path.display()))?.named(&name))
     }
 

@@ -137,7 +137,12 @@ fn from_readme(dir: &Path, cfg: &Config) -> (usize, usize) {
         .as_array()
         .unwrap()
         .iter()
-        .map(|l| (unit(vec3(&l["direction"])), l["intensity"].as_float().unwrap()))
+        .map(|l| {
+            (
+                unit(vec3(&l["direction"])),
+                l["intensity"].as_float().unwrap(),
+            )
+        })
         .collect();
     let max: f64 = text
         .split("scaled to\n  2^M - 1 = ")
@@ -193,7 +198,10 @@ fn the_readme_alone_gives_every_map_entry() {
     let t = helpers::tempdir();
     for (k, (flags, scene)) in [
         (vec![], "standard.toml"),
-        (vec!["--no-compensation", "--index-bits", "4"], "four_lights.toml"),
+        (
+            vec!["--no-compensation", "--index-bits", "4"],
+            "four_lights.toml",
+        ),
         (vec!["--map-bits", "10"], "engine.toml"),
     ]
     .into_iter()

@@ -13,7 +13,14 @@ fn commands(scene: &str) -> Vec<(Vec<&str>, &'static str)> {
         (vec!["roms"], "map_y.hex"),
         (vec!["render", "--size", "32"], "model.png"),
         (
-            vec!["volume", "--synthetic", "--dims", "32,32,16", "--size", "32"],
+            vec![
+                "volume",
+                "--synthetic",
+                "--dims",
+                "32,32,16",
+                "--size",
+                "32",
+            ],
             "model.png",
         ),
         (
@@ -93,7 +100,10 @@ fn every_command_that_builds_maps_follows_map_fit() {
     let scene = scene.to_str().unwrap();
     for (k, (args, file)) in commands(scene).into_iter().enumerate() {
         let name = if args[0] == "stress" { "r.json" } else { "o" };
-        let (a, b) = (t.path().join(format!("{k}a{name}")), t.path().join(format!("{k}b{name}")));
+        let (a, b) = (
+            t.path().join(format!("{k}a{name}")),
+            t.path().join(format!("{k}b{name}")),
+        );
         let run = |extra: &[&str], out: &Path| {
             let mut v = args.clone();
             v.extend(extra);
@@ -112,7 +122,11 @@ fn every_command_that_builds_maps_follows_map_fit() {
                 ["sample lsq", "lsq", "sample"]
             );
         } else {
-            assert_eq!(plain, again, "{}: --map-fit sample is the scene's own", args[0]);
+            assert_eq!(
+                plain, again,
+                "{}: --map-fit sample is the scene's own",
+                args[0]
+            );
         }
     }
 }
@@ -125,7 +139,12 @@ fn a_bad_map_fit_or_scene_is_one_line_on_every_command() {
     let out = t.path().join("out");
     for (args, _) in commands(scene) {
         let mut v = args.clone();
-        v.extend(["--map-fit", "cubic", out_flag(args[0]), out.to_str().unwrap()]);
+        v.extend([
+            "--map-fit",
+            "cubic",
+            out_flag(args[0]),
+            out.to_str().unwrap(),
+        ]);
         helpers::assert_error(&helpers::run(&v), "--map-fit");
         // A missing scene file, named.
         let mut v = Vec::new();

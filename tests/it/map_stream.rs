@@ -187,7 +187,8 @@ fn the_exported_stream_written_through_the_host_port_is_what_the_rtl_reads() {
             let f: Vec<&str> = l.split(' ').collect();
             let a = u32::from_str_radix(f[1], 16).unwrap();
             let (iu, iv) = ((a >> (i + 1)) & ((1 << i) - 1), a & ((1 << i) - 1));
-            let swapped = (a & !(((1 << i) - 1) << (i + 1)) & !((1 << i) - 1)) | (iv << (i + 1)) | iu;
+            let swapped =
+                (a & !(((1 << i) - 1) << (i + 1)) & !((1 << i) - 1)) | (iv << (i + 1)) | iu;
             format!("{} {:0da$x} {}\n", f[0], swapped, f[2])
         })
         .collect();
@@ -203,7 +204,13 @@ fn every_format_holds_the_maps_generate_writes() {
     let scene = scene_path("two_lights.toml");
     for flags in [
         vec![],
-        vec!["--index-bits", "4", "--no-interpolation", "--map-bits", "10"],
+        vec![
+            "--index-bits",
+            "4",
+            "--no-interpolation",
+            "--map-bits",
+            "10",
+        ],
         vec!["--no-compensation", "--prefix", "p_", "--map-fit", "lsq"],
     ] {
         let d = t.path().join("d");
@@ -223,7 +230,11 @@ fn every_format_holds_the_maps_generate_writes() {
             assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
             let bytes = std::fs::read(&f).unwrap();
             let writes = map_stream::decode(format, &bytes).unwrap();
-            assert_eq!(writes, map_stream::writes(&cfg, &committed), "{name} {flags:?}");
+            assert_eq!(
+                writes,
+                map_stream::writes(&cfg, &committed),
+                "{name} {flags:?}"
+            );
             // A second run replaces the file it wrote without --force.
             let o = helpers::run(&a);
             assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -243,7 +254,13 @@ fn bad_input_is_one_line_and_writes_nothing() {
     helpers::assert_error(&o, "--map-fit");
     let o = helpers::run(&["maps", "--index-bits", "9", "--out", out.to_str().unwrap()]);
     helpers::assert_error(&o, "--index-bits");
-    let o = helpers::run(&["maps", "--scene", "/nonexistent.toml", "--out", out.to_str().unwrap()]);
+    let o = helpers::run(&[
+        "maps",
+        "--scene",
+        "/nonexistent.toml",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
     helpers::assert_error(&o, "nonexistent.toml");
     assert!(!out.exists());
     // A file rmapgen did not write is not replaced, in any format.
