@@ -276,3 +276,46 @@ fn bad_input_is_one_line_and_writes_nothing() {
     helpers::assert_error(&o, "was not written by rmapgen");
     assert_eq!(helpers::entries(t.path()), ["m.hex", "notes.hex"]);
 }
+
+#[test]
+fn the_c_array_compiles_and_holds_the_writes() {
+    // A C compiler is part of the toolchain (Verilator needs one).
+    let t = helpers::tempdir();
+    let h = t.path().join("maps.h");
+    let o = helpers::run(&[
+        "maps",
+        "--prefix",
+        "q_",
+        "--no-interpolation",
+        "--format",
+        "c",
+        "--out",
+        h.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let c = t.path().join("main.c");
+    std::fs::write(
+        &c,
+        "#include <stdio.h>\n#include \"maps.h\"\nint main(void) {\n  for (unsigned k = 0; k < \
+         Q_RMAP_TOP_MAP_WRITES_COUNT; k++)\n    printf(\"%x %x %x\\n\", q_rmap_top_map_writes[k][0], \
+         q_rmap_top_map_writes[k][1], q_rmap_top_map_writes[k][2]);\n  return 0;\n}\n",
+    )
+    .unwrap();
+    let exe = t.path().join("main");
+    let cc = Command::new("cc")
+        .args(["-std=c99", "-Wall", "-Wextra", "-Werror", "-o"])
+        .arg(&exe)
+        .arg(&c)
+        .output()
+        .expect("cc runs");
+    assert!(cc.status.success(), "{}", String::from_utf8_lossy(&cc.stderr));
+    let out = Command::new(&exe).output().unwrap();
+    let got = map_stream::decode_hex(&String::from_utf8_lossy(&out.stdout)).unwrap();
+    let cfg = Config {
+        prefix: "q_".into(),
+        interpolation: false,
+        interp_bits: 0,
+        ..Config::default()
+    };
+    assert_eq!(got, map_stream::writes(&cfg, &Scene::standard().maps(&cfg)));
+}
