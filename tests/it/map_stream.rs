@@ -308,7 +308,11 @@ fn the_c_array_compiles_and_holds_the_writes() {
         .arg(&c)
         .output()
         .expect("cc runs");
-    assert!(cc.status.success(), "{}", String::from_utf8_lossy(&cc.stderr));
+    assert!(
+        cc.status.success(),
+        "{}",
+        String::from_utf8_lossy(&cc.stderr)
+    );
     let out = Command::new(&exe).output().unwrap();
     let got = map_stream::decode_hex(&String::from_utf8_lossy(&out.stdout)).unwrap();
     let cfg = Config {
