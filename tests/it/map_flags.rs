@@ -145,7 +145,7 @@ fn a_bad_map_fit_or_scene_is_one_line_on_every_command() {
             out_flag(args[0]),
             out.to_str().unwrap(),
         ]);
-        helpers::assert_error(&helpers::run(&v), "--map-fit");
+        helpers::assert_error(&helpers::run(&v), "invalid value 'cubic' for '--map-fit");
         // A missing scene file, named.
         let mut v = Vec::new();
         let mut it = args.iter();
