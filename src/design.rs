@@ -12,22 +12,20 @@ use anyhow::Result;
 pub struct Design {
     pub model: Model,
     pub maps: MapSet,
+    /// The scene of buffer 0 (its name and light model, with the `map_fit` that filled the
+    /// map), for the generated README.
+    pub scene: Scene,
 }
 
 impl Design {
-    /// Validates `cfg` and builds its tables; `maps` are the two buffers.
-    pub fn new(cfg: &Config, maps: MapSet) -> Result<Design> {
-        cfg.validate()?;
-        Ok(Design {
-            model: Model::new(cfg),
-            maps,
-        })
-    }
-
     /// `scene`'s map in buffer 0, the alternate scene's in buffer 1.
     pub fn for_scene(cfg: &Config, scene: &Scene) -> Result<Design> {
         cfg.validate()?;
-        Design::new(cfg, MapSet::from_scenes(cfg, scene, &Scene::alternate()))
+        Ok(Design {
+            model: Model::new(cfg),
+            maps: MapSet::from_scenes(cfg, scene, &Scene::alternate()),
+            scene: scene.clone(),
+        })
     }
 
     /// The standard scene's design.

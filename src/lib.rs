@@ -11,6 +11,7 @@ pub mod fit;
 pub mod geometry;
 pub mod grid;
 pub mod hexfile;
+pub mod map_stream;
 pub mod model;
 pub mod output;
 pub mod reference;

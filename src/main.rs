@@ -22,6 +22,9 @@ enum Command {
     Generate(cmd::generate::GenerateArgs),
     /// Write the ROM and map contents as $readmemh hex files.
     Roms(cmd::roms::RomsArgs),
+    /// Write one frame's maps as the host write port's stream (axis, address, data in write
+    /// order) as hex, raw binary or a C array, for a host driver to send.
+    Maps(cmd::maps::MapsArgs),
     /// Render the sphere test image with the model and the float reference, and measure the error.
     Render(cmd::render::RenderArgs),
     /// Write a large top-level vector stream for the Verilator C++ harness (tb/top_stream.cpp).
@@ -73,6 +76,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Generate(a) => done(cmd::generate::run(&a)),
         Command::Roms(a) => done(cmd::roms::run(&a)),
+        Command::Maps(a) => done(cmd::maps::run(&a)),
         Command::Render(a) => done(cmd::render::run(&a)),
         Command::Vectors(a) => done(cmd::vectors::run(&a)),
         Command::Stress(a) => done(cmd::stress::run(&a)),

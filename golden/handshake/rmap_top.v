@@ -41,7 +41,7 @@ module rmap_top #(
   input  wire [7:0]  wr_data_i,
   input  wire        ready_i,    // the result leaves at a rising edge with valid_o && ready_i
   output wire        ready_o,    // the pipeline accepts a sample (a register; low in reset)
-  output wire        valid_o,    // holds, with the outputs, until ready_i
+  output wire        valid_o,    // a result is on the outputs; holds, with them, until ready_i
   output wire        zero_o,     // the sample's gradient was zero
   output wire [7:0]  i_o         // intensity (0 when zero_o)
 );

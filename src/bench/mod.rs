@@ -46,7 +46,14 @@ pub struct Options {
     pub yosys: bool,
     /// Only the paper's configuration (and the octahedral map).
     pub quick: bool,
+    /// The scenes measured, (name, scene): [`scenes`] unless the command names one.
+    pub scenes: Vec<(String, Scene)>,
+    /// The map fits measured for each scene: [`FITS`] unless the command names one.
+    pub fits: Vec<MapFit>,
 }
+
+/// The map fits measured by default.
+pub const FITS: [MapFit; 2] = [MapFit::Sample, MapFit::Lsq];
 
 impl Default for Options {
     fn default() -> Self {
@@ -55,7 +62,18 @@ impl Default for Options {
             seconds: 0.3,
             yosys: true,
             quick: false,
+            scenes: scenes(),
+            fits: FITS.to_vec(),
         }
+    }
+}
+
+impl Options {
+    /// Progress steps of [`run`]: each scene's reference, each configuration's speed and
+    /// synthesis and its (scene, fit) rows, each scene's octahedral map.
+    pub fn steps(&self) -> usize {
+        configurations(self.quick).len() * (1 + self.fits.len() * self.scenes.len())
+            + 2 * self.scenes.len()
     }
 }
 
@@ -138,7 +156,7 @@ pub fn scenes() -> Vec<(String, Scene)> {
 pub fn run(opts: &Options, progress: &dyn Fn(&str)) -> Result<Vec<Row>> {
     let grads = uniform(1 << 20);
     let mut out16 = vec![0u16; grads.len()];
-    let scenes = scenes();
+    let scenes = &opts.scenes;
     let mut rows = Vec::new();
     // The float reference's throughput per scene, and the sphere's gradients and reference
     // values per (scene, configuration output width): every configuration here has 12-bit
@@ -150,7 +168,7 @@ pub fn run(opts: &Options, progress: &dyn Fn(&str)) -> Result<Vec<Row>> {
         .collect();
     let mut reference_speed = Vec::new();
     let mut reference_values = Vec::new();
-    for (name, s) in &scenes {
+    for (name, s) in scenes {
         let r = Reference::new(&d, s);
         reference_speed.push(
             grads.len() as f64
@@ -181,7 +199,7 @@ pub fn run(opts: &Options, progress: &dyn Fn(&str)) -> Result<Vec<Row>> {
         progress(&format!("{design}: speed and synthesis"));
         let lsq = LsqFit::new(&cfg);
         for (k, (name, scene)) in scenes.iter().enumerate() {
-            for fit in [MapFit::Sample, MapFit::Lsq] {
+            for &fit in &opts.fits {
                 let p = scene.prepared();
                 let build = match fit {
                     MapFit::Sample => median(7, || {
@@ -287,7 +305,13 @@ pub fn write(rows: &[Row], out: &StagedDir) -> Result<()> {
     out.write_text("bench.md", &markdown(rows))?;
     out.write_text("bench.csv", &csv(rows))?;
     out.write_text("bench.json", &serde_json::to_string_pretty(rows)?)?;
-    let scene_names: Vec<String> = scenes().into_iter().map(|s| s.0).collect();
+    // The scenes in the order of their first row.
+    let mut scene_names: Vec<String> = Vec::new();
+    for r in rows {
+        if !scene_names.contains(&r.scene) {
+            scene_names.push(r.scene.clone());
+        }
+    }
     let marker = |r: &Row| {
         if r.design.starts_with("octahedral") {
             2

@@ -34,6 +34,10 @@ pub struct BenchArgs {
     /// Only the paper's configuration (and the octahedral map).
     #[arg(long)]
     pub quick: bool,
+    /// Measure only this scene (--scene, named by its file's stem) and this map fit
+    /// (--map-fit) [default: the standard, two-lights and diffuse scenes, sample and lsq].
+    #[command(flatten)]
+    pub map: super::map_args::MapArgs,
 }
 
 pub fn run(a: &BenchArgs) -> Result<()> {
@@ -48,16 +52,23 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         "seconds {} is out of range; allowed (0, {MAX_SECONDS}]",
         a.seconds
     );
-    let out = StagedDir::new(&a.out, &a.force.policy(&[]))?;
+    let scenes = match &a.map.scene {
+        Some(p) => {
+            let name = p.file_stem().unwrap_or(p.as_os_str()).to_string_lossy();
+            vec![(name.into_owned(), a.map.scene()?)]
+        }
+        None => bench::scenes(),
+    };
+    let out = StagedDir::new(&a.out, &a.force.policy(&[a.map.input()]))?;
     let opts = Options {
         size: a.size,
         seconds: a.seconds,
         yosys: !a.no_yosys,
         quick: a.quick,
+        scenes,
+        fits: a.map.map_fit.map_or(bench::FITS.to_vec(), |f| vec![f]),
     };
-    let steps = bench::configurations(a.quick).len() * (1 + 2 * bench::scenes().len())
-        + 2 * bench::scenes().len();
-    let bar = ProgressBar::new(steps as u64);
+    let bar = ProgressBar::new(opts.steps() as u64);
     bar.set_style(
         ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} {msg}")
             .expect("valid template")

@@ -2,13 +2,12 @@
 //! target; prints the decision and writes the chosen design as `generate` does.
 
 use super::generate;
+use super::map_args::MapArgs;
 use super::parse;
 use crate::config::Config;
 use crate::fit::outcome::Outcome;
 use crate::fit::target::Target;
 use crate::fit::{self, CostKind, Options};
-use crate::model::map_fit::MapFit;
-use crate::scene::Scene;
 use anyhow::Result;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -27,10 +26,11 @@ pub const MAX_SYNTH_LIMIT: usize = 64;
 
 #[derive(Args, Debug)]
 #[command(group(clap::ArgGroup::new("target").required(true).multiple(true).args(["max_error", "rmse"])))]
+#[command(mut_arg("scene", |a| a.required(true)
+    .help("Scene whose sphere test image the error is measured on (its maps fill the design)")))]
 pub struct FitArgs {
-    /// Scene whose sphere test image the error is measured on (its maps fill the design).
-    #[arg(long, value_name = "FILE")]
-    pub scene: PathBuf,
+    #[command(flatten)]
+    pub map: MapArgs,
     /// Largest absolute error allowed on any output, in its LSBs (intensity: map-bits wide;
     /// colour channels: 8 bits).
     #[arg(long, value_name = "E", value_parser = parse::at_least::<u32>(0))]
@@ -61,9 +61,6 @@ pub struct FitArgs {
     /// Valid/ready handshake on the generated top.
     #[arg(long)]
     pub handshake: bool,
-    /// How the maps are filled [default: the scene's map_fit].
-    #[arg(long, value_enum)]
-    pub map_fit: Option<MapFit>,
     /// Side of the sphere test image [16..=4096].
     #[arg(long, value_name = "N", default_value_t = 512, value_parser = parse::count::<u32>())]
     pub size: u32,
@@ -86,7 +83,8 @@ pub struct FitArgs {
 
 pub fn run(a: &FitArgs) -> Result<()> {
     crate::vectors::check_stage_vectors(a.vectors, "--vectors")?;
-    let scene = Scene::from_toml_file(&a.scene)?;
+    let scene = a.map.scene_or(|| anyhow::bail!("fit needs --scene FILE"))?;
+    let scene_file = a.map.input().unwrap_or(std::path::Path::new("")).display();
     let base = Config {
         grad_bits: a.grad_bits,
         map_bits: a.map_bits,
@@ -122,7 +120,7 @@ pub fn run(a: &FitArgs) -> Result<()> {
         cost: a.cost,
         runners_up: a.runners_up,
         synth_limit: a.synth_limit,
-        map_fit: a.map_fit.unwrap_or(scene.map_fit),
+        map_fit: scene.map_fit,
     };
     // A progress bar, shown once the search has run for a second (on a terminal).
     let bar = ProgressBar::with_draw_target(Some(0), ProgressDrawTarget::hidden());
@@ -146,7 +144,7 @@ pub fn run(a: &FitArgs) -> Result<()> {
     bar.finish_and_clear();
     let d = match outcome? {
         Outcome::Found(d) => d,
-        Outcome::Unreachable(u) => anyhow::bail!(u.message(&a.scene.display().to_string())),
+        Outcome::Unreachable(u) => anyhow::bail!(u.message(&scene_file.to_string())),
     };
     let json = serde_json::to_string_pretty(&d)?;
     let cfg = &d.chosen.config;
@@ -154,14 +152,14 @@ pub fn run(a: &FitArgs) -> Result<()> {
         cfg,
         &scene,
         &a.out,
-        &a.force.policy(&[Some(&a.scene)]),
+        &a.force.policy(&[a.map.input()]),
         a.vectors,
         a.seed,
         &[("fit.json".to_string(), json)],
     )?;
     println!(
         "fit: {} ({}), {}x{} sphere ({} pixels), maps {}; target {}; cost {}",
-        a.scene.display(),
+        scene_file,
         d.scene_terms,
         d.image_size,
         d.image_size,

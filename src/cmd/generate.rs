@@ -3,6 +3,7 @@
 //! whole or not at all.
 
 use super::config_args::ConfigArgs;
+use super::map_args::MapArgs;
 use crate::config::Config;
 use crate::design::Design;
 use crate::output::{Policy, StagedDir};
@@ -18,9 +19,8 @@ use std::path::{Path, PathBuf};
 pub struct GenerateArgs {
     #[command(flatten)]
     pub cfg: ConfigArgs,
-    /// Scene whose light model fills the maps [default: the standard scene].
-    #[arg(long, value_name = "FILE")]
-    pub scene: Option<PathBuf>,
+    #[command(flatten)]
+    pub map: MapArgs,
     /// Output directory (replaced whole on success).
     #[arg(long, value_name = "DIR", default_value = "rtl_out")]
     pub out: PathBuf,
@@ -42,13 +42,8 @@ pub const DEFAULT_SEED: u64 = 1;
 pub fn run(a: &GenerateArgs) -> Result<()> {
     vectors::check_stage_vectors(a.vectors, "--vectors")?;
     let cfg = a.cfg.resolve()?;
-    let scene = match &a.scene {
-        Some(p) => Scene::from_toml_file(p)?,
-        None => Scene::standard(),
-    };
-    let policy = a
-        .force
-        .policy(&[a.cfg.config.as_deref(), a.scene.as_deref()]);
+    let scene = a.map.scene()?;
+    let policy = a.force.policy(&[a.cfg.config.as_deref(), a.map.input()]);
     let (p, manifest) = write_dir(&cfg, &scene, &a.out, &policy, a.vectors, a.seed, &[])?;
     eprintln!(
         "rmapgen: wrote {} ({} modules, latency {}, {} memory bits) to {}",

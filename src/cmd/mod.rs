@@ -7,6 +7,8 @@ pub mod force;
 pub mod fpga;
 pub mod generate;
 pub mod lint;
+pub mod map_args;
+pub mod maps;
 pub mod parse;
 pub mod render;
 pub mod roms;

@@ -2,9 +2,9 @@
 //! the error image and the error statistics.
 
 use super::config_args::ConfigArgs;
+use super::map_args::MapArgs;
 use crate::output::StagedDir;
 use crate::render::{self, Options};
-use crate::scene::Scene;
 use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
@@ -13,9 +13,9 @@ use std::path::PathBuf;
 pub struct RenderArgs {
     #[command(flatten)]
     pub cfg: ConfigArgs,
-    /// Scene to shade [default: the standard scene].
-    #[arg(long, value_name = "FILE")]
-    pub scene: Option<PathBuf>,
+    /// The scene to shade, and how its maps are filled.
+    #[command(flatten)]
+    pub map: MapArgs,
     /// Image width and height in pixels [1..=4096].
     #[arg(long, value_name = "N", default_value_t = render::DEFAULT_SIZE, value_parser = super::parse::count::<u32>())]
     pub size: u32,
@@ -36,18 +36,13 @@ pub struct RenderArgs {
 
 pub fn run(a: &RenderArgs) -> Result<()> {
     let cfg = a.cfg.resolve()?;
-    let scene = match &a.scene {
-        Some(p) => Scene::from_toml_file(p)?,
-        None => Scene::standard(),
-    };
+    let scene = a.map.scene()?;
     let options = Options {
         size: a.size,
         shrink: a.shrink,
     };
     options.validate(&cfg)?;
-    let policy = a
-        .force
-        .policy(&[a.cfg.config.as_deref(), a.scene.as_deref()]);
+    let policy = a.force.policy(&[a.cfg.config.as_deref(), a.map.input()]);
     let out = StagedDir::new(&a.out, &policy)?;
     let rtl = if a.rtl {
         Some(crate::rtl::verilated::VerilatedTop::build(&cfg, &scene)?)

@@ -1,9 +1,9 @@
 //! `rmapgen roms`: the ROM and map contents as `$readmemh` files, nothing else.
 
 use super::config_args::ConfigArgs;
+use super::map_args::MapArgs;
 use crate::design::Design;
 use crate::output::StagedDir;
-use crate::scene::Scene;
 use anyhow::Context;
 use anyhow::Result;
 use clap::Args;
@@ -13,12 +13,8 @@ use std::path::PathBuf;
 pub struct RomsArgs {
     #[command(flatten)]
     pub cfg: ConfigArgs,
-    /// Scene whose light model fills the maps [default: the standard scene].
-    #[arg(long, value_name = "FILE")]
-    pub scene: Option<PathBuf>,
-    /// How the maps are filled from the light model [default: the scene's `map_fit`, else sample].
-    #[arg(long, value_enum)]
-    pub map_fit: Option<crate::model::map_fit::MapFit>,
+    #[command(flatten)]
+    pub map: MapArgs,
     /// Output directory (replaced whole on success).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
@@ -37,21 +33,13 @@ pub struct RomsArgs {
 
 pub fn run(a: &RomsArgs) -> Result<()> {
     let cfg = a.cfg.resolve()?;
-    let mut scene = match &a.scene {
-        Some(p) => Scene::from_toml_file(p)?,
-        None => Scene::standard(),
-    };
-    if let Some(f) = a.map_fit {
-        scene.map_fit = f;
-    }
+    let scene = a.map.scene()?;
     let target = a
         .out
         .as_ref()
         .or(a.update.as_ref())
         .context("--out or --update")?;
-    let policy = a
-        .force
-        .policy(&[a.cfg.config.as_deref(), a.scene.as_deref()]);
+    let policy = a.force.policy(&[a.cfg.config.as_deref(), a.map.input()]);
     if a.update.is_some() && crate::output::stamp::read(target).is_none() {
         anyhow::bail!(
             "--update {}: not a directory rmapgen generated (it has no {})",

@@ -2,8 +2,8 @@
 //! sweeps every magnitude, against the true direction and the float reference.
 
 use super::config_args::ConfigArgs;
+use super::map_args::MapArgs;
 use crate::output::StagedFile;
-use crate::scene::Scene;
 use crate::stress::{self, exhaustive, Report, Setup};
 use anyhow::{Context, Result};
 use clap::Args;
@@ -14,12 +14,9 @@ use std::path::PathBuf;
 pub struct StressArgs {
     #[command(flatten)]
     pub cfg: ConfigArgs,
-    /// Scene whose light model fills the maps and the reference [default: the standard scene].
-    #[arg(long, value_name = "FILE")]
-    pub scene: Option<PathBuf>,
-    /// How the maps are filled from the light model [default: the scene's `map_fit`, else sample].
-    #[arg(long, value_enum)]
-    pub map_fit: Option<crate::model::map_fit::MapFit>,
+    /// The maps' scene is also the reference's.
+    #[command(flatten)]
+    pub map: MapArgs,
     /// Every gradient (2^(3 grad-bits) inputs; grad-bits <= 12).
     #[arg(long, conflicts_with = "samples")]
     pub exhaustive: bool,
@@ -42,19 +39,12 @@ pub fn run(a: &StressArgs) -> Result<()> {
         stress::check_samples(a.samples)?;
     }
     let cfg = a.cfg.resolve()?;
-    let mut scene = match &a.scene {
-        Some(p) => Scene::from_toml_file(p)?,
-        None => Scene::standard(),
-    };
-    if let Some(f) = a.map_fit {
-        scene.map_fit = f;
-    }
+    let scene = a.map.scene()?;
     // Claimed before the run, so a refused path fails at once rather than after it.
     let json = match &a.json {
         Some(p) => Some(StagedFile::new(
             p,
-            &a.force
-                .policy(&[a.cfg.config.as_deref(), a.scene.as_deref()]),
+            &a.force.policy(&[a.cfg.config.as_deref(), a.map.input()]),
             stress::is_report_json,
         )?),
         None => None,

@@ -2,6 +2,7 @@
 //! Verilator C++ harness `tb/top_stream.cpp`, which checks millions of samples per run.
 
 use super::config_args::ConfigArgs;
+use super::map_args::MapArgs;
 use crate::output::StagedFile;
 use crate::scene::Scene;
 use crate::vectors::{self, MapSet};
@@ -24,11 +25,12 @@ pub struct VectorsArgs {
     pub seed: u64,
     /// Take the maps from a generated directory (map_<axis>.hex and map2_<axis>.hex), so the
     /// vectors match the scene it was generated with.
-    #[arg(long, value_name = "DIR", conflicts_with = "scene")]
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "map_fit"])]
     pub maps: Option<PathBuf>,
-    /// Scene of map 0 [default: the standard scene]; map 1 is always the alternate scene.
-    #[arg(long, value_name = "FILE")]
-    pub scene: Option<PathBuf>,
+    /// The scene and fit of map 0; map 1 is always the alternate scene's
+    /// (scenes/two_lights.toml).
+    #[command(flatten)]
+    pub map: MapArgs,
     /// Vector file to write (replaced only when complete).
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
@@ -39,18 +41,13 @@ pub struct VectorsArgs {
 pub fn run(a: &VectorsArgs) -> Result<()> {
     let cfg = a.cfg.resolve()?;
     vectors::check_stream_vectors(a.count as u64)?;
-    let maps = match (&a.maps, &a.scene) {
-        (Some(dir), _) => MapSet::from_dir(&cfg, dir)?,
-        (None, Some(p)) => {
-            MapSet::from_scenes(&cfg, &Scene::from_toml_file(p)?, &Scene::alternate())
-        }
-        (None, None) => MapSet::standard(&cfg),
+    let maps = match &a.maps {
+        Some(dir) => MapSet::from_dir(&cfg, dir)?,
+        None => MapSet::from_scenes(&cfg, &a.map.scene()?, &Scene::alternate()),
     };
-    let policy = a.force.policy(&[
-        a.cfg.config.as_deref(),
-        a.scene.as_deref(),
-        a.maps.as_deref(),
-    ]);
+    let policy = a
+        .force
+        .policy(&[a.cfg.config.as_deref(), a.map.input(), a.maps.as_deref()]);
     let out = StagedFile::new(&a.out, &policy, vectors::is_vector_stream)?;
     // The whole file must fit before the first byte is written (its size is exact: every
     // line has the same length).

@@ -4,6 +4,7 @@
 //! skipping.
 
 use super::config_args::ConfigArgs;
+use super::map_args::MapArgs;
 use crate::config::Config;
 use crate::output::StagedDir;
 use crate::reference::Reference;
@@ -50,10 +51,10 @@ pub struct VolumeArgs {
     /// Raw voxels are signed (two's complement).
     #[arg(long)]
     pub signed: bool,
-    /// Scene: view, lights, material and [transfer] opacity function [default: the engine
-    /// block scene, scenes/engine.toml].
-    #[arg(long, value_name = "FILE")]
-    pub scene: Option<PathBuf>,
+    /// The scene (view, lights, material and [transfer] opacity function) and how its maps
+    /// are filled.
+    #[command(flatten)]
+    pub map: MapArgs,
     /// Transfer function breakpoints value:opacity,... (replaces the scene's).
     #[arg(long, value_name = "V:A,...", allow_hyphen_values = true)]
     pub transfer: Option<String>,
@@ -117,10 +118,11 @@ fn triple<T: std::str::FromStr>(flag: &str, s: &str) -> Result<[T; 3]> {
 
 /// The scene with --view and --transfer applied, validated, with a transfer function.
 fn scene(a: &VolumeArgs) -> Result<Scene> {
-    let mut scene = match &a.scene {
-        Some(p) => Scene::from_toml_file(p)?,
-        None => Scene::from_toml_str(ENGINE_SCENE_TOML).context("the built-in engine scene")?,
-    };
+    let mut scene = a.map.scene_or(|| {
+        Ok(Scene::from_toml_str(ENGINE_SCENE_TOML)
+            .context("the built-in engine scene")?
+            .named("scenes/engine.toml"))
+    })?;
     if let Some(v) = &a.view {
         let d = triple::<f64>("--view", v)?;
         crate::scene::check_direction("--view", d)?;
@@ -323,11 +325,9 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
     let vol = volume(a)?;
     let load_ms = t.elapsed().as_secs_f64() * 1e3;
 
-    let policy = a.force.policy(&[
-        a.cfg.config.as_deref(),
-        a.scene.as_deref(),
-        a.input.as_deref(),
-    ]);
+    let policy = a
+        .force
+        .policy(&[a.cfg.config.as_deref(), a.map.input(), a.input.as_deref()]);
     let out = StagedDir::new(&a.out, &policy)?;
     let t = Instant::now();
     let p = Prepared::try_new(&vol, cfg.grad_bits, opts.brick)?;

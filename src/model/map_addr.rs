@@ -20,26 +20,49 @@ impl MapAddr {
     /// The address of these fields in the map of one axis.
     #[inline]
     pub fn encode(self, cfg: &Config) -> u32 {
-        let i = cfg.index_bits;
-        (self.s_max << (2 * i + 2))
-            | (self.s_u << (2 * i + 1))
-            | (self.i_u << (i + 1))
-            | (self.s_v << i)
-            | self.i_v
+        let [s_max, s_u, i_u, s_v, i_v] = fields(cfg);
+        (self.s_max << s_max.lsb)
+            | (self.s_u << s_u.lsb)
+            | (self.i_u << i_u.lsb)
+            | (self.s_v << s_v.lsb)
+            | (self.i_v << i_v.lsb)
     }
 
     /// Splits an address into its fields (the inverse of [`MapAddr::encode`]).
     pub fn decode(cfg: &Config, addr: u32) -> MapAddr {
-        let i = cfg.index_bits;
-        let idx = cfg.entries() - 1;
+        let get = |f: Field| (addr >> f.lsb) & ((1 << f.width) - 1);
+        let [s_max, s_u, i_u, s_v, i_v] = fields(cfg);
         MapAddr {
-            s_max: (addr >> (2 * i + 2)) & 1,
-            s_u: (addr >> (2 * i + 1)) & 1,
-            i_u: (addr >> (i + 1)) & idx,
-            s_v: (addr >> i) & 1,
-            i_v: addr & idx,
+            s_max: get(s_max),
+            s_u: get(s_u),
+            i_u: get(i_u),
+            s_v: get(s_v),
+            i_v: get(i_v),
         }
     }
+}
+
+/// One field of the address layout: its name, lowest bit and width.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Field {
+    pub name: &'static str,
+    pub lsb: u32,
+    pub width: u32,
+}
+
+/// The layout's fields, most significant first: the one definition that [`MapAddr::encode`],
+/// [`MapAddr::decode`] and the generated README's address table read.
+#[inline]
+pub fn fields(cfg: &Config) -> [Field; 5] {
+    let i = cfg.index_bits;
+    let f = |name, lsb, width| Field { name, lsb, width };
+    [
+        f("s_max", 2 * i + 2, 1),
+        f("s_u", 2 * i + 1, 1),
+        f("i_u", i + 1, i),
+        f("s_v", i, 1),
+        f("i_v", 0, i),
+    ]
 }
 
 /// Address of entry (i_u, i_v) with these signs in the map of one axis.
@@ -72,6 +95,27 @@ mod tests {
                     a,
                     "{}",
                     cfg.summary()
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn fields_are_where_encode_puts_them() {
+        for index_bits in 2..=6 {
+            let cfg = Config {
+                index_bits,
+                ..Config::default()
+            };
+            let fs = fields(&cfg);
+            assert_eq!(fs.iter().map(|f| f.width).sum::<u32>(), cfg.map_addr_bits());
+            for (k, f) in fs.iter().enumerate() {
+                let mut v = [0u32; 5];
+                v[k] = (1 << f.width) - 1;
+                assert_eq!(
+                    addr(&cfg, v[0], v[1], v[2], v[3], v[4]),
+                    v[k] << f.lsb,
+                    "{f:?}"
                 );
             }
         }

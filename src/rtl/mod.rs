@@ -66,7 +66,7 @@ pub fn write_design(design: &Design, out: &StagedDir) -> Result<Manifest> {
         write(name, &text)?;
     }
     write(package::core_file(cfg), &package::core(cfg)?)?;
-    write(package::README_FILE.into(), &package::readme(cfg)?)?;
+    write(package::README_FILE.into(), &package::readme(design)?)?;
     files.push(manifest::FILE.to_string());
     let manifest = Manifest::new(cfg, files);
     out.write_text(manifest::FILE, &manifest.to_json())?;

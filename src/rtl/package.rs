@@ -8,7 +8,11 @@
 
 use super::{manifest, Dir, Width};
 use crate::config::Config;
-use crate::model::map_set::map_file;
+use crate::design::Design;
+use crate::geometry::{face_tangent, place};
+use crate::map_stream;
+use crate::model::map_addr;
+use crate::model::map_set::{map_file, AXES};
 use crate::stages::map_bank::MapBank;
 use crate::stages::rmap_top::{latency_list, top_latency};
 use crate::stages::testbench::TbFile;
@@ -65,6 +69,32 @@ struct Readme {
     memories: Vec<(String, String, String, String)>,
     /// [`crate::config::Target::name`].
     target: &'static str,
+    /// The edge after which `valid_o` is high for a sample accepted at edge 0.
+    valid_edge: u32,
+    compensation: bool,
+    interpolation: bool,
+    addr_bits: u32,
+    /// (name, bits, width, meaning) of each address field.
+    addr_fields: Vec<(String, String, u32, String)>,
+    /// (wr_axis_i, max axis, u axis, v axis).
+    uv_rows: Vec<(u32, String, String, String)>,
+    entries: u32,
+    /// (index, tangent with compensation, without).
+    tangents: Vec<(u32, f64, f64)>,
+    map_glob: String,
+    map_x: String,
+    scene_name: String,
+    scene_toml: String,
+    map_fit: &'static str,
+    map_max: u32,
+    map_bits: u32,
+    writes: u32,
+    last_addr: u32,
+    addr_digits: u32,
+    data_digits: u32,
+    record_bytes: usize,
+    c_array: String,
+    c_count: String,
 }
 
 /// The core's VLNV name, `rmapgen:ip:<top module>_<hash>:<version>`: the top's module name
@@ -123,8 +153,9 @@ pub fn core(cfg: &Config) -> Result<String> {
     Ok(text + "\n")
 }
 
-/// `README.md` for `cfg`.
-pub fn readme(cfg: &Config) -> Result<String> {
+/// `README.md` for a design: its configuration, and the scene its maps come from.
+pub fn readme(design: &Design) -> Result<String> {
+    let cfg = design.cfg();
     let config_rows = toml::to_string(cfg)
         .context("cannot serialise the configuration")?
         .lines()
@@ -182,6 +213,71 @@ pub fn readme(cfg: &Config) -> Result<String> {
         latency_list,
         memories,
         target: cfg.target.name(),
+        valid_edge: top_latency(cfg) - 1,
+        compensation: cfg.compensation,
+        interpolation: cfg.interpolation,
+        addr_bits: cfg.map_addr_bits(),
+        addr_fields: map_addr::fields(cfg)
+            .iter()
+            .map(|f| {
+                let bits = if f.width == 1 {
+                    format!("[{}]", f.lsb)
+                } else {
+                    format!("[{}:{}]", f.lsb + f.width - 1, f.lsb)
+                };
+                let meaning = match f.name {
+                    "s_max" => "sign of the max-axis component".to_string(),
+                    "s_u" => "sign of the u component".to_string(),
+                    "s_v" => "sign of the v component".to_string(),
+                    n => format!(
+                        "index along {}: 0 (component 0) to {} (magnitude equal to the max's)",
+                        &n[2..],
+                        cfg.entries() - 1
+                    ),
+                };
+                (f.name.to_string(), bits, f.width, meaning)
+            })
+            .collect(),
+        uv_rows: (0..3u32)
+            .map(|a| {
+                let [x, y, z] = place(a, 0, 1, 2);
+                let pos = |k: u32| AXES[[x, y, z].iter().position(|&c| c == k).expect("placed")];
+                (
+                    a,
+                    pos(0).to_string(),
+                    pos(1).to_string(),
+                    pos(2).to_string(),
+                )
+            })
+            .collect(),
+        entries: cfg.entries(),
+        tangents: (0..cfg.entries())
+            .map(|i| {
+                let r = i as f64 / (cfg.entries() - 1) as f64;
+                (i, face_tangent(true, r), face_tangent(false, r))
+            })
+            .collect(),
+        map_glob: map_file(cfg, 0, "<axis>"),
+        map_x: map_file(cfg, 0, AXES[0]),
+        scene_name: if design.scene.name.is_empty() {
+            "(given as text)".to_string()
+        } else {
+            design.scene.name.clone()
+        },
+        scene_toml: toml::to_string(&design.scene)
+            .context("cannot serialise the scene")?
+            .trim_end()
+            .to_string(),
+        map_fit: design.scene.map_fit.name(),
+        map_max: cfg.map_max(),
+        map_bits: cfg.map_bits,
+        writes: 3 * cfg.map_entries(),
+        last_addr: cfg.map_entries() - 1,
+        addr_digits: cfg.map_addr_bits().div_ceil(4),
+        data_digits: cfg.map_bits.div_ceil(4),
+        record_bytes: map_stream::RECORD_BYTES,
+        c_array: map_stream::c_array(cfg),
+        c_count: map_stream::c_count(cfg),
     }
     .render()
     .context("cannot render templates/pkg/README.md")?;

@@ -15,6 +15,11 @@ use crate::toml_input::{self, Invalid};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Scene {
+    /// Where the scene came from, for generated documentation: `scenes/standard.toml` for
+    /// the built-in scenes, the file's name (without its directory, so output does not
+    /// depend on where a command ran) for a file, empty for other text. Not a TOML key.
+    #[serde(skip)]
+    pub name: String,
     #[serde(default)]
     pub view: View,
     pub material: Material,
@@ -126,11 +131,21 @@ impl Scene {
     }
 
     pub fn standard() -> Scene {
-        Scene::from_toml_str(STANDARD_TOML).expect("the standard scene is valid")
+        Scene::from_toml_str(STANDARD_TOML)
+            .expect("the standard scene is valid")
+            .named("scenes/standard.toml")
     }
 
     pub fn alternate() -> Scene {
-        Scene::from_toml_str(ALTERNATE_TOML).expect("the alternate scene is valid")
+        Scene::from_toml_str(ALTERNATE_TOML)
+            .expect("the alternate scene is valid")
+            .named("scenes/two_lights.toml")
+    }
+
+    /// The scene with [`Scene::name`] set.
+    pub fn named(mut self, name: &str) -> Scene {
+        self.name = name.to_string();
+        self
     }
 
     pub fn from_toml_str(text: &str) -> anyhow::Result<Scene> {
@@ -147,7 +162,11 @@ impl Scene {
 
     pub fn from_toml_file(path: &Path) -> anyhow::Result<Scene> {
         let text = toml_input::read(path, "scene")?;
-        Scene::from_toml_named(&text, &format!("scene {}", path.display()))
+        let name = path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        Ok(Scene::from_toml_named(&text, &format!("scene {}", path.display()))?.named(&name))
     }
 
     /// Checks every value, naming the first bad one by its key.

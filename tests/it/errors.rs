@@ -368,7 +368,7 @@ fn usage_errors_are_one_line_naming_the_flag() {
             &["render"],
             "the following required arguments were not provided: --out <DIR>",
         ),
-        (&[], "give a command: generate, roms, render"),
+        (&[], "give a command: generate, roms, maps, render"),
         (
             &["generate", "--prefix", "9a_", "--out", o_],
             "--prefix \"9a_\" starts with a digit; allowed a letter or _ then letters, digits and _",

@@ -164,9 +164,9 @@ impl Unit for RmapTop {
             "valid_o",
             1,
             if cfg.handshake {
-                "holds, with the outputs, until ready_i"
+                "a result is on the outputs; holds, with them, until ready_i"
             } else {
-                ""
+                "a result is on the outputs (high one clock per sample)"
             },
         ));
         v.push(o("zero_o", 1, "the sample's gradient was zero"));
