@@ -33,7 +33,7 @@ module rmap_top #(
   input  wire [1:0]  wr_axis_i,
   input  wire [8:0]  wr_addr_i,  // {s_max, s_u, i_u, s_v, i_v}
   input  wire [7:0]  wr_data_i,
-  output wire        valid_o,
+  output wire        valid_o,    // a result is on the outputs (high one clock per sample)
   output wire        zero_o,     // the sample's gradient was zero
   output wire [7:0]  i_o         // intensity (0 when zero_o)
 );
