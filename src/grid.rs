@@ -7,7 +7,8 @@
 //! The rows are chosen for coverage, and `tests/it/grid.rs` holds them to it: each width at
 //! both ends of its range (recip_bits at its smallest legal value, frac_bits + 1), each of the
 //! eight combinations of compensation, interpolation and colour, every pipeline depth, and the
-//! handshake on and off, mixed so that the ends meet each other and the optional stages.
+//! handshake on and off, mixed so that the ends meet each other and the optional stages, and
+//! the AXI4-Stream top.
 
 use crate::config::{Config, RANGES};
 
@@ -28,7 +29,7 @@ pub struct GridRow {
 macro_rules! grid {
     ($( $name:ident: $g:literal $r:literal $w:literal $f:literal $i:literal $p:literal $m:literal
         $comp:literal $interp:literal $color:literal $depth:literal $hs:literal $icarus:literal
-        $covers:literal; )*) => {
+        $(axis $user:literal)? $covers:literal; )*) => {
         /// Every row, in the order below.
         pub fn rows() -> Vec<GridRow> {
             vec![$(GridRow {
@@ -39,6 +40,8 @@ macro_rules! grid {
                     compensation: $comp == 1, interpolation: $interp == 1, color: $color == 1,
                     pipeline_depth: $depth, handshake: $hs == 1,
                     prefix: String::new(),
+                    axis: false $(|| { let _: u32 = $user; true })?,
+                    axis_user: 0 $(+ $user)?,
                 },
                 icarus: $icarus == 1,
                 covers: $covers,
@@ -48,7 +51,8 @@ macro_rules! grid {
 }
 
 // G grad, R reduced, W reciprocal entry, F fraction, I index, P interpolation fraction, M map
-// entry bits; comp(ensation), interp(olation), color, pipeline depth, handshake, run in Icarus.
+// entry bits; comp(ensation), interp(olation), color, pipeline depth, handshake, run in Icarus;
+// `axis U`: the AXI4-Stream top rmap_axis with a U-bit tuser.
 grid! {
 //                  G  R  W  F  I  P  M  comp interp color depth hs icarus
     paper:          12 8  10 8  3  3  8  1    1      0     2     0  1
@@ -101,6 +105,8 @@ grid! {
         "the narrowest map entries, nearest entry";
     index6_nearest: 14 10 12 10 6  0  10 0    0      0     1     1  0
         "the largest map without interpolation (the widest bank address), under backpressure";
+    axis_color:     12 8  10 8  3  3  8  1    1      1     2     1  1  axis 3
+        "the AXI4-Stream top (rmap_axis: byte-padded tdata, 3-bit tuser, tlast) around the handshake top with colour";
 }
 
 /// The row called `name`.

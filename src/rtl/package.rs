@@ -11,7 +11,7 @@ use crate::config::Config;
 use crate::model::map_set::{map_file, AXES};
 use crate::stages::map_bank::MapBank;
 use crate::stages::rmap_top::{latency_list, top_latency};
-use crate::stages::{self, Unit, TOP};
+use crate::stages::{self, rmap_axis, Unit, TOP};
 use anyhow::{Context, Result};
 use askama::Template;
 
@@ -29,7 +29,10 @@ struct Core {
     summary: String,
     vlnv: String,
     core_file: String,
+    /// The design's top ([`stages::top`]).
     top: String,
+    /// The top testbench's module (`<rmap_top module>_tb`).
+    tb_top: String,
     tb_file: String,
     vector_file: String,
     latency: u32,
@@ -57,6 +60,52 @@ struct Readme {
     depth: u32,
     latency_list: String,
     memories: Vec<(String, String, String)>,
+    /// The `## AXI4-Stream` section (`axis` only).
+    axis: Option<AxisReadme>,
+}
+
+/// What the README's `## AXI4-Stream` section prints: the wrapper's ports and the `tdata`
+/// layouts, from [`rmap_axis`].
+struct AxisReadme {
+    top: String,
+    tuser: u32,
+    vectors: String,
+    ports: Vec<(String, &'static str, u32, String)>,
+    /// (bus, its width, field, field bits, `[hi:lo]`).
+    slots: Vec<(&'static str, u32, &'static str, u32, String)>,
+}
+
+impl AxisReadme {
+    fn new(cfg: &Config) -> Option<AxisReadme> {
+        let info = rmap_axis::AxisInfo::new(cfg)?;
+        let mut slots = Vec::new();
+        for (bus, p) in [
+            ("s_axis_tdata", &info.s_tdata),
+            ("m_axis_tdata", &info.m_tdata),
+        ] {
+            for s in &p.slots {
+                let pad = match s.pad() {
+                    Some((h, l)) if h == l => format!(", [{h}] 0"),
+                    Some((h, l)) => format!(", [{h}:{l}] 0"),
+                    None => String::new(),
+                };
+                slots.push((bus, p.bits, s.field, s.bits, format!("{}{pad}", s.range())));
+            }
+        }
+        Some(AxisReadme {
+            top: rmap_axis::RmapAxis.module(cfg),
+            tuser: info.tuser_bits,
+            vectors: info.vectors,
+            ports: rmap_axis::port_rows(cfg)
+                .into_iter()
+                .map(|(n, d, w, note)| {
+                    let text = describe(&n, note);
+                    (n, d, w, text)
+                })
+                .collect(),
+            slots,
+        })
+    }
 }
 
 /// The core's VLNV name, `rmapgen:ip:<top module>_<hash>:<version>`: the top's module name
@@ -98,7 +147,8 @@ pub fn core(cfg: &Config) -> Result<String> {
         summary: cfg.summary(),
         vlnv: vlnv(cfg),
         core_file: core_file(cfg),
-        top: TOP.module(cfg),
+        top: stages::top(cfg).module(cfg),
+        tb_top: format!("{}_tb", TOP.module(cfg)),
         tb_file: top.testbench_file(cfg),
         vector_file: top.vector_file(cfg),
         latency: top_latency(cfg),
@@ -169,6 +219,7 @@ pub fn readme(cfg: &Config) -> Result<String> {
         depth: cfg.pipeline_depth,
         latency_list,
         memories,
+        axis: AxisReadme::new(cfg),
     }
     .render()
     .context("cannot render templates/pkg/README.md")?;
