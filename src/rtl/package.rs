@@ -71,8 +71,8 @@ struct AxisReadme {
     tuser: u32,
     vectors: String,
     ports: Vec<(String, &'static str, u32, String)>,
-    /// (bus, its width, field, field bits, `[hi:lo]`).
-    slots: Vec<(&'static str, u32, &'static str, u32, String)>,
+    /// (bus, its width, field, field bits, `[hi:lo]`, the padding's `[hi:lo]` or `—`).
+    slots: Vec<(&'static str, u32, &'static str, u32, String, String)>,
 }
 
 impl AxisReadme {
@@ -85,11 +85,11 @@ impl AxisReadme {
         ] {
             for s in &p.slots {
                 let pad = match s.pad() {
-                    Some((h, l)) if h == l => format!(", [{h}] 0"),
-                    Some((h, l)) => format!(", [{h}:{l}] 0"),
-                    None => String::new(),
+                    Some((h, l)) if h == l => format!("[{h}]"),
+                    Some((h, l)) => format!("[{h}:{l}]"),
+                    None => "—".into(),
                 };
-                slots.push((bus, p.bits, s.field, s.bits, format!("{}{pad}", s.range())));
+                slots.push((bus, p.bits, s.field, s.bits, s.range(), pad));
             }
         }
         Some(AxisReadme {

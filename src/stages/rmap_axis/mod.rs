@@ -391,6 +391,31 @@ mod tests {
     }
 
     #[test]
+    fn the_readme_prints_the_packing_only_with_axis() {
+        let cfg = axis(true, 3);
+        let text = crate::rtl::package::readme(&cfg).unwrap();
+        assert!(text.contains("## AXI4-Stream"), "{text}");
+        for (bus, p) in [
+            ("s_axis_tdata", packing(&cfg, field::Dir::In)),
+            ("m_axis_tdata", packing(&cfg, field::Dir::Out)),
+        ] {
+            for s in &p.slots {
+                let row = format!(
+                    "| `{bus}` ({} bits) | `{}` | {} | {} |",
+                    p.bits,
+                    s.field,
+                    s.bits,
+                    s.range()
+                );
+                assert!(text.contains(&row), "{row}");
+            }
+        }
+        assert!(text.contains("| `s_axis_tuser` | in | 3 |"));
+        let plain = crate::rtl::package::readme(&Config::default()).unwrap();
+        assert!(!plain.contains("AXI4-Stream ports"));
+    }
+
+    #[test]
     fn the_design_top_is_the_wrapper_with_axis() {
         let cfg = axis(false, 2);
         assert_eq!(super::super::top(&cfg).name(), "rmap_axis");
