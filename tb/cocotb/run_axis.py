@@ -16,6 +16,7 @@ Exit 0 when every run did what it should, 1 otherwise; the last line is `N passe
 
 import argparse
 import json
+import re
 import shutil
 import sys
 import time
@@ -88,13 +89,18 @@ def main():
             if text.count(old) != 1:
                 sys.exit(f"run_axis: plant {name}: `{old}` is not in {f} exactly once")
             f.write_text(text.replace(old, new))
-        passed = run(d, build / (name or "clean") / "sim", a.limit, env)
+        sim = build / (name or "clean") / "sim"
+        passed = run(d, sim, a.limit, env)
         want = name is None
         what = f"cocotb {'clean' if want else 'planted ' + name}"
-        verdict = "passed" if passed else "failed"
+        # The test's own verdict line (samples), when it got that far.
+        log = sim / "test.log"
+        counts = [l for l in (log.read_text().splitlines() if log.exists() else [])
+                  if re.fullmatch(r"\d+ passed, \d+ failed", l)]
+        verdict = ("passed" if passed else "failed") + (f": {counts[-1]}" if counts else "")
         good = passed == want
         print(f"run_axis: {what}: the test {verdict}{'' if good else ' (WRONG)'} "
-              f"({time.time() - t0:.1f} s; log {build / (name or 'clean') / 'sim' / 'test.log'})",
+              f"({time.time() - t0:.1f} s; log {log})",
               flush=True)
         ok += good
         bad += not good
