@@ -255,7 +255,10 @@ fn manifest_agrees_with_the_files_and_the_latency_function() {
         assert_eq!(m["top"], listed[0], "{name}");
         if cfg.axis {
             assert_eq!(listed[..2], ["rmap_axis", "rmap_top"], "{name}");
-            assert!(m["axis"]["s_tdata"]["bits"].as_u64().unwrap() % 8 == 0, "{name}");
+            assert!(
+                m["axis"]["s_tdata"]["bits"].as_u64().unwrap() % 8 == 0,
+                "{name}"
+            );
         } else {
             assert_eq!(listed[0], "rmap_top");
             assert!(m.get("axis").is_none(), "{name}");
