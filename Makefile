@@ -36,9 +36,10 @@ roms: build
 
 # Everything: cargo tests (model, golden rtl_out/, vectors, CLI errors, sampled stress), Verilator
 # lint, Yosys synthesis, and every testbench in Icarus and Verilator plus the 1M-vector harness.
-# Also the handshake design's top testbench under random backpressure (sim-handshake) and
-# the default design placed and routed (fpga-check: block RAMs and the Fmax target, ~20 s).
-test: tools cargo-test lint synth sim-all sim-handshake fpga-check
+# Also the handshake design's top testbench under random backpressure (sim-handshake), the
+# AXI4-Stream top under cocotb (axis-test: makes the venv first) and the default design
+# placed and routed (fpga-check: block RAMs and the Fmax target, ~20 s).
+test: tools cargo-test lint synth sim-all sim-handshake axis-test fpga-check
 	@echo "make test: all checks passed"
 
 # ---- Simulation (rmapgen sim, src/sim/): every testbench of the design generated with
@@ -107,6 +108,34 @@ HS_OUT ?= build/rtl_handshake
 sim-handshake: build
 	$(RMAPGEN) generate --out $(HS_OUT) --handshake $(GEN_FLAGS)
 	$(SIM) --icarus --verilator --only rmap_top --stream $(SIM_STREAM) --tb-stream $(SIM_TB_STREAM) $(HS_OUT)
+
+# ---- Python venv (scripts/install-venv.sh): $(VENV) (gitignored) with the pinned PyPI
+# packages below; rebuilt only when the pins change. A fresh machine gets it from make test.
+PYTHON  ?= python3
+VENV    ?= .venv
+PY_PINS  = cocotb==2.1.0 cocotbext-axi==0.1.28
+
+.PHONY: venv
+
+venv:
+	@PYTHON=$(PYTHON) scripts/install-venv.sh $(VENV) $(PY_PINS)
+
+# ---- AXI4-Stream (--axis): the colour design with the handshake, AXI4-Stream ports and a
+# $(AXIS_USER)-bit tuser into $(AXIS_OUT); the cocotb test (tb/cocotb/test_axis.py: the
+# cocotbext-axi source and sink, random pauses and backpressure) compares every result of the
+# top's vector file exactly, tuser and tlast included, in Icarus; then each planted fault of
+# tb/cocotb/run_axis.py must make it fail. Builds and logs in $(AXIS_BUILD). About 15 s.
+AXIS_OUT   ?= build/rtl_axis
+AXIS_BUILD ?= build/axis
+AXIS_USER  ?= 3
+AXIS_PLANTS = expected skid-side skid-drop skid-dup
+
+.PHONY: axis-test
+
+axis-test: build venv
+	$(RMAPGEN) generate --out $(AXIS_OUT) --handshake --axis --axis-user $(AXIS_USER) --color $(GEN_FLAGS)
+	$(VENV)/bin/python tb/cocotb/run_axis.py $(AXIS_OUT) --build $(AXIS_BUILD)
+	$(VENV)/bin/python tb/cocotb/run_axis.py $(AXIS_OUT) --build $(AXIS_BUILD) $(addprefix --plant ,$(AXIS_PLANTS))
 
 # ---- FPGA (src/rtl/fpga.rs): Yosys synth_ice40 and nextpnr-ice40 on the default design built
 # for the iCE40 (--target ice40; rtl_out/ is the portable --target generic): post-route Fmax,

@@ -48,6 +48,18 @@ pub struct Config {
     /// JSON when empty, so a design without one is written as before it existed.
     #[serde(skip_serializing_if = "String::is_empty")]
     pub prefix: String,
+    /// AXI4-Stream ports: the design's top becomes `rmap_axis` (src/stages/rmap_axis), which
+    /// wraps the handshake top in `s_axis_*` / `m_axis_*` ports with byte-aligned `tdata`
+    /// ([`crate::stages::rmap_axis::Packing`]) and passes `tlast` (and `tuser`, when
+    /// [`Config::axis_user`] > 0) through with each sample. Needs `handshake` (refused
+    /// without it, not implied: the configuration says what is built). Left out of the TOML
+    /// and JSON when off, so a design without it is written as before it existed.
+    #[serde(skip_serializing_if = "is_false")]
+    pub axis: bool,
+    /// Width of `tuser` with [`Config::axis`] (0: no `tuser` ports; range [`AXIS_USER_MAX`]);
+    /// 0 when `axis` is off. Left out of the TOML and JSON when 0.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub axis_user: u32,
     /// The tools the memories are written for: [`Target`]. Left out of the TOML and JSON when
     /// `generic` (the default).
     #[serde(skip_serializing_if = "Target::is_generic")]
@@ -92,6 +104,17 @@ impl Target {
         *self == Target::Ice40
     }
 }
+
+fn is_false(b: &bool) -> bool {
+    !*b
+}
+
+fn is_zero(v: &u32) -> bool {
+    *v == 0
+}
+
+/// Widest `tuser` of [`Config::axis_user`].
+pub const AXIS_USER_MAX: u32 = 64;
 
 /// Longest [`Config::prefix`].
 pub const PREFIX_MAX_LEN: usize = 32;
@@ -173,10 +196,13 @@ impl ConfigError {
     }
 }
 
-/// The allowed range of a width field from [`RANGES`], or of `pipeline_depth`.
+/// The allowed range of a width field from [`RANGES`], or of `pipeline_depth` or `axis_user`.
 pub fn range_of(field: &str) -> Option<(u32, u32)> {
     if field == "pipeline_depth" {
         return Some(PIPELINE_DEPTHS);
+    }
+    if field == "axis_user" {
+        return Some((0, AXIS_USER_MAX));
     }
     RANGES
         .iter()
@@ -204,6 +230,8 @@ impl Default for Config {
             pipeline_depth: 2,
             handshake: false,
             prefix: String::new(),
+            axis: false,
+            axis_user: 0,
             target: Target::Generic,
         }
     }
@@ -268,6 +296,23 @@ impl Config {
                 "recip_bits = {} must be at least frac_bits + 1 = {} so the normalised fraction keeps its precision",
                 self.recip_bits,
                 self.frac_bits + 1
+            ));
+        }
+        if self.axis_user > AXIS_USER_MAX {
+            return Err(ConfigError::OutOfRange {
+                field: "axis_user",
+                value: self.axis_user,
+                min: 0,
+                max: AXIS_USER_MAX,
+            });
+        }
+        if self.axis && !self.handshake {
+            return c(&["axis", "handshake"], "axis = true needs handshake = true (AXI4-Stream is a valid/ready interface); add --handshake".into());
+        }
+        if !self.axis && self.axis_user != 0 {
+            return c(&["axis_user", "axis"], format!(
+                "axis_user = {} without axis; tuser exists only on the AXI4-Stream ports (add --axis)",
+                self.axis_user
             ));
         }
         if self.interpolation && self.interp_bits == 0 {
@@ -427,6 +472,15 @@ impl Config {
     pub fn bank_total_bits(&self) -> u64 {
         self.bank_count() as u64 * self.bank_entries() as u64 * self.map_bits as u64
     }
+    /// Bits that travel through the top beside each sample with `axis`: `{tuser, tlast}`
+    /// (axis_user + 1); 0 without it (the top then has no `side_i` / `side_o`).
+    pub fn side_bits(&self) -> u32 {
+        if self.axis {
+            self.axis_user + 1
+        } else {
+            0
+        }
+    }
     pub fn frac_max(&self) -> u32 {
         (1 << self.frac_bits) - 1
     }
@@ -461,7 +515,11 @@ impl Config {
             self.color as u8,
             self.pipeline_depth,
             self.handshake as u8
-        )
+        ) + &if self.axis {
+            format!(" axis user={}", self.axis_user)
+        } else {
+            String::new()
+        }
     }
 }
 
@@ -553,5 +611,46 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("interpolation on"));
+    }
+
+    #[test]
+    fn axis_needs_the_handshake_and_tuser_needs_axis() {
+        let on = Config {
+            axis: true,
+            handshake: true,
+            axis_user: 8,
+            ..Config::default()
+        };
+        on.validate().unwrap();
+        assert_eq!(on.side_bits(), 9);
+        assert_eq!(Config::default().side_bits(), 0);
+        let e = Config {
+            handshake: false,
+            ..on.clone()
+        }
+        .validate()
+        .unwrap_err();
+        assert_eq!(e.fields(), ["axis", "handshake"]);
+        assert!(e.to_string().contains("needs handshake"), "{e}");
+        let e = Config {
+            axis: false,
+            ..on.clone()
+        }
+        .validate()
+        .unwrap_err();
+        assert_eq!(e.fields(), ["axis_user", "axis"]);
+        let e = Config {
+            axis_user: AXIS_USER_MAX + 1,
+            ..on
+        }
+        .validate()
+        .unwrap_err();
+        assert!(e.to_string().contains("axis_user = 65"), "{e}");
+    }
+
+    #[test]
+    fn axis_off_leaves_the_toml_as_it_was() {
+        let t = toml::to_string(&Config::default()).unwrap();
+        assert!(!t.contains("axis"), "{t}");
     }
 }

@@ -8,7 +8,7 @@
 //! both ends of its range (recip_bits at its smallest legal value, frac_bits + 1), each of the
 //! eight combinations of compensation, interpolation and colour, every pipeline depth, and the
 //! handshake on and off, both memory targets, mixed so that the ends meet each other and the
-//! optional stages.
+//! optional stages, and the AXI4-Stream top.
 
 use crate::config::{Config, Target, RANGES};
 
@@ -30,7 +30,7 @@ macro_rules! grid {
     ($( $name:ident: $g:literal $r:literal $w:literal $f:literal $i:literal $p:literal $m:literal
         $comp:literal $interp:literal $color:literal $depth:literal $hs:literal $icarus:literal
         $ice40:literal
-        $covers:literal; )*) => {
+        $(axis $user:literal)? $covers:literal; )*) => {
         /// Every row, in the order below.
         pub fn rows() -> Vec<GridRow> {
             vec![$(GridRow {
@@ -42,6 +42,8 @@ macro_rules! grid {
                     pipeline_depth: $depth, handshake: $hs == 1,
                     prefix: String::new(),
                     target: if $ice40 == 1 { Target::Ice40 } else { Target::Generic },
+                    axis: false $(|| { let _: u32 = $user; true })?,
+                    axis_user: 0 $(+ $user)?,
                 },
                 icarus: $icarus == 1,
                 covers: $covers,
@@ -52,7 +54,7 @@ macro_rules! grid {
 
 // G grad, R reduced, W reciprocal entry, F fraction, I index, P interpolation fraction, M map
 // entry bits; comp(ensation), interp(olation), color, pipeline depth, handshake, run in Icarus,
-// --target ice40 (else generic).
+// --target ice40 (else generic); `axis U`: the AXI4-Stream top rmap_axis with a U-bit tuser.
 grid! {
 //                  G  R  W  F  I  P  M  comp interp color depth hs icarus ice40
     paper:          12 8  10 8  3  3  8  1    1      0     2     0  1  0
@@ -105,6 +107,8 @@ grid! {
         "the narrowest map entries, nearest entry";
     index6_nearest: 14 10 12 10 6  0  10 0    0      0     1     1  0  0
         "the largest map without interpolation (the widest bank address), under backpressure";
+    axis_color:     12 8  10 8  3  3  8  1    1      1     2     1  1  0  axis 3
+        "the AXI4-Stream top (rmap_axis: byte-padded tdata, 3-bit tuser, tlast) around the handshake top with colour";
 }
 
 /// The row called `name`.

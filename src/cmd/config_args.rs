@@ -49,6 +49,12 @@ pub struct ConfigArgs {
     /// [default: generic].
     #[arg(long, value_enum, value_name = "T")]
     pub target: Option<crate::config::Target>,
+    /// AXI4-Stream ports (s_axis_*, m_axis_*; byte-aligned tdata, tlast passed through with
+    /// each sample): the top becomes rmap_axis around the handshake top. Needs --handshake.
+    #[arg(long)]
+    pub axis: bool,
+    #[arg(long, value_name = "BITS", value_parser = parse::field("axis_user"), help = parse::field_help("axis_user", "tuser width passed through with each sample (0: no tuser)", ", needs --axis"))]
+    pub axis_user: Option<u32>,
 }
 
 impl ConfigArgs {
@@ -74,11 +80,15 @@ impl ConfigArgs {
         if cfg.pipeline_depth != d.pipeline_depth {
             f.extend(["--pipeline-depth".into(), cfg.pipeline_depth.to_string()]);
         }
+        if cfg.axis_user != d.axis_user {
+            f.extend(["--axis-user".into(), cfg.axis_user.to_string()]);
+        }
         for (on, flag) in [
             (!cfg.compensation, "--no-compensation"),
             (!cfg.interpolation, "--no-interpolation"),
             (cfg.color, "--color"),
             (cfg.handshake, "--handshake"),
+            (cfg.axis, "--axis"),
         ] {
             if on {
                 f.push(flag.into());
@@ -123,7 +133,8 @@ impl ConfigArgs {
             frac_bits,
             index_bits,
             map_bits,
-            pipeline_depth
+            pipeline_depth,
+            axis_user
         );
         if self.no_compensation {
             c.compensation = false;
@@ -147,6 +158,10 @@ impl ConfigArgs {
         if self.handshake {
             c.handshake = true;
             flags.push(("handshake", "--handshake".into()));
+        }
+        if self.axis {
+            c.axis = true;
+            flags.push(("axis", "--axis".into()));
         }
         if let Some(p) = &self.prefix {
             c.prefix = p.clone();

@@ -91,6 +91,7 @@ pub fn field_help(name: &str, what: &str, note: &str) -> String {
     let d = crate::config::Config::default();
     let default = match name {
         "pipeline_depth" => d.pipeline_depth,
+        "axis_user" => d.axis_user,
         _ => d.field(name),
     };
     format!("{what} [{min}..={max}{note}, default {default}]")

@@ -4,9 +4,10 @@
 
 use super::ports;
 use crate::config::Config;
+use crate::stages;
+use crate::stages::rmap_axis::AxisInfo;
 use crate::stages::rmap_top::{self, SidebandDelays};
 pub use crate::stages::unit::Memory;
-use crate::stages::{self, TOP};
 use serde::Serialize;
 
 pub const FILE: &str = "manifest.json";
@@ -16,7 +17,8 @@ pub struct Manifest {
     pub rmapgen_version: &'static str,
     pub config: Config,
     pub config_summary: String,
-    /// The top's module name (with the configuration's prefix, as every name here).
+    /// The design's top module ([`stages::top`]: rmap_axis with `axis`, else rmap_top), with
+    /// the configuration's prefix, as every name here.
     pub top: String,
     /// Clock cycles from accepting a sample to its result at the top's outputs.
     pub latency: u32,
@@ -27,6 +29,9 @@ pub struct Manifest {
     pub memory_bits: u64,
     /// Every file of the directory written by the design generator, in writing order.
     pub files: Vec<String>,
+    /// The AXI4-Stream `tdata` layouts and `tuser` width (`axis` only; absent without it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub axis: Option<AxisInfo>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -41,9 +46,9 @@ pub struct ModuleInfo {
     pub ports: Vec<ports::Port>,
 }
 
-/// The memory arrays of a configuration, named below rmap_top.
+/// The memory arrays of a configuration, named below the design's top ([`stages::top`]).
 pub fn memories(cfg: &Config) -> Vec<Memory> {
-    TOP.memories(cfg)
+    stages::top(cfg).memories(cfg)
 }
 
 impl Manifest {
@@ -68,13 +73,14 @@ impl Manifest {
             rmapgen_version: env!("CARGO_PKG_VERSION"),
             config: cfg.clone(),
             config_summary: cfg.summary(),
-            top: TOP.module(cfg),
+            top: stages::top(cfg).module(cfg),
             latency: rmap_top::top_latency(cfg),
             sideband_delays: rmap_top::sideband_delays(cfg),
             modules,
             memory_bits: memories.iter().map(|m| m.bits).sum(),
             memories,
             files,
+            axis: AxisInfo::new(cfg),
         }
     }
 

@@ -17,7 +17,7 @@ use crate::stages::map_bank::MapBank;
 use crate::stages::rmap_top::{latency_list, top_latency};
 use crate::stages::testbench::TbFile;
 use crate::stages::unit::{file_params, FileParam};
-use crate::stages::{self, Unit, TOP};
+use crate::stages::{self, rmap_axis, Unit, TOP};
 use anyhow::{Context, Result};
 use askama::Template;
 
@@ -35,7 +35,10 @@ struct Core {
     summary: String,
     vlnv: String,
     core_file: String,
+    /// The design's top ([`stages::top`]).
     top: String,
+    /// The top testbench's module (`<rmap_top module>_tb`).
+    tb_top: String,
     tb_file: String,
     vector_file: String,
     latency: u32,
@@ -95,6 +98,52 @@ struct Readme {
     record_bytes: usize,
     c_array: String,
     c_count: String,
+    /// The `## AXI4-Stream` section (`axis` only).
+    axis: Option<AxisReadme>,
+}
+
+/// What the README's `## AXI4-Stream` section prints: the wrapper's ports and the `tdata`
+/// layouts, from [`rmap_axis`].
+struct AxisReadme {
+    top: String,
+    tuser: u32,
+    vectors: String,
+    ports: Vec<(String, &'static str, u32, String)>,
+    /// (bus, its width, field, field bits, `[hi:lo]`, the padding's `[hi:lo]` or `—`).
+    slots: Vec<(&'static str, u32, &'static str, u32, String, String)>,
+}
+
+impl AxisReadme {
+    fn new(cfg: &Config) -> Option<AxisReadme> {
+        let info = rmap_axis::AxisInfo::new(cfg)?;
+        let mut slots = Vec::new();
+        for (bus, p) in [
+            ("s_axis_tdata", &info.s_tdata),
+            ("m_axis_tdata", &info.m_tdata),
+        ] {
+            for s in &p.slots {
+                let pad = match s.pad() {
+                    Some((h, l)) if h == l => format!("[{h}]"),
+                    Some((h, l)) => format!("[{h}:{l}]"),
+                    None => "—".into(),
+                };
+                slots.push((bus, p.bits, s.field, s.bits, s.range(), pad));
+            }
+        }
+        Some(AxisReadme {
+            top: rmap_axis::RmapAxis.module(cfg),
+            tuser: info.tuser_bits,
+            vectors: info.vectors,
+            ports: rmap_axis::port_rows(cfg)
+                .into_iter()
+                .map(|(n, d, w, note)| {
+                    let text = describe(&n, note);
+                    (n, d, w, text)
+                })
+                .collect(),
+            slots,
+        })
+    }
 }
 
 /// The core's VLNV name, `rmapgen:ip:<top module>_<hash>:<version>`: the top's module name
@@ -137,7 +186,8 @@ pub fn core(cfg: &Config) -> Result<String> {
         summary: cfg.summary(),
         vlnv: vlnv(cfg),
         core_file: core_file(cfg),
-        top: TOP.module(cfg),
+        top: stages::top(cfg).module(cfg),
+        tb_top: format!("{}_tb", TOP.module(cfg)),
         tb_file: top.testbench_file(cfg),
         vector_file: top.vector_file(cfg),
         latency: top_latency(cfg),
@@ -278,6 +328,7 @@ pub fn readme(design: &Design) -> Result<String> {
         record_bytes: map_stream::RECORD_BYTES,
         c_array: map_stream::c_array(cfg),
         c_count: map_stream::c_count(cfg),
+        axis: AxisReadme::new(cfg),
     }
     .render()
     .context("cannot render templates/pkg/README.md")?;

@@ -12,6 +12,7 @@
 //! its output, and the other runs go on; [`Outcome::failed`] lists them.
 
 use crate::design_dir::DesignDir;
+use crate::stages::TOP;
 use crate::toolchain::{self, icarus, verilator, Ran};
 use crate::vectors::{self, MapSet};
 use anyhow::{Context, Result};
@@ -143,7 +144,10 @@ pub fn run(
     opts: &Options,
     say: &mut dyn FnMut(&str),
 ) -> Result<Outcome> {
-    let top_tb = format!("{}_tb", design.top);
+    // The shading pipeline's top (inside rmap_axis with `axis`): its testbench takes the
+    // long stream and the C++ harness drives it.
+    let top = TOP.module(&design.config);
+    let top_tb = format!("{top}_tb");
     let tbs = match &opts.only {
         Some(m) if design.testbench(m).is_file() => vec![format!("{m}_tb")],
         Some(m) => anyhow::bail!(
@@ -225,7 +229,7 @@ pub fn run(
         std::fs::write(&harness, HARNESS)
             .with_context(|| format!("cannot write {}", harness.display()))?;
         let mut build_cmd = verilator::harness(
-            &design.top,
+            &top,
             &sdir,
             "top_stream",
             &design.files(),

@@ -6,7 +6,8 @@
 //!
 //! | folder | module | instantiated by | has vectors and a testbench |
 //! |---|---|---|---|
-//! | `rmap_top` | the top | — | yes |
+//! | `rmap_axis` | the AXI4-Stream top (`axis`) | — | — (the cocotb test, tb/cocotb/) |
+//! | `rmap_top` | the top (the shading pipeline; inside rmap_axis with `axis`) | rmap_axis | yes |
 //! | `zero_detect` | zero detect | rmap_top | yes |
 //! | `sort_shift` | sort & shift | rmap_top | yes |
 //! | `normalise` | normalise | rmap_top | yes |
@@ -33,6 +34,7 @@ pub mod normalise;
 pub mod pipe_delay;
 pub mod position;
 pub mod recip_rom;
+pub mod rmap_axis;
 pub mod rmap_top;
 pub mod sort_shift;
 pub mod testbench;
@@ -42,8 +44,19 @@ pub mod zero_detect;
 use crate::config::Config;
 pub use unit::{Head, Memory, Unit, Vectors};
 
-/// The top of every design.
+/// The top of the shading pipeline, with the top-level vectors and testbench; the design's
+/// top too, except with `axis` ([`top`]).
 pub const TOP: &dyn Unit = &rmap_top::RmapTop;
+
+/// The design's outermost module: [`rmap_axis::RmapAxis`] (which instantiates [`TOP`]) with
+/// `axis`, else [`TOP`]. The manifest's `top`, lint, synthesis and the FPGA flow start here.
+pub fn top(cfg: &Config) -> &'static dyn Unit {
+    if cfg.axis {
+        &rmap_axis::RmapAxis
+    } else {
+        TOP
+    }
+}
 
 /// The modules of a configuration in instantiation order: the top, then what it instantiates
 /// in the order its file does, each child right after its parent and each module once.
@@ -59,13 +72,13 @@ pub fn modules(cfg: &Config) -> Vec<&'static dyn Unit> {
         }
     }
     let mut out = Vec::new();
-    walk(cfg, TOP, &mut out);
+    walk(cfg, top(cfg), &mut out);
     out
 }
 
 /// The module that instantiates each module of [`modules`], by name (None for the top).
 pub fn parents(cfg: &Config) -> Vec<(&'static str, Option<&'static str>)> {
-    let mut v = vec![(TOP.name(), None)];
+    let mut v = vec![(top(cfg).name(), None)];
     for m in modules(cfg) {
         for c in m.children(cfg) {
             if !v.iter().any(|(n, _)| *n == c.name()) {

@@ -431,6 +431,43 @@ fn a_bad_prefix_is_refused_by_every_command() {
     assert!(!o.exists());
 }
 
+/// Issue 14 §4: AXI4-Stream needs the handshake (refused, not implied) and tuser needs
+/// AXI4-Stream, from flags or from the file; one line, exit 2, nothing written.
+#[test]
+fn axis_without_the_handshake_is_refused() {
+    let t = tempdir();
+    let o = t.path().join("o");
+    let o_ = o.to_str().unwrap();
+    let c = t.path().join("c.toml");
+    std::fs::write(&c, "axis = true\n").unwrap();
+    let c_ = c.to_str().unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &["generate", "--axis", "--out", o_],
+            "axis = true needs handshake = true (AXI4-Stream is a valid/ready interface); add --handshake (axis from --axis, handshake by default)",
+        ),
+        (
+            &["generate", "--handshake", "--axis-user", "4", "--out", o_],
+            "axis_user = 4 without axis; tuser exists only on the AXI4-Stream ports (add --axis) (axis_user from --axis-user 4, axis by default)",
+        ),
+        (
+            &["generate", "--handshake", "--axis", "--axis-user", "65", "--out", o_],
+            "--axis-user must be in 0..=64, not 65",
+        ),
+        (
+            &["generate", "--config", c_, "--out", o_],
+            "axis = true needs handshake = true",
+        ),
+    ];
+    for (args, needle) in cases {
+        assert_error(&run(args), needle);
+    }
+    assert!(!o.exists());
+    let ok = run(&["generate", "--config", c_, "--handshake", "--out", o_]);
+    assert_eq!(ok.status.code(), Some(0), "{}", stderr(&ok));
+    assert!(o.join("rmap_axis.v").is_file());
+}
+
 #[test]
 fn a_directory_is_not_a_toml_file() {
     let t = tempdir();

@@ -39,7 +39,7 @@ tests! {
     paper, paper_depth0, paper_depth1, paper_hs, color, no_comp, no_interp, bare, no_comp_color,
     no_interp_color, bare_color, narrowest, narrowest_bare, widest, widest_depth0, grad16_red6,
     grad8_red8, no_truncation, frac4_recip20, frac12_recip13, index6_interp1, index2_interp5,
-    map12, map6_nearest, index6_nearest,
+    map12, map6_nearest, index6_nearest, axis_color,
 }
 
 #[test]
@@ -180,4 +180,5 @@ fn grid_covers_every_range_end_and_switch() {
     assert!(ic.iter().any(|r| r.config.color) && ic.iter().any(|r| !r.config.compensation));
     assert!(ic.iter().any(|r| r.config.handshake) && ic.iter().any(|r| !r.config.interpolation));
     assert!(ic.iter().any(|r| r.config.target == Target::Ice40));
+    assert!(ic.iter().any(|r| r.config.axis && r.config.axis_user > 0));
 }

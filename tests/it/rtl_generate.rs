@@ -250,7 +250,19 @@ fn manifest_agrees_with_the_files_and_the_latency_function() {
             .collect();
         let expected: Vec<&str> = stages::modules(&cfg).iter().map(|m| m.name()).collect();
         assert_eq!(listed, expected, "{name}");
-        assert_eq!(listed[0], "rmap_top");
+        // The design's top: the AXI4-Stream wrapper with `axis`, which instantiates rmap_top.
+        assert_eq!(listed[0], stages::top(&cfg).name(), "{name}");
+        assert_eq!(m["top"], listed[0], "{name}");
+        if cfg.axis {
+            assert_eq!(listed[..2], ["rmap_axis", "rmap_top"], "{name}");
+            assert!(
+                m["axis"]["s_tdata"]["bits"].as_u64().unwrap() % 8 == 0,
+                "{name}"
+            );
+        } else {
+            assert_eq!(listed[0], "rmap_top");
+            assert!(m.get("axis").is_none(), "{name}");
+        }
         // Exactly the listed modules have files.
         let mut files: Vec<String> = listed.iter().map(|n| format!("{n}.v")).collect();
         files.sort();

@@ -94,6 +94,9 @@ struct Verilog {
     zero_delay: u32,
     rgb_delay: u32,
     i_delay: u32,
+    /// Width of side_i / side_o (0: absent).
+    sd: u32,
+    side_delay: u32,
 }
 
 /// `sort_shift 4, normalise 6, ...`: each stage of [`pipeline`] with its latency.
@@ -148,6 +151,13 @@ impl Unit for RmapTop {
             "{s_max, s_u, i_u, s_v, i_v}",
         ));
         v.push(i("wr_data_i", mb, ""));
+        if cfg.side_bits() > 0 {
+            v.push(i(
+                "side_i",
+                cfg.side_bits(),
+                "{tuser, tlast} of the sample (axis): leaves unchanged on side_o with its result",
+            ));
+        }
         if cfg.handshake {
             v.push(i(
                 "ready_i",
@@ -175,6 +185,9 @@ impl Unit for RmapTop {
             v.push(o("r_o", COLOR_BITS, "colour times intensity"));
             v.push(o("g_o", COLOR_BITS, ""));
             v.push(o("b_o", COLOR_BITS, ""));
+        }
+        if cfg.side_bits() > 0 {
+            v.push(o("side_o", cfg.side_bits(), "side_i of the sample"));
         }
         v
     }
@@ -237,6 +250,8 @@ impl Unit for RmapTop {
             zero_delay: d.zero,
             rgb_delay: d.rgb.unwrap_or(0),
             i_delay: d.intensity.unwrap_or(0),
+            sd: cfg.side_bits(),
+            side_delay: d.side.unwrap_or(0),
         }
         .render()
     }

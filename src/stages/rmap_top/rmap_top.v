@@ -3,7 +3,7 @@
 
 // Reflectance-map shader: gradient in, intensity out, one sample per clock.
 // zero_detect runs beside sort_shift -> normalise -> {= position =} -> map_lookup{% if interpolation %} -> interpolate{% endif %}{% if color %} -> color_mul{% endif %};
-// pipe_delay lines carry the sideband (signs, axis, buffer{% if color %}, colour{% endif %}, zero flag) beside the
+// pipe_delay lines carry the sideband (signs, axis, buffer{% if color %}, colour{% endif %}, zero flag{% if sd > 0 %}, side_i{% endif %}) beside the
 // stages, and one output register applies the zero flag.
 // Stage latencies: {= latency_list =}, output register 1: total {= total =}.
 {%- if handshake %}
@@ -32,6 +32,9 @@ module {= h.module =}{= h.params =} (
 {%- if color %}
   localparam C   = {= c =};  // colour channel width
 {%- endif %}
+{%- if sd > 0 %}
+  localparam SD  = {= sd =};  // side_i width: {tuser, tlast} of the AXI4-Stream top
+{%- endif %}
 
   // Sideband delays, from rmapgen::stages::rmap_top (the stage latencies above).
   localparam SIGN_DELAY = {= sign_delay =};  // sort_shift out to map_lookup in
@@ -40,6 +43,9 @@ module {= h.module =}{= h.params =} (
 {%- if color %}
   localparam RGB_DELAY  = {= rgb_delay =};  // accept to color_mul in
   localparam I_DELAY    = {= i_delay =};  // intensity beside color_mul
+{%- endif %}
+{%- if sd > 0 %}
+  localparam SIDE_DELAY = {= side_delay =};  // accept to the output register
 {%- endif %}
 
 {%- if handshake %}
@@ -289,6 +295,22 @@ module {= h.module =}{= h.params =} (
     .d_i   (zd_zero),
     .q_o   (out_zero)
   );
+{%- if sd > 0 %}
+
+  // The sample's side_i beside the whole pipeline, on the same clock enable, so it reaches
+  // the output register with its result.
+  wire [SD-1:0] out_side;
+
+  {= mods.pipe_delay =} #(
+    .WIDTH (SD),
+    .DEPTH (SIDE_DELAY)
+  ) u_side_delay (
+    .clk_i (clk_i),
+    .en_i  (en),
+    .d_i   (side_i),
+    .q_o   (out_side)
+  );
+{%- endif %}
 
 {%- if handshake %}
   // ---------------------------------------------------------------- flow control
@@ -311,12 +333,19 @@ module {= h.module =}{= h.params =} (
   assign g_in = out_zero ? {C{1'b0}} : out_g;
   assign b_in = out_zero ? {C{1'b0}} : out_b;
 {%- endif %}
+{%- if sd > 0 %}
+  wire [SD-1:0] side_in;
+  assign side_in = out_side;
+{%- endif %}
 
   reg         valid_q, skid_valid_q, en_q;
   reg         zero_q, skid_zero_q;
   reg [M-1:0] i_q, skid_i_q;
 {%- if color %}
   reg [C-1:0] r_q, g_q, b_q, skid_r_q, skid_g_q, skid_b_q;
+{%- endif %}
+{%- if sd > 0 %}
+  reg [SD-1:0] side_q, skid_side_q;
 {%- endif %}
   wire        skid_valid_d;
   assign skid_valid_d = take ? (skid_valid_q && push) : (skid_valid_q || push);
@@ -345,6 +374,9 @@ module {= h.module =}{= h.params =} (
       g_q    <= skid_valid_q ? skid_g_q : g_in;
       b_q    <= skid_valid_q ? skid_b_q : b_in;
 {%- endif %}
+{%- if sd > 0 %}
+      side_q <= skid_valid_q ? skid_side_q : side_in;
+{%- endif %}
     end
     if (push && (skid_valid_q || !take)) begin
       // The new result waits behind the head.
@@ -354,6 +386,9 @@ module {= h.module =}{= h.params =} (
       skid_r_q    <= r_in;
       skid_g_q    <= g_in;
       skid_b_q    <= b_in;
+{%- endif %}
+{%- if sd > 0 %}
+      skid_side_q <= side_in;
 {%- endif %}
     end
   end
@@ -394,6 +429,9 @@ module {= h.module =}{= h.params =} (
   assign r_o     = r_q;
   assign g_o     = g_q;
   assign b_o     = b_q;
+{%- endif %}
+{%- if sd > 0 %}
+  assign side_o  = side_q;
 {%- endif %}
 
 endmodule
