@@ -396,7 +396,8 @@ mod tests {
     #[test]
     fn the_readme_prints_the_packing_only_with_axis() {
         let cfg = axis(true, 3);
-        let text = crate::rtl::package::readme(&cfg).unwrap();
+        let text =
+            crate::rtl::package::readme(&crate::design::Design::standard(&cfg).unwrap()).unwrap();
         assert!(text.contains("## AXI4-Stream"), "{text}");
         for (bus, p) in [
             ("s_axis_tdata", packing(&cfg, field::Dir::In)),
@@ -414,7 +415,10 @@ mod tests {
             }
         }
         assert!(text.contains("| `s_axis_tuser` | in | 3 |"));
-        let plain = crate::rtl::package::readme(&Config::default()).unwrap();
+        let plain = crate::rtl::package::readme(
+            &crate::design::Design::standard(&Config::default()).unwrap(),
+        )
+        .unwrap();
         assert!(!plain.contains("AXI4-Stream ports"));
     }
 
