@@ -561,4 +561,22 @@ fn bad_input_is_one_line_and_exit_2_with_nothing_written() {
     let o = helpers::run(&["sim", "--icarus", "--build", b, d]);
     helpers::assert_error(&o, "it holds mine.txt, which rmapgen did not write");
     assert_eq!(helpers::entries(&build.join("d")), ["mine.txt"]);
+    // Yosys's iCE40 cell models not where YOSYS_DATDIR says: one line naming the place tried.
+    if !require("yosys") {
+        return;
+    }
+    let other = t.join("other_build");
+    let o = helpers::rmapgen()
+        .args(["sim", "--gate", "--build", s(&other), d])
+        .env("YOSYS_DATDIR", &missing)
+        .output()
+        .unwrap();
+    helpers::assert_error(
+        &o,
+        &format!(
+            "cannot find Yosys's iCE40 cell models (ice40/cells_sim.v): not at {}/ice40/cells_sim.v; set YOSYS_DATDIR",
+            s(&missing)
+        ),
+    );
+    assert!(!other.exists());
 }
