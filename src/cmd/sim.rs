@@ -1,5 +1,6 @@
 //! `rmapgen sim`: the self-checking testbenches of a generated design under Icarus Verilog
-//! and/or Verilator, and the Verilator C++ harness on a long random stream of top vectors
+//! and/or Verilator, the Verilator C++ harness on a long random stream of top vectors, and
+//! (`--gate`) the top's testbench on the Yosys `synth_ice40` netlist in Icarus
 //! ([`crate::sim`]); with `--matrix`, every configuration of the parameter grid
 //! ([`crate::grid`]) generated and simulated in turn.
 //!
@@ -47,6 +48,21 @@ pub struct SimArgs {
     /// GTKWave.
     #[arg(long, requires = "icarus")]
     pub vcd: bool,
+    /// Gate-level sign-off: synthesise the top with Yosys synth_ice40 (the flow of `rmapgen
+    /// fpga`), and run the top's testbench on the netlist (write_verilog) with Yosys's iCE40
+    /// cell models in Icarus, on its vectors and the --tb-stream; the netlist and logs go to
+    /// BUILD/<name>/gate.
+    #[arg(long)]
+    pub gate: bool,
+    /// With --gate: simulate this netlist instead of synthesising DIR (a write_verilog of
+    /// synth_ice40 for DIR's top, such as rmap_top_netlist.v in the logs of `rmapgen fpga`).
+    #[arg(
+        long,
+        value_name = "FILE",
+        requires = "gate",
+        conflicts_with = "matrix"
+    )]
+    pub netlist: Option<PathBuf>,
     /// Build products and logs go to BUILD/<name of the design directory> (replaced whole,
     /// also when a simulation fails, so its logs can be read).
     #[arg(long, value_name = "BUILD", default_value = "build/sim")]
@@ -71,6 +87,8 @@ impl SimArgs {
             tb_stream: self.tb_stream,
             only: self.only.clone(),
             vcd: self.vcd,
+            gate: self.gate,
+            netlist: self.netlist.as_deref().map(absolute),
         }
     }
 }
@@ -78,7 +96,7 @@ impl SimArgs {
 pub fn run(a: &SimArgs) -> Result<ExitCode> {
     let opts = a.options();
     if !opts.runs_something() {
-        bail!("nothing to run: give --icarus, --verilator or --stream N");
+        bail!("nothing to run: give --icarus, --verilator, --gate or --stream N");
     }
     // Bad input first, then the tools, then the runs.
     let failed = if a.matrix {
@@ -92,6 +110,9 @@ pub fn run(a: &SimArgs) -> Result<ExitCode> {
             .expect("clap requires DIR without --matrix");
         let design = DesignDir::open(dir)?;
         check_only(&design, &opts)?;
+        if let Some(n) = &a.netlist {
+            anyhow::ensure!(n.is_file(), "--netlist {}: no such file", n.display());
+        }
         need_tools(&opts)?;
         !simulate(&design, a, &opts)?.failed.is_empty()
     };
@@ -103,13 +124,16 @@ pub fn run(a: &SimArgs) -> Result<ExitCode> {
 }
 
 fn need_tools(opts: &Options) -> Result<()> {
-    match opts.missing_tools().first() {
-        Some(tool) => bail!("{tool} not found (make tools installs it)"),
-        None => Ok(()),
+    if let Some(tool) = opts.missing_tools().first() {
+        bail!("{tool} not found (make tools installs it)");
     }
+    if opts.gate {
+        crate::toolchain::yosys::ice40_cell_models()?;
+    }
+    Ok(())
 }
 
-/// `--only MODULE` names a testbench of the design.
+/// `--only MODULE` names a testbench of the design, and the top's with `--gate`.
 fn check_only(design: &DesignDir, opts: &Options) -> Result<()> {
     if let Some(m) = opts.only.as_deref() {
         anyhow::ensure!(
@@ -117,6 +141,11 @@ fn check_only(design: &DesignDir, opts: &Options) -> Result<()> {
             "--only {m}: no testbench {} in {}",
             design.testbench(m).display(),
             design.path().display()
+        );
+        anyhow::ensure!(
+            !opts.gate || m == design.top,
+            "--only {m}: --gate simulates the top's netlist; give --only {} or leave it out",
+            design.top
         );
     }
     Ok(())

@@ -1,6 +1,16 @@
 //! Runs the self-checking testbenches of a generated design under Icarus Verilog and
-//! Verilator, and the Verilator C++ harness `tb/top_stream.cpp` on a long random stream of
-//! top vectors (`rmapgen sim`, the Makefile's sim targets).
+//! Verilator, the Verilator C++ harness `tb/top_stream.cpp` on a long random stream of
+//! top vectors, and the top's testbench on the gate-level netlist of Yosys `synth_ice40`
+//! (`rmapgen sim`, the Makefile's sim targets and gate-sim).
+//!
+//! The gate-level run (`--gate`) synthesises the top as `rmapgen fpga` does
+//! ([`yosys::synth_ice40`], one flat netlist of iCE40 cells, written with `write_verilog
+//! -noattr`) and compiles the top's testbench, unchanged, with that netlist and Yosys's iCE40
+//! cell models in place of the design files ([`icarus::compile_gate`]). The testbench reaches
+//! the design through its ports only, so it runs on the flat netlist as on the RTL. It is
+//! the check that synthesis kept the behaviour: the block RAMs' contents taken from the
+//! `$readmemh` files at synthesis, their read and write ports, the reset and the flip-flops'
+//! start.
 //!
 //! Simulations run in the build directory, never in the design directory: every file a
 //! testbench or the design reads is passed as an absolute path (the testbench's file
@@ -13,7 +23,7 @@
 
 use crate::design_dir::DesignDir;
 use crate::stages::TOP;
-use crate::toolchain::{self, icarus, verilator, Ran};
+use crate::toolchain::{self, icarus, verilator, yosys, Ran};
 use crate::vectors::{self, MapSet};
 use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
@@ -45,19 +55,27 @@ pub struct Options {
     pub only: Option<String>,
     /// A VCD of each Icarus testbench run, into the build directory.
     pub vcd: bool,
+    /// The top's testbench on the gate-level netlist in Icarus (and on the `tb_stream`).
+    pub gate: bool,
+    /// With `gate`: simulate this netlist (a `write_verilog` of `synth_ice40`) instead of
+    /// synthesising the design.
+    pub netlist: Option<PathBuf>,
 }
 
 impl Options {
     /// Whether anything would run.
     pub fn runs_something(&self) -> bool {
-        self.icarus || self.verilator || self.stream > 0
+        self.icarus || self.verilator || self.gate || self.stream > 0
     }
 
     /// The programs the runs need that cannot be found, by name.
     pub fn missing_tools(&self) -> Vec<String> {
         let mut need = Vec::new();
-        if self.icarus {
+        if self.icarus || self.gate {
             need.extend([icarus::iverilog(), icarus::vvp()]);
+        }
+        if self.gate && self.netlist.is_none() {
+            need.push(yosys::yosys());
         }
         if self.verilator || self.stream > 0 {
             need.push(verilator::verilator());
@@ -69,7 +87,7 @@ impl Options {
     /// Bytes of the vector streams written into the build directory for `design`.
     pub fn stream_bytes(&self, design: &DesignDir) -> u64 {
         let cfg = &design.config;
-        let tb = if self.icarus || self.verilator {
+        let tb = if self.icarus || self.verilator || self.gate {
             self.tb_stream
         } else {
             0
@@ -164,7 +182,7 @@ pub fn run(
         say,
         outcome: Outcome::default(),
     };
-    let simulating = opts.icarus || opts.verilator;
+    let simulating = opts.icarus || opts.verilator || opts.gate;
     let tb_stream = if opts.tb_stream > 0 && simulating && tbs.contains(&top_tb) {
         Some(r.stream(opts.tb_stream, "tb_stream.hex")?)
     } else {
@@ -221,6 +239,9 @@ pub fn run(
                 }
             }
         }
+    }
+    if opts.gate {
+        r.gate(opts.netlist.as_deref(), tb_stream.as_deref())?;
     }
     if opts.stream > 0 {
         let sdir = r.dir("verilator/top_stream")?;
@@ -302,6 +323,66 @@ impl Runner<'_> {
             self.say(&format!("  | {l}"));
         }
         self.outcome.failed.push(name.to_string());
+    }
+
+    /// The gate-level run: `netlist`, else the design synthesised with `synth_ice40` into
+    /// `gate/`, compiled with the top's testbench and the iCE40 cell models, run on the top's
+    /// vectors and on `stream` when given.
+    fn gate(&mut self, netlist: Option<&Path>, stream: Option<&Path>) -> Result<()> {
+        let design = self.design;
+        let dir = self.dir("gate")?;
+        let m = format!("{}_tb", design.top);
+        let cells = yosys::ice40_cell_models()?;
+        let netlist = match netlist {
+            Some(n) => n.to_path_buf(),
+            None => {
+                let name = "gate yosys synth_ice40";
+                let t0 = std::time::Instant::now();
+                match yosys::synth_ice40(design.path(), &design.top, design.file_names(), &dir) {
+                    Ok(st) => self.say(&format!(
+                        "ok:   {name}: {} cells ({} SB_LUT4, {} SB_CARRY, {} flip-flops, {} SB_RAM40_4K) in {:.1} s",
+                        st.cells,
+                        st.luts,
+                        st.carries,
+                        st.flip_flops,
+                        st.block_rams,
+                        t0.elapsed().as_secs_f64()
+                    )),
+                    Err(e) => {
+                        let why = self.show(&format!("{e:#}"));
+                        self.say(&format!("FAIL: {name}: {why}"));
+                        let log = self.show(&dir.join(yosys::LOG).display().to_string());
+                        self.say(&format!("  log: {log}"));
+                        self.outcome.failed.push(name.to_string());
+                        return Ok(());
+                    }
+                }
+                yosys::netlist(&dir, &design.top)
+            }
+        };
+        let shown = self.show(&netlist.display().to_string());
+        self.say(&format!("  netlist: {shown}"));
+        let tb = design.testbench(&design.top);
+        let vvp = dir.join(format!("{m}.vvp"));
+        // The testbench's files by absolute path, as for the RTL runs; the netlist itself
+        // holds the memories' contents.
+        let (strings, vectors) = design.testbench_files(&m)?;
+        let mut compile = icarus::compile_gate(&m, &vvp, &tb, &netlist, &cells, &strings);
+        let log = dir.join(format!("{m}.compile.log"));
+        let Some(ran) = self.step(&format!("gate {m} (compile)"), &mut compile, &log)? else {
+            return Ok(());
+        };
+        for l in ran.output.lines() {
+            self.say(&format!("  iverilog: {l}"));
+        }
+        let run = icarus::simulate(&dir, &vvp, &[format!("+vectors={}", vectors.display())]);
+        self.simulation(&format!("gate {m}"), run, &dir.join(format!("{m}.log")))?;
+        if let Some(s) = stream {
+            let run = icarus::simulate(&dir, &vvp, &[format!("+vectors={}", s.display())]);
+            let log = dir.join(format!("{m}.stream.log"));
+            self.simulation(&format!("gate {m} (stream)"), run, &log)?;
+        }
+        Ok(())
     }
 
     /// A build step: its run if it succeeded, None (reported) if not.

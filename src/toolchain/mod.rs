@@ -14,7 +14,7 @@ pub mod verilator;
 pub mod yosys;
 
 use anyhow::{bail, Context, Result};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Stdio};
 use std::time::Instant;
 
@@ -44,12 +44,18 @@ pub fn verilog_string_ok(value: &str) -> bool {
 
 /// Whether `program` can be started: a path that is a file, or a name found on PATH.
 pub fn installed(program: &str) -> bool {
+    locate(program).is_some()
+}
+
+/// The file `program` starts: itself when it is a path to a file, else the first match on
+/// PATH.
+pub fn locate(program: &str) -> Option<PathBuf> {
     if program.contains('/') {
-        return Path::new(program).is_file();
+        return Some(PathBuf::from(program)).filter(|p| p.is_file());
     }
-    std::env::var_os("PATH")
-        .map(|p| std::env::split_paths(&p).any(|d| d.join(program).is_file()))
-        .unwrap_or(false)
+    std::env::split_paths(&std::env::var_os("PATH")?)
+        .map(|d| d.join(program))
+        .find(|p| p.is_file())
 }
 
 /// Parallel jobs for a tool's own build (Verilator's C++ compile): JOBS from the environment,

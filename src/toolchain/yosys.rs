@@ -1,8 +1,10 @@
 //! Yosys: `synth_ice40` for place and route ([`synth_ice40`]: what `rmapgen fpga`, bench and
-//! `fit --cost cells` measure) and the synthesis check of `rmapgen synth` ([`check`]: no
-//! latch, the memories inferred, the cells mapped for the iCE40 or to generic gates). Both run
-//! in the generated directory, so that `$readmemh` finds the hex files, and write their logs,
-//! statistics and netlist to a log directory, never into the design.
+//! `fit --cost cells` measure, and the netlist `rmapgen sim --gate` simulates) and the
+//! synthesis check of `rmapgen synth` ([`check`]: no latch, the memories inferred, the cells
+//! mapped for the iCE40 or to generic gates). Both run in the generated directory, so that
+//! `$readmemh` finds the hex files, and write their logs, statistics and netlist to a log
+//! directory, never into the design. [`ice40_cell_models`] finds the simulation models of the
+//! iCE40 cells that Yosys ships, for simulating its netlist.
 
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
@@ -43,18 +45,33 @@ pub struct Ice40Stat {
     pub carries: u32,
     /// SB_DFF* of every kind.
     pub flip_flops: u32,
+    /// SB_RAM40_4K block RAMs.
+    pub block_rams: u32,
+}
+
+/// The Verilog netlist [`synth_ice40`] writes into its log directory `logs` for `top`:
+/// `<top>_netlist.v`, a flat module `top` of iCE40 cells (SB_LUT4, SB_CARRY, SB_DFF*,
+/// SB_RAM40_4K with the memories' contents in its INIT_0..INIT_F parameters).
+pub fn netlist(logs: &Path, top: &str) -> PathBuf {
+    logs.join(format!("{top}_netlist.v"))
 }
 
 /// `synth_ice40 -top TOP` of `files` (names in `dir`) for place and route: the netlist
-/// `LOGS/<top>.json`, `yosys.log` and the statistics `yosys_stat.txt` go to `logs`. The flow
-/// `rmapgen fpga`, bench and `fit --cost cells` measure (figures in README.md come from it).
+/// `LOGS/<top>.json` for nextpnr and the same netlist as Verilog ([`netlist`], `write_verilog
+/// -noattr`: no source attributes, so it is a third of the size and simulators read only
+/// cells), `yosys.log` and the statistics `yosys_stat.txt` go to `logs`. The flow `rmapgen
+/// fpga`, bench and `fit --cost cells` measure (figures in README.md come from it), and the
+/// netlist `rmapgen sim --gate` simulates: the one that is placed and routed, from the same
+/// run. Writing the Verilog costs no measurable time beside the synthesis (8 s for the default
+/// design).
 pub fn synth_ice40(dir: &Path, top: &str, files: &[String], logs: &Path) -> Result<Ice40Stat> {
     let json = logs.join(format!("{top}.json"));
     let stat = logs.join("yosys_stat.txt");
     let script = format!(
-        "read_verilog {}; synth_ice40 -top {top} -json {}; tee -q -o {} stat",
+        "read_verilog {}; synth_ice40 -top {top} -json {}; write_verilog -noattr {}; tee -q -o {} stat",
         files.join(" "),
         json.display(),
+        netlist(logs, top).display(),
         stat.display()
     );
     let ran = super::capture(&mut command(dir, logs, &script))?;
@@ -77,7 +94,52 @@ pub fn synth_ice40(dir: &Path, top: &str, files: &[String], logs: &Path) -> Resu
             .filter(|(t, _)| t.starts_with("SB_DFF"))
             .map(|c| c.1)
             .sum(),
+        block_rams: last_count(&counts, |t| t == "SB_RAM40_4K"),
     })
+}
+
+/// The file of Yosys's simulation models of the iCE40 cells, relative to its data directory.
+pub const ICE40_CELL_MODELS: &str = "ice40/cells_sim.v";
+
+/// Yosys's simulation models of the iCE40 cells (`<datdir>/ice40/cells_sim.v`), what a
+/// simulator needs beside a [`netlist`]. The data directory is YOSYS_DATDIR when set, else what
+/// `yosys-config --datdir` prints (Debian ships `yosys-config` only in yosys-dev), else
+/// `../share/yosys` beside the Yosys program (YOSYS, else `yosys` on PATH, links followed),
+/// where Yosys itself looks for it. An error names the places tried.
+pub fn ice40_cell_models() -> Result<PathBuf> {
+    let mut tried = Vec::new();
+    let env = std::env::var_os("YOSYS_DATDIR").filter(|v| !v.is_empty());
+    let config = || {
+        Command::new("yosys-config")
+            .arg("--datdir")
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| PathBuf::from(String::from_utf8_lossy(&o.stdout).trim()))
+    };
+    let beside = || {
+        let exe = super::locate(&yosys())?.canonicalize().ok()?;
+        Some(exe.parent()?.parent()?.join("share/yosys"))
+    };
+    let candidates: Vec<PathBuf> = match env {
+        Some(d) => vec![PathBuf::from(d)],
+        None => config().into_iter().chain(beside()).collect(),
+    };
+    for d in candidates {
+        let f = d.join(ICE40_CELL_MODELS);
+        if f.is_file() {
+            return Ok(f);
+        }
+        tried.push(f.display().to_string());
+    }
+    bail!(
+        "cannot find Yosys's iCE40 cell models ({ICE40_CELL_MODELS}){}; set YOSYS_DATDIR to Yosys's data directory (yosys-config --datdir)",
+        if tried.is_empty() {
+            " (no yosys-config, no yosys on PATH)".to_string()
+        } else {
+            format!(": not at {}", tried.join(", "))
+        }
+    )
 }
 
 /// What [`check`] maps the design to after its checks.

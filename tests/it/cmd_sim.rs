@@ -150,6 +150,138 @@ fn sim_passes_every_testbench_under_icarus_and_fails_on_a_planted_rom_fault() {
     assert_eq!(o.status.code(), Some(0), "{:?}", text(&o));
 }
 
+/// The netlist `text` (Yosys `write_verilog` of `synth_ice40`) with one bit of one block
+/// RAM's contents complemented: the most significant bit of map bank 00's entry 0 (buffer 0,
+/// axis x, every sign and index 0), the entry a gradient along +x reads with all the weight.
+/// The bit is found from the cell's own wiring, as Yosys mapped it: the RDATA bit that drives
+/// `rd_data_q[M-1]` (M = map_bits), in word 0 of INIT_0 (read and write mode 1 keep the entry
+/// of an even address in the even bits of a 16-bit word).
+fn flip_bank_entry_msb(text: &str, map_bits: u32) -> String {
+    let name = text
+        .find(") \\u_map_lookup.u_bank_00.mem.")
+        .expect("a block RAM of bank 00 in the netlist");
+    let start = text[..name].rfind("SB_RAM40_4K #(").expect("its cell");
+    let end = name + text[name..].find(");").expect("the end of its cell");
+    let cell = &text[start..end];
+    let rdata = cell
+        .split(".RDATA({ ")
+        .nth(1)
+        .expect("RDATA wired bit by bit");
+    let rdata = &rdata[..rdata.find(" })").unwrap()];
+    let bits: Vec<&str> = rdata.split(", ").collect();
+    assert_eq!(bits.len(), 16, "{rdata}");
+    let msb = format!("rd_data_q [{}]", map_bits - 1);
+    let bit = 15 - bits.iter().position(|b| b.ends_with(&msb)).expect(&msb);
+    let init = cell.find(".INIT_0(256'h").expect("INIT_0 in hex") + ".INIT_0(256'h".len();
+    // Word 0 is the last four hex digits of the 256-bit parameter.
+    let at = start + init + 64 - 1 - bit / 4;
+    let digit = u32::from_str_radix(&text[at..=at], 16).expect("a hex digit");
+    let flipped = format!("{:x}", digit ^ (1 << (bit % 4)));
+    let mut out = text.to_string();
+    out.replace_range(at..=at, &flipped);
+    out
+}
+
+#[test]
+fn gate_level_sim_passes_the_netlist_and_fails_on_a_flipped_block_ram_bit_or_a_stale_netlist() {
+    if !require("iverilog") || !require("vvp") || !require("yosys") {
+        return;
+    }
+    // A small design (2 index bits: one block RAM per map bank) and few random vectors:
+    // about 10 s of synthesis and 3 s of gate-level simulation a run.
+    let tmp = helpers::tempdir();
+    let dir = tmp.path().join("d");
+    hdl::generate(&dir, &["--index-bits", "2"], 50);
+    let build = tmp.path().join("build");
+    let o = helpers::run(&[
+        "sim",
+        "--icarus",
+        "--only",
+        "rmap_top",
+        "--gate",
+        "--tb-stream",
+        "100",
+        "--build",
+        s(&build),
+        s(&dir),
+    ]);
+    let (out, err) = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{out}{err}");
+    let cfg = hdl::config_of(&dir);
+    let n = hdl::vector_count(&dir, "rmap_top");
+    let stream = rmapgen::vectors::top_stream_lines(&cfg, 100);
+    for want in [
+        format!("ok:   icarus rmap_top_tb: {n} passed, 0 failed ("),
+        "ok:   gate yosys synth_ice40: ".to_string(),
+        format!("ok:   gate rmap_top_tb: {n} passed, 0 failed ("),
+        format!("ok:   gate rmap_top_tb (stream): {stream} passed, 0 failed ("),
+    ] {
+        assert!(out.contains(&want), "{want:?} in {out}");
+    }
+    assert!(out.contains(" SB_RAM40_4K) in "), "{out}");
+    let gate = build.join("d/gate");
+    let netlist = gate.join("rmap_top_netlist.v");
+    let text_of = |p: &Path| std::fs::read_to_string(p).unwrap();
+    let good = text_of(&netlist);
+    // The testbench ran on the netlist, not on the design's files: one flat module of cells.
+    assert!(good.contains("module rmap_top(") && !good.contains("module map_bank"));
+    assert!(text_of(&gate.join("rmap_top_tb.log")).ends_with(" passed, 0 failed\n"));
+
+    // One bit of one block RAM's contents flipped in the netlist: the RTL cannot see it, the
+    // gate-level run fails and names the vector that read it.
+    let bad = tmp.path().join("flipped.v");
+    std::fs::write(&bad, flip_bank_entry_msb(&good, cfg.map_bits)).unwrap();
+    let diff = good
+        .bytes()
+        .zip(text_of(&bad).bytes())
+        .filter(|(a, b)| a != b)
+        .count();
+    assert_eq!(diff, 1, "one hex digit changed");
+    let args = |netlist: &Path, dir: &Path| {
+        let (n, d) = (s(netlist).to_string(), s(dir).to_string());
+        let b = s(&build).to_string();
+        helpers::run(&["sim", "--gate", "--netlist", &n, "--build", &b, &d])
+    };
+    let o = args(&bad, &dir);
+    let (out, err) = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{out}{err}");
+    assert!(
+        out.contains("FAIL: gate rmap_top_tb (exit 1, last line: "),
+        "{out}"
+    );
+    assert!(out.contains("  | MISMATCH line "), "{out}");
+    assert!(
+        out.contains(&format!(
+            "  netlist: {}\n",
+            bad.canonicalize().unwrap().display()
+        )),
+        "{out}"
+    );
+    let canonical = dir.canonicalize().unwrap();
+    assert!(
+        out.ends_with(&format!(
+            "sim: 1 FAILED in {}:\n  gate rmap_top_tb\n",
+            canonical.display()
+        )),
+        "{out}"
+    );
+    // The intact netlist passes the same command: the flipped bit is what failed it.
+    let kept = tmp.path().join("good.v");
+    std::fs::write(&kept, &good).unwrap();
+    let o = args(&kept, &dir);
+    assert_eq!(o.status.code(), Some(0), "{:?}", text(&o));
+
+    // A stale netlist: the same configuration regenerated with another scene's maps (the
+    // $readmemh files the RTL reads change; the netlist holds the old contents).
+    let other = tmp.path().join("other");
+    let scene = helpers::root().join("scenes/diffuse.toml");
+    hdl::generate(&other, &["--index-bits", "2", "--scene", s(&scene)], 50);
+    let o = args(&kept, &other);
+    let (out, err) = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{out}{err}");
+    assert!(out.contains("  | MISMATCH line "), "{out}");
+}
+
 #[test]
 fn sim_runs_verilator_and_the_cpp_harness_and_the_harness_catches_a_fault() {
     if !require("verilator") {
@@ -376,7 +508,7 @@ fn bad_input_is_one_line_and_exit_2_with_nothing_written() {
         ),
         (
             vec!["sim", "--build", b, d],
-            "nothing to run: give --icarus, --verilator or --stream N".into(),
+            "nothing to run: give --icarus, --verilator, --gate or --stream N".into(),
         ),
         (
             vec!["sim", "--icarus", "--only", "nope", "--build", b, d],
@@ -400,6 +532,18 @@ fn bad_input_is_one_line_and_exit_2_with_nothing_written() {
         ),
         (vec!["sim", "--icarus", "--build", b], "DIR".into()),
         (
+            vec!["sim", "--gate", "--only", "normalise", "--build", b, d],
+            "--only normalise: --gate simulates the top's netlist; give --only rmap_top".into(),
+        ),
+        (
+            vec!["sim", "--gate", "--netlist", s(&missing), "--build", b, d],
+            format!("--netlist {}: no such file", s(&missing)),
+        ),
+        (
+            vec!["sim", "--icarus", "--netlist", s(&file), "--build", b, d],
+            "--gate".into(),
+        ),
+        (
             vec!["synth", s(&missing), "--logs", b],
             "No such file".into(),
         ),
@@ -421,4 +565,22 @@ fn bad_input_is_one_line_and_exit_2_with_nothing_written() {
     let o = helpers::run(&["sim", "--icarus", "--build", b, d]);
     helpers::assert_error(&o, "it holds mine.txt, which rmapgen did not write");
     assert_eq!(helpers::entries(&build.join("d")), ["mine.txt"]);
+    // Yosys's iCE40 cell models not where YOSYS_DATDIR says: one line naming the place tried.
+    if !require("yosys") {
+        return;
+    }
+    let other = t.join("other_build");
+    let o = helpers::rmapgen()
+        .args(["sim", "--gate", "--build", s(&other), d])
+        .env("YOSYS_DATDIR", &missing)
+        .output()
+        .unwrap();
+    helpers::assert_error(
+        &o,
+        &format!(
+            "cannot find Yosys's iCE40 cell models (ice40/cells_sim.v): not at {}/ice40/cells_sim.v; set YOSYS_DATDIR",
+            s(&missing)
+        ),
+    );
+    assert!(!other.exists());
 }
