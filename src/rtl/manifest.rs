@@ -95,14 +95,19 @@ mod tests {
 
     #[test]
     fn memory_bits_add_up() {
+        // Generic (the default): recip 128 x 10, one atan ROM 256 x 6, four banks 1024 x 8.
         let cfg = Config::default();
         let m = Manifest::new(&cfg, vec![]);
-        // recip 128 x 10, two atan copies 256 x 6, four banks of 1024 x 8.
+        assert_eq!(m.memory_bits, 1280 + 1536 + 4 * 8192);
+        assert_eq!(m.memory_bits, cfg.rom_total_bits() + cfg.bank_total_bits());
+        assert_eq!(m.latency, 24);
+        // iCE40: the atan ROM twice, one copy per read port.
+        let ice40 = cfg.for_target(crate::config::Target::Ice40);
+        let m = Manifest::new(&ice40, vec![]);
         assert_eq!(m.memory_bits, 1280 + 2 * 1536 + 4 * 8192);
         assert_eq!(
             m.memory_bits,
             cfg.rom_total_bits() + 1536 + cfg.bank_total_bits()
         );
-        assert_eq!(m.latency, 24);
     }
 }
