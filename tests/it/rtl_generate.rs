@@ -66,7 +66,7 @@ fn committed_golden_designs_are_what_their_configs_generate() {
         .iter()
         .map(|d| d.file_name().unwrap().to_string_lossy().into_owned())
         .collect();
-    assert_eq!(names, ["color", "handshake", "no_interpolation"]);
+    assert_eq!(names, ["color", "handshake", "ice40", "no_interpolation"]);
     let t = helpers::tempdir();
     for dir in &dirs {
         let fresh = t.path().join(dir.file_name().unwrap());

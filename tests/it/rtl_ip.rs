@@ -233,7 +233,9 @@ fn fpga_fails_on_a_memory_in_logic_and_on_a_design_too_big() {
     // The narrow configuration's ROMs are small enough that Yosys would build them from LUTs
     // without the ram_style attribute.
     let dir = tmp.path().join("d");
-    hdl::generate(&dir, &hdl::strs(&hdl::narrowest_flags()), 1);
+    let mut flags = hdl::narrowest_flags();
+    flags.extend(["--target".to_string(), "ice40".to_string()]);
+    hdl::generate(&dir, &hdl::strs(&flags), 1);
     sabotage(
         &dir,
         "recip_rom.v",
@@ -244,6 +246,14 @@ fn fpga_fails_on_a_memory_in_logic_and_on_a_design_too_big() {
     helpers::assert_error(&o, "fell back to logic");
     helpers::assert_error(&o, "u_normalise.u_recip_rom.rom");
     assert!(!String::from_utf8_lossy(&o.stderr).contains("u_atan_rom"));
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("--target"));
+    // The same configuration generated for the portable default: its small ROMs are Yosys's
+    // to place, and when they land in logic the error says how to get block RAM.
+    let generic = tmp.path().join("g");
+    hdl::generate(&generic, &hdl::strs(&hdl::narrowest_flags()), 1);
+    let o = helpers::run(&["fpga", "--dir", generic.to_str().unwrap(), "--logs", l]);
+    helpers::assert_error(&o, "fell back to logic");
+    helpers::assert_error(&o, "generate it with --target ice40");
     // The default design needs about 1,700 logic cells; the HX1K has 1,280.
     let o = helpers::run(&[
         "fpga",
@@ -273,7 +283,9 @@ fn ice40_report_gives_a_missed_target_as_a_figure() {
         !r.timing_met && r.fmax_mhz > 50.0 && r.fmax_mhz < 500.0,
         "{r:?}"
     );
-    assert_eq!(r.memories.len(), rtl::manifest::memories(&cfg).len());
+    // The report is of the design built for the iCE40, whatever the configuration's target.
+    let ice40 = cfg.for_target(rmapgen::config::Target::Ice40);
+    assert_eq!(r.memories.len(), rtl::manifest::memories(&ice40).len());
     assert!(r.in_logic().is_empty());
     assert_eq!(
         r.block_rams,
