@@ -164,7 +164,11 @@ def prove(design, build, depth, bmc):
     (build / "sby.log").write_text(r.stdout + r.stderr)
     m = re.search(r"DONE \((\w+), rc=", r.stdout)
     status = m.group(1) if m else "ERROR"
-    failed = sorted(set(re.findall(r"failed assertion rmap_formal\.(\w+) at", r.stdout)))
+    # "failed assertion rmap_formal.a_order at rmap_formal.sv:151.7-151.50 step 14": the name,
+    # and for a bounded search the clock of the counterexample (trace in the sby directory).
+    failed = sorted({f"{m.group(1)}" + (f" at step {m.group(2)}" if m.group(2) else "")
+                     for m in re.finditer(r"failed assertion rmap_formal\.(\w+) at \S+(?: step (\d+))?",
+                                          r.stdout)})
     return status, failed, secs, p
 
 
@@ -209,7 +213,7 @@ def main():
         else:
             want = PLANTS[name][2]
             want = want if isinstance(want, tuple) else (want,)
-            good = status == "FAIL" and any(w in failed for w in want)
+            good = status == "FAIL" and any(f.split()[0] in want for f in failed)
             what = (f"plant {name}: {status} (bmc from reset), failed "
                     f"{', '.join(failed) or 'nothing'}"
                     f" ({'caught' if good else 'expected ' + ' or '.join(want) + ' to fail'})")
