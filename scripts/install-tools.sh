@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the simulators and synthesis tools from Debian's packages when any is missing;
-# WITH_FPGA=1 also nextpnr-ice40 and fpga-icestorm (place and route, make fpga).
+# WITH_FPGA=1 also nextpnr-ice40 and fpga-icestorm (place and route, make fpga); WITH_FORMAL=1
+# also z3 (the SMT solver of make formal's SymbiYosys runs).
 # Fails loudly (exit 1) when it cannot: the tests must never skip a simulator silently.
 set -euo pipefail
 need=()
@@ -11,6 +12,9 @@ done
 if [ "${WITH_FPGA:-0}" = 1 ]; then
   command -v nextpnr-ice40 >/dev/null 2>&1 || need+=(nextpnr-ice40)
   command -v icepack >/dev/null 2>&1 || need+=(fpga-icestorm)
+fi
+if [ "${WITH_FORMAL:-0}" = 1 ]; then
+  command -v z3 >/dev/null 2>&1 || need+=(z3)
 fi
 if [ ${#need[@]} -eq 0 ]; then
   exit 0
@@ -27,6 +31,7 @@ DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${need[@]}" >/dev/n
   || { echo "install-tools: apt-get install ${need[*]} failed" >&2; exit 1; }
 check=(iverilog vvp verilator yosys)
 [ "${WITH_FPGA:-0}" = 1 ] && check+=(nextpnr-ice40 icepack)
+[ "${WITH_FORMAL:-0}" = 1 ] && check+=(z3)
 for t in "${check[@]}"; do
   command -v "$t" >/dev/null 2>&1 || { echo "install-tools: $t still missing after install" >&2; exit 1; }
 done

