@@ -277,7 +277,14 @@ fn gate_level_sim_passes_the_netlist_and_fails_on_a_flipped_block_ram_bit_or_a_s
     // $readmemh files the RTL reads change; the netlist holds the old contents).
     let other = tmp.path().join("other");
     let scene = helpers::root().join("scenes/diffuse.toml");
-    let flags = ["--index-bits", "2", "--target", "ice40", "--scene", s(&scene)];
+    let flags = [
+        "--index-bits",
+        "2",
+        "--target",
+        "ice40",
+        "--scene",
+        s(&scene),
+    ];
     hdl::generate(&other, &flags, 50);
     let o = args(&kept, &other);
     let (out, err) = text(&o);
