@@ -203,11 +203,10 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
         .filter_map(|x| x["file"].as_str().map(String::from))
         .collect();
     let top = m["top"].as_str().unwrap_or("rmap_top").to_string();
-    // Absent from the JSON when generic (the default).
-    let target = m["config"]["target"]
-        .as_str()
-        .unwrap_or("generic")
-        .to_string();
+    // The manifest's configuration, read as `Config` reads it (an absent target is generic).
+    let target = serde_json::from_value::<Config>(m["config"].clone())
+        .map(|c| c.target)
+        .unwrap_or_default();
     let mems: Vec<(String, u64)> = m["memories"]
         .as_array()
         .context("the manifest lists no memories")?
@@ -281,11 +280,12 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
         .map(|x| x.instance.as_str())
         .collect();
     if !lost.is_empty() {
-        let hint = if target == Target::Ice40.name() {
+        let hint = if target == Target::Ice40 {
             String::new()
         } else {
             format!(
-                "; the design was generated for --target {target}: generate it with --target ice40 for block-RAM attributes and one ROM copy per read port"
+                "; the design was generated for --target {}: generate it with --target ice40 for block-RAM attributes and one ROM copy per read port",
+                target.name()
             )
         };
         bail!(

@@ -92,7 +92,7 @@ impl Unit for AtanRom {
             param: file_param(self.name()),
             ice40: cfg.target.ice40(),
             rom_u: arrays(cfg)[0],
-            rom_v: arrays(cfg)[arrays(cfg).len() - 1],
+            rom_v: arrays(cfg).last().expect("at least one array"),
             pos: cfg.pos_bits(),
             entries: cfg.atan_entries(),
         }
