@@ -157,6 +157,32 @@ formal: build venv
 	$(VENV)/bin/python formal/run_formal.py $(FORMAL_OUT) --build $(FORMAL_BUILD)
 	$(VENV)/bin/python formal/run_formal.py $(FORMAL_OUT) --build $(FORMAL_BUILD) $(addprefix --plant ,$(FORMAL_PLANTS))
 
+# ---- Every input (rmapgen prove, src/prove/): the generated RTL of $(PROVE_DIR) equal to
+# its model on all 2^(3G) gradients (2^36 for the default design), factored by the pipeline's
+# structure (docs/VERIFICATION.md "Every input"), as $(PROVE_SHARDS) shards run side by side
+# (one per core), then merged into one verdict. A benchmark-style target, not in make test
+# (which proves a G = 8 design and every G = 8 grid row in cargo-test). Reports and logs in
+# $(PROVE_BUILD).
+PROVE_DIR    ?= $(OUT)
+PROVE_SHARDS ?= 2
+PROVE_BUILD  ?= build/prove
+
+.PHONY: prove
+
+prove: build
+	@mkdir -p $(PROVE_BUILD)
+	@start=$$(date +%s); pids=; \
+	for k in $$(seq 1 $(PROVE_SHARDS)); do \
+	  $(RMAPGEN) prove $(PROVE_DIR) --shard $$k/$(PROVE_SHARDS) --build $(PROVE_BUILD) \
+	    --report $(PROVE_BUILD)/shard-$$k-of-$(PROVE_SHARDS).json > $(PROVE_BUILD)/shard-$$k-of-$(PROVE_SHARDS).log 2>&1 & \
+	  pids="$$pids $$!"; \
+	done; \
+	status=0; for p in $$pids; do wait $$p || status=1; done; \
+	cat $(PROVE_BUILD)/shard-*-of-$(PROVE_SHARDS).log; \
+	$(RMAPGEN) prove --merge $$(seq -f "$(PROVE_BUILD)/shard-%g-of-$(PROVE_SHARDS).json" 1 $(PROVE_SHARDS)) || status=1; \
+	echo "make prove: $$(( $$(date +%s) - start )) s wall on $(PROVE_SHARDS) shards"; \
+	exit $$status
+
 # ---- FPGA (src/rtl/fpga.rs): Yosys synth_ice40 and nextpnr-ice40 on the default design built
 # for the iCE40 (--target ice40; rtl_out/ is the portable --target generic): post-route Fmax,
 # logic cells, block RAMs, critical path; fails if a ROM or map bank is not in block RAM (a

@@ -14,6 +14,7 @@ pub mod hexfile;
 pub mod map_stream;
 pub mod model;
 pub mod output;
+pub mod prove;
 pub mod reference;
 pub mod render;
 pub mod rng;

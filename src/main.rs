@@ -64,6 +64,13 @@ enum Command {
     Synth(cmd::synth::SynthArgs),
     /// Lint a generated design with Verilator --lint-only -Wall (exit 1 on any warning).
     Lint(cmd::lint::LintArgs),
+    /// Prove a generated design equal to its model on every gradient: its own netlist's
+    /// structure (Yosys), its front (zero detect, sort & shift) on all 2^(3 grad-bits)
+    /// gradients and its top on one gradient of every sort & shift state, in Verilator
+    /// (--direct: every gradient through the top); exit 1 if any input fails.
+    ///
+    /// --shard K/N runs one of N parts, --merge combines their reports into one verdict.
+    Prove(cmd::prove::ProveArgs),
 }
 
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
@@ -87,6 +94,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Sim(a) => cmd::sim::run(&a),
         Command::Synth(a) => cmd::synth::run(&a),
         Command::Lint(a) => cmd::lint::run(&a),
+        Command::Prove(a) => cmd::prove::run(&a),
     }
 }
 

@@ -99,3 +99,40 @@ pub fn harness(
         .arg(format!("-O2 -I{}", include.display()));
     c
 }
+
+/// The module `top` linked with the C++ `harness` (no `main`: it exports C functions) into
+/// the shared object `MDIR/LIB`, for a program to load: [`harness`]'s flags with `--prefix
+/// PREFIX`, every object compiled `-fPIC -O3` and linked `-shared`.
+#[allow(clippy::too_many_arguments)]
+pub fn shared(
+    top: &str,
+    prefix: &str,
+    mdir: &Path,
+    lib: &str,
+    files: &[PathBuf],
+    harness: &Path,
+    include: &Path,
+    strings: &[(String, String)],
+) -> Command {
+    let mut c = Command::new(verilator());
+    c.args(["--cc", "--exe", "--build", "-j", &super::jobs().to_string()])
+        .args([
+            "-O3",
+            "--x-assign",
+            "fast",
+            "--x-initial",
+            "fast",
+            "--noassert",
+        ])
+        .args(["--top-module", top, "--prefix", prefix])
+        .arg("--Mdir")
+        .arg(mdir)
+        .args(["-o", lib])
+        .args(strings.iter().map(|(n, v)| param(n, v)))
+        .args(files)
+        .arg(harness)
+        .arg("-CFLAGS")
+        .arg(format!("-fPIC -O3 -I{}", include.display()))
+        .args(["-LDFLAGS", "-shared"]);
+    c
+}

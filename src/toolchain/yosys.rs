@@ -287,6 +287,41 @@ fn last_count(counts: &[(String, u32)], is: impl Fn(&str) -> bool) -> u32 {
     counts.iter().rev().find(|(t, _)| is(t)).map_or(0, |c| c.1)
 }
 
+/// The netlists `rmapgen prove` reads the design's structure from, written by Yosys into
+/// `logs` from `files` (names in `dir`): `hier.json`, the top with its instances after
+/// `proc`, and `flat.json`, the whole design flattened, its memories as `proc` leaves them
+/// (`$memrd_v2` asynchronous reads, their data registers `$dff`s as the RTL writes them,
+/// `$memwr_v2` write ports), registers as `$dff`-family cells whose hold multiplexers became
+/// enables (`opt_dff`; `-nosdff`, so that no data multiplexer becomes a synchronous reset).
+/// No memory pass runs: `memory_dff` would fold the data registers into the reads and
+/// rewrite their enables as address multiplexers.
+pub fn structure(
+    dir: &Path,
+    top: &str,
+    files: &[String],
+    logs: &Path,
+) -> Result<(PathBuf, PathBuf)> {
+    std::fs::create_dir_all(logs)?;
+    let hier = logs.join("hier.json");
+    let flat = logs.join("flat.json");
+    let script = format!(
+        "read_verilog {}; hierarchy -check -top {top}; proc; opt_clean; write_json {}; \
+         flatten; opt_expr; opt_clean; opt_dff -nosdff; opt_clean; write_json {}",
+        files.join(" "),
+        super::quoted(&hier.to_string_lossy()),
+        super::quoted(&flat.to_string_lossy()),
+    );
+    let ran = super::run_logged(&mut command(dir, logs, &script), &logs.join("yosys.out"))?;
+    if !ran.success() {
+        bail!(
+            "Yosys could not read the design's structure ({}): {}",
+            ran.exit(),
+            super::complaint(&ran.output)
+        );
+    }
+    Ok((hier, flat))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

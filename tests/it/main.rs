@@ -21,6 +21,7 @@ mod map_stream;
 mod model_stages;
 mod output_safety;
 mod prefix;
+mod prove;
 mod render;
 mod rtl_generate;
 mod rtl_in_loop;

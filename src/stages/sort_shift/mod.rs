@@ -105,6 +105,13 @@ impl Unit for SortShift {
     }
 }
 
+/// The module's outputs for the model's result, in the order of the output fields
+/// ([`Vectors::fields`]); `rmapgen prove` packs them without allocating (src/prove/front.rs).
+#[inline]
+pub fn outputs(s: &model::SortShift) -> [u64; 7] {
+    [s.axis, s.s_max, s.s_u, s.s_v, s.m, s.a, s.b].map(u64::from)
+}
+
 impl Vectors for SortShift {
     fn fields(&self, cfg: &Config) -> Vec<Field> {
         let (g, r) = (cfg.grad_bits, cfg.red_bits);
@@ -137,10 +144,7 @@ impl Vectors for SortShift {
 
     fn expected(&self, model: &Model, _maps: &MapSet, inp: &[u64]) -> Vec<u64> {
         let g = |k: usize| dec_grad(&model.cfg, inp[k]);
-        let s = model::eval(&model.cfg, [g(0), g(1), g(2)]);
-        [s.axis, s.s_max, s.s_u, s.s_v, s.m, s.a, s.b]
-            .map(u64::from)
-            .to_vec()
+        outputs(&model::eval(&model.cfg, [g(0), g(1), g(2)])).to_vec()
     }
 
     fn testbench(&self, t: &TbData) -> askama::Result<String> {

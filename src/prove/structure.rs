@@ -1,0 +1,480 @@
+//! Part 1 of the proof: what the factoring assumes about the RTL, read from the design's own
+//! netlist (Yosys `proc`, then flattened with the memories kept as `$mem_v2` cells), not
+//! assumed:
+//!
+//! - **the gradient reaches only the front**: in the top, every connection of a gradient
+//!   input bit is an input of a module of [`super::front::FRONT`], and no output is one;
+//! - **one sample at a time**: in the flattened design, no loop passes through a signal the
+//!   sample inputs (gradient, colour, sideband) reach; no control input (a register's clock,
+//!   enable, reset or load; a memory's read enable, clock or reset; any write-port input)
+//!   depends on them; the control outputs (valid, ready) do not depend on them; every
+//!   register and memory read the samples reach moves on the same enable (or always); and every
+//!   path from a sample input to the output register's inputs (the top's `out_*` wires)
+//!   passes through exactly latency − 1 registers (a memory's synchronous read counts one).
+//!
+//! Together: each output register's input for a sample is a function of that sample's inputs
+//! alone, read through the front's outputs, whatever came before or after it and whatever
+//! the control did; which result leaves when is the handshake's business, proven by `make
+//! formal` and exercised by every testbench.
+
+use super::front::FRONT;
+use super::report::Part;
+use super::Failures;
+use crate::design_dir::DesignDir;
+use crate::stages::TOP;
+use crate::toolchain::yosys;
+use crate::vectors::field::Dir;
+use anyhow::{bail, Context, Result};
+use serde_json::Value;
+use std::collections::HashMap;
+use std::path::Path;
+
+/// A netlist bit: a signal number, or None for a constant.
+type Bit = Option<u64>;
+
+fn bits(v: &Value) -> Vec<Bit> {
+    v.as_array()
+        .map(|a| a.iter().map(Value::as_u64).collect())
+        .unwrap_or_default()
+}
+
+struct Cell {
+    name: String,
+    kind: String,
+    inputs: Vec<(String, Vec<Bit>)>,
+    outputs: Vec<(String, Vec<Bit>)>,
+    params: HashMap<String, String>,
+}
+
+struct Module {
+    ports: HashMap<String, (String, Vec<Bit>)>,
+    netnames: HashMap<String, Vec<Bit>>,
+    cells: Vec<Cell>,
+}
+
+fn module(json: &Value, name: &str) -> Result<Module> {
+    let m = &json["modules"][name];
+    if m.is_null() {
+        bail!("the netlist has no module {name}");
+    }
+    let ports = m["ports"]
+        .as_object()
+        .into_iter()
+        .flatten()
+        .map(|(k, p)| {
+            (
+                k.clone(),
+                (
+                    p["direction"].as_str().unwrap_or("").to_string(),
+                    bits(&p["bits"]),
+                ),
+            )
+        })
+        .collect();
+    let netnames = m["netnames"]
+        .as_object()
+        .into_iter()
+        .flatten()
+        .map(|(k, n)| (k.clone(), bits(&n["bits"])))
+        .collect();
+    let cells = m["cells"]
+        .as_object()
+        .into_iter()
+        .flatten()
+        .map(|(k, c)| {
+            let dirs = &c["port_directions"];
+            let mut inputs = Vec::new();
+            let mut outputs = Vec::new();
+            for (pin, b) in c["connections"].as_object().into_iter().flatten() {
+                let entry = (pin.clone(), bits(b));
+                if dirs[pin].as_str() == Some("output") {
+                    outputs.push(entry);
+                } else {
+                    inputs.push(entry);
+                }
+            }
+            let params = c["parameters"]
+                .as_object()
+                .into_iter()
+                .flatten()
+                .map(|(k, v)| (k.clone(), v.as_str().unwrap_or("").to_string()))
+                .collect();
+            Cell {
+                name: k.clone(),
+                kind: c["type"].as_str().unwrap_or("").to_string(),
+                inputs,
+                outputs,
+                params,
+            }
+        })
+        .collect();
+    Ok(Module {
+        ports,
+        netnames,
+        cells,
+    })
+}
+
+fn read(path: &Path) -> Result<Value> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    serde_json::from_str(&text).with_context(|| format!("{} is not JSON", path.display()))
+}
+
+fn is_register(kind: &str) -> bool {
+    kind.contains("dff") || kind.contains("dlatch") || kind == "$sr"
+}
+
+/// Cells whose output bit k reads only bit k of each data input (bit k of every word, for a
+/// parallel case multiplexer's B).
+fn bitwise(kind: &str) -> bool {
+    is_register(kind)
+        || matches!(
+            kind,
+            "$mux" | "$pmux" | "$and" | "$or" | "$xor" | "$xnor" | "$not" | "$pos" | "$bwmux"
+        )
+}
+
+fn is_memory(kind: &str) -> bool {
+    kind.starts_with("$mem")
+}
+
+/// How an input pin of a cell passes to its outputs: registered data (one register), a
+/// memory read address (one register for a synchronous read), combinational, or control.
+#[derive(Clone, Copy, PartialEq)]
+enum Pin {
+    Data(u32),
+    Control,
+}
+
+fn pin_class(cell: &Cell, pin: &str) -> Pin {
+    if is_register(&cell.kind) {
+        if pin == "D" {
+            Pin::Data(1)
+        } else {
+            Pin::Control
+        }
+    } else if is_memory(&cell.kind) {
+        // A read passes its address to its data (a clocked read through one register);
+        // every other memory pin, write ports' included, is control.
+        let read = cell.kind.starts_with("$memrd") && pin == "ADDR";
+        if read {
+            let sync = cell
+                .params
+                .get("CLK_ENABLE")
+                .is_some_and(|v| v.contains('1'));
+            Pin::Data(sync as u32)
+        } else {
+            Pin::Control
+        }
+    } else {
+        Pin::Data(0)
+    }
+}
+
+/// The sample inputs and data outputs of the top, as its vector fields name them.
+fn sample_ports(d: &DesignDir) -> (Vec<String>, Vec<String>) {
+    let cfg = &d.config;
+    let top = TOP.vectors().expect("the top has vectors");
+    let mut ins = Vec::new();
+    let mut outs = Vec::new();
+    for f in top.fields(cfg) {
+        if let Some(p) = top.port(&f) {
+            match f.dir {
+                Dir::In => ins.push(p),
+                Dir::Out => outs.push(p),
+            }
+        }
+    }
+    if cfg.side_bits() > 0 {
+        ins.push("side_i".into());
+        outs.push("side_o".into());
+    }
+    (ins, outs)
+}
+
+/// Checks the design in `d`; Yosys writes its netlists under `build/structure`.
+pub fn check(d: &DesignDir, build: &Path) -> Result<Part> {
+    let cfg = &d.config;
+    let top_name = TOP.module(cfg);
+    let logs = build.join("structure");
+    let mut files: Vec<String> = d.file_names().to_vec();
+    if cfg.axis {
+        // The proof is of rmap_top; the AXI4-Stream wrapper only renames its ports.
+        let axis = crate::stages::top(cfg).file(cfg);
+        files.retain(|f| *f != axis);
+    }
+    let (hier, flat) = yosys::structure(d.path(), &top_name, &files, &logs)?;
+    let mut fails = Failures::default();
+    let (sample_in, data_out) = sample_ports(d);
+
+    // The gradient reaches only the front.
+    let hier = read(&hier)?;
+    let top = module(&hier, &top_name)?;
+    let front: Vec<String> = FRONT.iter().map(|u| u.module(cfg)).collect();
+    let grad: Vec<u64> = ["gx_i", "gy_i", "gz_i"]
+        .iter()
+        .flat_map(|p| {
+            top.ports
+                .get(*p)
+                .map(|(_, b)| b.clone())
+                .unwrap_or_default()
+        })
+        .flatten()
+        .collect();
+    if grad.len() != 3 * cfg.grad_bits as usize {
+        fails.add(format!(
+            "structure: the top {top_name} has no {}-bit gradient ports",
+            cfg.grad_bits
+        ));
+    }
+    for c in &top.cells {
+        let reads = c
+            .inputs
+            .iter()
+            .chain(&c.outputs)
+            .any(|(_, b)| b.iter().flatten().any(|x| grad.contains(x)));
+        if reads && !front.contains(&c.kind) {
+            fails.add(format!(
+                "structure: {} ({}) in {top_name} reads the gradient; only {} may",
+                c.name,
+                c.kind,
+                front.join(" and ")
+            ));
+        }
+        for (pin, b) in &c.outputs {
+            if b.iter().flatten().any(|x| grad.contains(x)) {
+                fails.add(format!("structure: {}.{pin} drives the gradient", c.name));
+            }
+        }
+    }
+    for (name, (dir, b)) in &top.ports {
+        if dir == "output" && b.iter().flatten().any(|x| grad.contains(x)) {
+            fails.add(format!("structure: output {name} is wired to the gradient"));
+        }
+    }
+
+    // One sample at a time, in the flattened design.
+    let flat = read(&flat)?;
+    let m = module(&flat, &top_name)?;
+    let mut sources: Vec<u64> = Vec::new();
+    for p in &sample_in {
+        match m.ports.get(p) {
+            Some((_, b)) => sources.extend(b.iter().flatten()),
+            None => fails.add(format!("structure: the top has no sample input {p}")),
+        }
+    }
+    // Drivers: bit -> (cell, output pin, bit position).
+    let mut driver: HashMap<u64, (usize, usize)> = HashMap::new();
+    for (ci, c) in m.cells.iter().enumerate() {
+        for (pi, (_, b)) in c.outputs.iter().enumerate() {
+            for x in b.iter().flatten() {
+                driver.insert(*x, (ci, pi));
+            }
+        }
+    }
+    // Readers, for the forward reach: bit -> cells.
+    let mut readers: HashMap<u64, Vec<usize>> = HashMap::new();
+    for (ci, c) in m.cells.iter().enumerate() {
+        for (_, b) in &c.inputs {
+            for x in b.iter().flatten() {
+                readers.entry(*x).or_default().push(ci);
+            }
+        }
+    }
+    let mut reached: std::collections::HashSet<u64> = sources.iter().copied().collect();
+    let mut reached_cells = vec![false; m.cells.len()];
+    let mut stack: Vec<u64> = sources.clone();
+    while let Some(x) = stack.pop() {
+        for &ci in readers.get(&x).map(Vec::as_slice).unwrap_or(&[]) {
+            if !reached_cells[ci] {
+                reached_cells[ci] = true;
+                for (_, b) in &m.cells[ci].outputs {
+                    for y in b.iter().flatten() {
+                        if reached.insert(*y) {
+                            stack.push(*y);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    // No control input depends on the samples.
+    for c in &m.cells {
+        for (pin, b) in &c.inputs {
+            if pin_class(c, pin) == Pin::Control && b.iter().flatten().any(|x| reached.contains(x))
+            {
+                fails.add(format!(
+                    "structure: the sample data reach control input {pin} of {} ({})",
+                    c.name, c.kind
+                ));
+            }
+        }
+    }
+    let mut outs: Vec<(&String, &Vec<Bit>)> = m
+        .netnames
+        .iter()
+        .filter(|(n, _)| n.starts_with("out_") && *n != "out_valid")
+        .collect();
+    outs.sort();
+    // The cells in front of the output register: the backward cone of the out_* wires.
+    let mut cone = vec![false; m.cells.len()];
+    let mut stack: Vec<u64> = outs
+        .iter()
+        .flat_map(|(_, b)| b.iter().flatten().copied())
+        .collect();
+    let mut seen: std::collections::HashSet<u64> = stack.iter().copied().collect();
+    while let Some(x) = stack.pop() {
+        if let Some(&(ci, _)) = driver.get(&x) {
+            if !cone[ci] {
+                cone[ci] = true;
+                for (_, b) in &m.cells[ci].inputs {
+                    for y in b.iter().flatten() {
+                        if seen.insert(*y) {
+                            stack.push(*y);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    // Every register in front of the output register that the samples reach moves on one
+    // enable: a constant, or the same net for all (the pipeline's clock enable), so none
+    // holds a sample while the others move.
+    let mut enables: std::collections::BTreeMap<String, Vec<String>> = Default::default();
+    for (ci, c) in m.cells.iter().enumerate() {
+        // An asynchronous read is combinational; its data register is a register here.
+        let clocked_read = c.kind.starts_with("$memrd")
+            && c.params.get("CLK_ENABLE").is_some_and(|v| v.contains('1'));
+        if !reached_cells[ci] || !cone[ci] || !(is_register(&c.kind) || clocked_read) {
+            continue;
+        }
+        let pin = "EN";
+        let en = c
+            .inputs
+            .iter()
+            .find(|(p, _)| p == pin)
+            .map(|(_, b)| b.clone())
+            .unwrap_or_default();
+        let name = if en.iter().all(Option::is_none) {
+            "constant".to_string()
+        } else {
+            format!("{en:?}")
+        };
+        enables.entry(name).or_default().push(c.name.clone());
+    }
+    let moving: Vec<_> = enables.iter().collect();
+    if moving.len() > 1 {
+        let (odd, cells) = moving
+            .iter()
+            .min_by_key(|(_, c)| c.len())
+            .expect("more than one");
+        fails.add(format!(
+            "structure: the registers the samples reach move on {} different enables; {} on net {odd} ({} of them) apart from the rest",
+            moving.len(),
+            cells[0],
+            cells.len()
+        ));
+    }
+    for (name, (dir, b)) in &m.ports {
+        if dir == "output"
+            && !data_out.contains(name)
+            && b.iter().flatten().any(|x| reached.contains(x))
+        {
+            fails.add(format!(
+                "structure: control output {name} depends on the sample data"
+            ));
+        }
+    }
+    // Register depths from the sample inputs, over the reached part (a DAG, or a loop is
+    // reported).
+    let mut depth: HashMap<u64, u128> = sources.iter().map(|&x| (x, 1u128)).collect();
+    let mut on_path: std::collections::HashSet<u64> = Default::default();
+    let mut looped = false;
+    fn depths(
+        x: u64,
+        m: &Module,
+        driver: &HashMap<u64, (usize, usize)>,
+        reached: &std::collections::HashSet<u64>,
+        depth: &mut HashMap<u64, u128>,
+        on_path: &mut std::collections::HashSet<u64>,
+        looped: &mut bool,
+    ) -> u128 {
+        if let Some(&d) = depth.get(&x) {
+            return d;
+        }
+        if !reached.contains(&x) {
+            return 0;
+        }
+        if !on_path.insert(x) {
+            *looped = true;
+            return 0;
+        }
+        let mut set = 0u128;
+        if let Some(&(ci, pi)) = driver.get(&x) {
+            let c = &m.cells[ci];
+            let out_width = c.outputs[pi].1.len();
+            let pos = c.outputs[pi]
+                .1
+                .iter()
+                .position(|b| *b == Some(x))
+                .unwrap_or(0);
+            for (pin, b) in &c.inputs {
+                if let Pin::Data(delay) = pin_class(c, pin) {
+                    // Registers and bitwise cells pass bit k to bit k (a parallel case
+                    // multiplexer's B holds one word per case); other cells mix every bit.
+                    let ins: Vec<u64> =
+                        if bitwise(&c.kind) && pin != "S" && b.len() % out_width == 0 {
+                            b.iter()
+                                .skip(pos)
+                                .step_by(out_width)
+                                .flatten()
+                                .copied()
+                                .collect()
+                        } else {
+                            b.iter().flatten().copied().collect()
+                        };
+                    for y in ins {
+                        let s = depths(y, m, driver, reached, depth, on_path, looped);
+                        set |= s.checked_shl(delay).unwrap_or(0);
+                    }
+                }
+            }
+        }
+        on_path.remove(&x);
+        depth.insert(x, set);
+        set
+    }
+    let want = TOP.latency(cfg).unwrap_or(0).saturating_sub(1);
+    if outs.is_empty() {
+        fails.add(format!(
+            "structure: {top_name} has no out_* wires at its output register"
+        ));
+    }
+    for (name, b) in outs {
+        let mut set = 0u128;
+        for x in b.iter().flatten() {
+            set |= depths(
+                *x,
+                &m,
+                &driver,
+                &reached,
+                &mut depth,
+                &mut on_path,
+                &mut looped,
+            );
+        }
+        let list: Vec<u32> = (0..128).filter(|k| set >> k & 1 == 1).collect();
+        if list != [want] {
+            fails.add(format!(
+                "structure: {name} is {list:?} registers from the sample inputs, not exactly {want} (the latency before the output register)"
+            ));
+        }
+    }
+    if looped {
+        fails.add(
+            "structure: a loop through the sample data (a register or wire that feeds back)".into(),
+        );
+    }
+    Ok(Part::new("structure", 0..1, 1, fails))
+}

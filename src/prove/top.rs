@@ -1,0 +1,110 @@
+//! The top driven with chosen gradients: one representative of every sort & shift state
+//! (part 2), the zero gradient (part 3), or, for a narrow gradient, every gradient itself
+//! (`--direct`). Every result is compared with the model's output for the same gradient.
+
+use super::ffi::{self, TOP_IN, TOP_OUT};
+use super::{Failures, Progress};
+use crate::model::{Maps, Model};
+use crate::rng::SplitMix64;
+use crate::vectors::inputs::{dec_grad, enc_grad};
+use anyhow::Result;
+
+/// Samples per call into the Verilated top.
+const CHUNK: usize = 1 << 18;
+
+/// The colour a sample carries with colour multiply on: drawn from its ordinal, so every run
+/// of the same range drives the same colours.
+fn colour(model: &Model, ordinal: u64) -> [u32; 3] {
+    if !model.cfg.color {
+        return [0; 3];
+    }
+    let mut r = SplitMix64::new(ordinal);
+    [0; 3].map(|_| r.bits(model.cfg.map_bits) as u32)
+}
+
+/// Gradients queued for the top, run and checked a chunk at a time.
+pub struct Batch<'a> {
+    top: &'a mut ffi::Top,
+    model: &'a Model,
+    maps: &'a Maps,
+    part: &'static str,
+    input: Vec<u32>,
+    ordinals: Vec<u64>,
+    out: Vec<u32>,
+}
+
+impl<'a> Batch<'a> {
+    pub fn new(
+        top: &'a mut ffi::Top,
+        model: &'a Model,
+        maps: &'a Maps,
+        part: &'static str,
+    ) -> Self {
+        Batch {
+            top,
+            model,
+            maps,
+            part,
+            input: Vec::with_capacity(TOP_IN * CHUNK),
+            ordinals: Vec::with_capacity(CHUNK),
+            out: vec![0; TOP_OUT * CHUNK],
+        }
+    }
+
+    /// Queues gradient `g` (sample `ordinal` of its part); runs the batch when full.
+    pub fn push(
+        &mut self,
+        ordinal: u64,
+        g: [i32; 3],
+        failures: &mut Failures,
+        progress: &Progress,
+    ) -> Result<()> {
+        let cfg = &self.model.cfg;
+        self.input.extend(g.map(|v| enc_grad(cfg, v) as u32));
+        self.input.extend(colour(self.model, ordinal));
+        self.ordinals.push(ordinal);
+        if self.ordinals.len() == CHUNK {
+            self.flush(failures, progress)?;
+        }
+        Ok(())
+    }
+
+    pub fn flush(&mut self, failures: &mut Failures, progress: &Progress) -> Result<()> {
+        let n = self.ordinals.len();
+        if n == 0 {
+            return Ok(());
+        }
+        let cfg = &self.model.cfg;
+        self.top.run(&self.input, &mut self.out[..TOP_OUT * n])?;
+        for k in 0..n {
+            let i = &self.input[TOP_IN * k..TOP_IN * k + TOP_IN];
+            let g = [i[0], i[1], i[2]].map(|v| dec_grad(cfg, v as u64));
+            let rgb = [i[3], i[4], i[5]];
+            let want = self.model.shade(self.maps, g, rgb);
+            let o = &self.out[TOP_OUT * k..TOP_OUT * k + TOP_OUT];
+            let got = (o[0] == 1, o[1], [o[2], o[3], o[4]]);
+            if (want.zero, want.intensity, want.rgb) != got {
+                let colour = if cfg.color {
+                    format!(" colour {rgb:?}")
+                } else {
+                    String::new()
+                };
+                failures.add(format!(
+                    "{}: sample {} gradient {g:?}{colour}: expected zero={} i={:#x}{}, got zero={} i={:#x}{}",
+                    self.part,
+                    self.ordinals[k],
+                    want.zero as u8,
+                    want.intensity,
+                    if cfg.color { format!(" rgb={:?}", want.rgb) } else { String::new() },
+                    o[0],
+                    o[1],
+                    if cfg.color { format!(" rgb={:?}", got.2) } else { String::new() },
+                ));
+            }
+        }
+        progress(n as u64);
+        self.input.clear();
+        self.ordinals.clear();
+        Ok(())
+    }
+}
