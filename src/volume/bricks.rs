@@ -78,11 +78,11 @@ impl Bricks {
         b[0] + self.counts[0] * (b[1] + self.counts[1] * b[2])
     }
 
-    /// For each brick, whether the transfer function is zero over its whole range.
+    /// For each brick, whether the transfer function is transparent over its whole range.
     pub fn empty(&self, tf: &Tf) -> Vec<bool> {
         self.ranges
             .iter()
-            .map(|&(lo, hi)| tf.zero_on(lo, hi))
+            .map(|&(lo, hi)| tf.transparent_on(lo, hi))
             .collect()
     }
 }
@@ -121,10 +121,7 @@ mod tests {
         }
         assert_eq!(b.of_cell([5, 2, 2]), 1);
         assert_eq!(b.of_cell([8, 0, 0]), 2);
-        let tf = Transfer {
-            points: vec![[5.5, 0.0], [6.0, 1.0]],
-        }
-        .compile(1.0);
+        let tf = Transfer::new(vec![[5.5, 0.0], [6.0, 1.0]]).compile(1.0, 1.0);
         assert_eq!(b.empty(&tf), vec![true, false, false]);
     }
 
@@ -144,16 +141,10 @@ mod tests {
         )
         .unwrap();
         let b = Bricks::new(&v, 8);
-        let tf = Transfer {
-            points: vec![[1100.0, 0.0], [1200.0, 1.0]],
-        }
-        .compile(1.0);
+        let tf = Transfer::new(vec![[1100.0, 0.0], [1200.0, 1.0]]).compile(1.0, 1.0);
         assert!(tf.opacity(f32::from_bits(1100.0f32.to_bits() + 1)) > 0.0);
         assert_eq!(b.empty(&tf), vec![false]);
-        let below = Transfer {
-            points: vec![[1101.0, 0.0], [1200.0, 1.0]],
-        }
-        .compile(1.0);
+        let below = Transfer::new(vec![[1101.0, 0.0], [1200.0, 1.0]]).compile(1.0, 1.0);
         assert_eq!(b.empty(&below), vec![true]);
     }
 }

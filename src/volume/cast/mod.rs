@@ -38,7 +38,7 @@ pub mod options;
 pub mod shader;
 
 use super::bricks::Bricks;
-use super::camera::Camera;
+use super::camera::{Camera, Framing};
 use super::prepared::Prepared;
 use super::Volume;
 use crate::scene::transfer::{Tf, Transfer};
@@ -69,7 +69,8 @@ pub struct Caster<'a> {
 }
 
 impl<'a> Caster<'a> {
-    /// `view` points from the volume towards the viewer, as the scene's view direction.
+    /// `view` points from the volume towards the viewer, as the scene's view direction (a
+    /// world direction; the caster works in the volume's voxel-axis frame).
     pub fn new(
         p: &'a Prepared,
         transfer: &Transfer,
@@ -84,11 +85,16 @@ impl<'a> Caster<'a> {
             p.bricks.size,
             opts.brick
         );
-        let tf = transfer.compile(opts.step as f32);
+        let tf = transfer.compile(opts.step as f32, p.grads.scale);
         let empty = p.bricks.empty(&tf);
         let s = p.vol.spacing;
         let hi = [0, 1, 2].map(|a| (p.vol.dims[a] - 1) as f64 * s[a]);
-        let camera = Camera::new([0.0; 3], hi, view, opts.size)?;
+        let framing = Framing {
+            up: opts.up,
+            zoom: opts.zoom,
+            axes: p.vol.axes,
+        };
+        let camera = Camera::new([0.0; 3], hi, view, opts.size, &framing)?;
         Ok(Caster {
             vol: p.vol,
             grads: &p.grads.data,
@@ -220,9 +226,7 @@ mod tests {
     use shader::ModelShader;
 
     fn transfer() -> Transfer {
-        Transfer {
-            points: vec![[1100.0, 0.0], [1900.0, 1.0]],
-        }
+        Transfer::new(vec![[1100.0, 0.0], [1900.0, 1.0]])
     }
 
     fn opts(size: u32, skip: bool) -> CastOptions {
@@ -259,6 +263,7 @@ mod tests {
                     ert,
                     brick,
                     skip: true,
+                    ..CastOptions::default()
                 };
                 let on = Caster::new(&p, &transfer(), view, o)
                     .unwrap()
@@ -351,9 +356,7 @@ mod tests {
         )
         .unwrap();
         let p = Prepared::new(&vol, 12, 2);
-        let tf = Transfer {
-            points: vec![[400.0, 0.0], [600.0, 1.0]],
-        };
+        let tf = Transfer::new(vec![[400.0, 0.0], [600.0, 1.0]]);
         let c = Caster::new(
             &p,
             &tf,
