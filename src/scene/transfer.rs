@@ -310,10 +310,18 @@ impl Tf {
         }
     }
 
-    /// Whether every value in `lo..=hi` is transparent: the largest opacity there is 0 or
-    /// below the minimum (the gradient ramp only lowers it).
-    pub fn transparent_on(&self, lo: f32, hi: f32) -> bool {
-        let m = self.value.max_on(lo, hi);
+    /// Whether every sample with a value in `lo..=hi` and a gradient magnitude (LSBs) up to
+    /// `grad_max` is transparent: the largest value opacity there, times the ramp's largest
+    /// factor up to `grad_max`, is 0 or below the minimum. f32 products are monotonic, so
+    /// every sample's product is at most this one.
+    pub fn transparent_on(&self, lo: f32, hi: f32, grad_max: f32) -> bool {
+        let mut m = self.value.max_on(lo, hi);
+        if m < self.min {
+            return true;
+        }
+        if let Some(r) = &self.ramp {
+            m *= r.max_on(0.0, grad_max);
+        }
         m <= 0.0 || m < self.min
     }
 
