@@ -53,7 +53,7 @@ pub fn default_transfer(vol: &Volume) -> (Transfer, String) {
     let t = otsu(vol) as f64;
     let [min, _, p50, p99, max] = percentiles(vol);
     let mut top = t + (p99 as f64 - t) / 2.0;
-    if !(top > t) {
+    if top.partial_cmp(&t) != Some(std::cmp::Ordering::Greater) {
         top = t + (max as f64 - min as f64).max(1.0) / BINS as f64;
     }
     // Values at least one f32 apart, as the transfer function requires.
