@@ -6,16 +6,23 @@
 //!   file; raw and gzip encodings); [`synthetic`]: the built-in machined part.
 //! - [`gradient`]: central differences on the voxel grid, scaled once per volume and
 //!   quantised to `grad_bits` two's complement: the shader's input, as hardware receives it.
-//! - [`bricks`]: per-brick value ranges for empty-space skipping.
-//! - [`transfer`]: the opacity transfer function of the scene file.
+//! - [`bricks`]: per-brick value ranges and largest gradient magnitudes for empty-space
+//!   skipping.
+//! - [`crate::scene::transfer`]: the opacity transfer function of the scene file (value
+//!   breakpoints, gradient-magnitude ramp, minimum opacity); [`histogram`]: a default one
+//!   from the data when none is given.
 //! - [`prepared`]: a volume's gradients and bricks, computed once for every view.
 //! - [`camera`] and [`cast`]: orthographic ray casting with trilinear sampling, front-to-back
 //!   compositing, empty-space skipping and early ray termination; each sample is shaded by a
 //!   [`cast::shader::Shader`] (the float reference or the bit-accurate model), or its
 //!   gradients are collected for a batch shader (an RTL simulation, through
 //!   [`crate::model::IntensitySource`]).
-//! - [`report`]: one render with every shader, the images, the error statistics and
-//!   `metrics.json`.
+//! - [`report`]: one render with every shader (or the model alone), the images, the error
+//!   statistics and `metrics.json`; [`picture`]: the images' pixel formats.
+//!
+//! Orientation: a volume's [`Volume::axes`] (NRRD `space directions`) place it in the world.
+//! The caster works in the voxel-axis frame; the camera turns the world view and up into it,
+//! and the shaders see the scene turned the same way ([`Volume::shading_scene`]).
 
 pub mod bricks;
 pub mod camera;

@@ -15,10 +15,13 @@
 //! composited intensity rounded to an integer in 0..=2^M - 1.
 //!
 //! **Skipping** (on by default) changes how much work is done, never the image:
-//! - empty-space skipping: a sample in a brick whose value range the transfer function
-//!   maps to zero opacity ([`super::bricks`]) jumps to the first sample past the brick;
+//! - empty-space skipping: a sample in a brick the transfer function makes transparent
+//!   (its value range maps to zero opacity, or below the minimum opacity once the
+//!   gradient-magnitude ramp's largest factor for the brick's gradients is applied;
+//!   [`super::bricks`]) jumps to the first sample past the brick;
 //! - early ray termination: the ray stops once A is 1 (after it, weights are 0);
-//! - a sample with zero opacity is not shaded, nor is a zero gradient (the shader's zero
+//! - a sample with zero opacity (after the ramp and the minimum) is not shaded, nor is a
+//!   zero gradient (the shader's zero
 //!   case gives intensity 0 in the model and the reference alike).
 //!
 //! With skipping off every sample on the ray is interpolated and shaded and composited with
