@@ -26,6 +26,14 @@ run: build
 tools:
 	@WITH_FPGA=1 scripts/install-tools.sh
 
+# rmapgen against VolPack (classified shear-warp) on VolPack's MRI head, 256^2 and 512^2, 1 and
+# 2 threads, in one run (scripts/bench-volume.sh; installs libvolpack1-dev when missing). A
+# benchmark, not part of make test; figures in docs/PERFORMANCE.md.
+.PHONY: bench-volume
+bench-volume: build
+	@WITH_VOLPACK=1 scripts/install-tools.sh
+	scripts/bench-volume.sh
+
 cargo-test:
 	$(CARGO) test
 

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs the simulators and synthesis tools from Debian's packages when any is missing;
 # WITH_FPGA=1 also nextpnr-ice40 and fpga-icestorm (place and route, make fpga); WITH_FORMAL=1
-# also z3 (the SMT solver of make formal's SymbiYosys runs).
+# also z3 (the SMT solver of make formal's SymbiYosys runs); WITH_VOLPACK=1 also
+# libvolpack1-dev (VolPack and its example MRI head, for make bench-volume only).
 # Fails loudly (exit 1) when it cannot: the tests must never skip a simulator silently.
 set -euo pipefail
 need=()
@@ -15,6 +16,9 @@ if [ "${WITH_FPGA:-0}" = 1 ]; then
 fi
 if [ "${WITH_FORMAL:-0}" = 1 ]; then
   command -v z3 >/dev/null 2>&1 || need+=(z3)
+fi
+if [ "${WITH_VOLPACK:-0}" = 1 ]; then
+  [ -f /usr/include/volpack.h ] || need+=(libvolpack1-dev)
 fi
 if [ ${#need[@]} -eq 0 ]; then
   exit 0
@@ -32,6 +36,9 @@ DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${need[@]}" >/dev/n
 check=(iverilog vvp verilator yosys)
 [ "${WITH_FPGA:-0}" = 1 ] && check+=(nextpnr-ice40 icepack)
 [ "${WITH_FORMAL:-0}" = 1 ] && check+=(z3)
+if [ "${WITH_VOLPACK:-0}" = 1 ] && [ ! -f /usr/include/volpack.h ]; then
+  echo "install-tools: libvolpack1-dev still missing after install" >&2; exit 1
+fi
 for t in "${check[@]}"; do
   command -v "$t" >/dev/null 2>&1 || { echo "install-tools: $t still missing after install" >&2; exit 1; }
 done

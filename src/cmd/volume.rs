@@ -15,9 +15,10 @@ use crate::volume::cast::options::{self, CastOptions};
 use crate::volume::cast::shader::ModelShader;
 use crate::volume::cast::Caster;
 use crate::volume::load::{self, RawFormat};
+use crate::volume::picture::PixelFormat;
 use crate::volume::prepared::Prepared;
 use crate::volume::report::{self, VolumeRender};
-use crate::volume::{synthetic, Volume, ENGINE_SCENE_TOML};
+use crate::volume::{histogram, synthetic, Volume, ENGINE_SCENE_TOML};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde::Serialize;
@@ -58,9 +59,38 @@ pub struct VolumeArgs {
     /// Transfer function breakpoints value:opacity,... (replaces the scene's).
     #[arg(long, value_name = "V:A,...", allow_hyphen_values = true)]
     pub transfer: Option<String>,
+    /// Opacity ramp on the gradient magnitude (value units per world unit),
+    /// magnitude:factor,... with magnitudes increasing; multiplies the value's opacity
+    /// (replaces the scene's [transfer] gradient).
+    #[arg(long, value_name = "M:A,...", allow_hyphen_values = true)]
+    pub gradient_ramp: Option<String>,
+    /// Opacity (per voxel length) below which a sample is transparent and skipped [0..=1].
+    #[arg(long, value_name = "A", allow_hyphen_values = true)]
+    pub min_opacity: Option<f64>,
     /// View direction, from the volume towards the viewer (replaces the scene's).
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
     pub view: Option<String>,
+    /// World direction shown as up in the image [default: +z, or +y for a view along z].
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    pub up: Option<String>,
+    /// Magnification about the volume's centre: 2 shows the middle half of the default
+    /// frame (0, 1000].
+    #[arg(
+        long,
+        value_name = "Z",
+        default_value_t = 1.0,
+        allow_hyphen_values = true
+    )]
+    pub zoom: f64,
+    /// Render only the voxels X0..=X1, Y0..=Y1, Z0..=Z1 (framed as the whole volume is).
+    #[arg(long, value_name = "X0:X1,Y0:Y1,Z0:Z1")]
+    pub crop: Option<String>,
+    /// Render with the model only: no float reference, no error image or statistics.
+    #[arg(long, conflicts_with = "rtl")]
+    pub model_only: bool,
+    /// Pixel format of the shaded images (the error image stays 8-bit grey).
+    #[arg(long, value_enum, default_value_t = PixelFormat::Gray8)]
+    pub png: PixelFormat,
     /// Image width and height in pixels [1..=4096].
     #[arg(long, value_name = "N", default_value_t = 512, value_parser = super::parse::count::<u32>())]
     pub size: u32,
@@ -116,7 +146,8 @@ fn triple<T: std::str::FromStr>(flag: &str, s: &str) -> Result<[T; 3]> {
     Ok([a, b, c])
 }
 
-/// The scene with --view and --transfer applied, validated, with a transfer function.
+/// The scene with --view, --up and --transfer applied, validated; without a transfer
+/// function when neither the arguments nor the scene give one (see [`transfer`]).
 fn scene(a: &VolumeArgs) -> Result<Scene> {
     let mut scene = a.map.scene_or(|| {
         Ok(Scene::from_toml_str(ENGINE_SCENE_TOML)
@@ -130,10 +161,81 @@ fn scene(a: &VolumeArgs) -> Result<Scene> {
     }
     if let Some(t) = &a.transfer {
         scene.transfer = Some(Transfer::parse(t)?);
+    } else if a.map.input().is_none() && !a.synthetic {
+        // The built-in scene's function is the synthetic part's (1100..1900): on another
+        // volume it is a guess, so the data's own default is used instead.
+        scene.transfer = None;
+    }
+    let ramp = a
+        .gradient_ramp
+        .as_deref()
+        .map(crate::scene::transfer::parse_ramp)
+        .transpose()?;
+    if let Some(m) = a.min_opacity {
+        if !(0.0..=1.0).contains(&m) {
+            bail!("--min-opacity {m} is out of range; allowed 0..=1");
+        }
+    }
+    if let Some(t) = &mut scene.transfer {
+        apply_classification(a, t, ramp.clone());
+    }
+    if let Some(u) = &a.up {
+        let u = triple::<f64>("--up", u)?;
+        let view = crate::scene::check_direction("view.direction", scene.view.direction)?;
+        crate::volume::camera::check_up(u, view)?;
     }
     scene.validate()?;
-    report::scene_transfer(&scene)?;
     Ok(scene)
+}
+
+/// Sets --gradient-ramp and --min-opacity on a transfer function.
+fn apply_classification(a: &VolumeArgs, t: &mut Transfer, ramp: Option<Vec<[f64; 2]>>) {
+    if ramp.is_some() {
+        t.gradient = ramp;
+    }
+    if a.min_opacity.is_some() {
+        t.min_opacity = a.min_opacity;
+    }
+}
+
+/// Gives the scene a transfer function from the data's histogram when it has none; returns
+/// the line saying what was chosen.
+fn transfer(a: &VolumeArgs, scene: &mut Scene, vol: &Volume) -> Result<Option<String>> {
+    if scene.transfer.is_some() {
+        return Ok(None);
+    }
+    let (mut t, text) = histogram::default_transfer(vol);
+    let ramp = a
+        .gradient_ramp
+        .as_deref()
+        .map(crate::scene::transfer::parse_ramp)
+        .transpose()?;
+    apply_classification(a, &mut t, ramp);
+    scene.transfer = Some(t);
+    scene.validate()?;
+    Ok(Some(text))
+}
+
+/// Parses `--crop X0:X1,Y0:Y1,Z0:Z1`.
+fn crop_box(s: &str) -> Result<([usize; 3], [usize; 3])> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        bail!("--crop {s}: give three ranges X0:X1,Y0:Y1,Z0:Z1 (voxel indices)");
+    }
+    let (mut lo, mut hi) = ([0; 3], [0; 3]);
+    for (a, p) in parts.iter().enumerate() {
+        let r = p.split_once(':').and_then(|(x, y)| {
+            Some((
+                x.trim().parse::<usize>().ok()?,
+                y.trim().parse::<usize>().ok()?,
+            ))
+        });
+        let Some((l, h)) = r else {
+            bail!("--crop {s}: '{p}' is not first:last (voxel indices >= 0)");
+        };
+        (lo[a], hi[a]) = (l, h);
+    }
+    Ok((lo, hi))
 }
 
 /// Loads the volume the arguments name.
@@ -155,7 +257,7 @@ fn volume(a: &VolumeArgs) -> Result<Volume> {
         let d =
             crate::volume::check_dims(dims.unwrap_or(synthetic::DIMS.map(|n| n as i64)), "--dims")?;
         let s = crate::volume::check_spacing(spacing.unwrap_or([1.0; 3]), "--spacing")?;
-        return synthetic::engine_block(d, s);
+        return crop(a, synthetic::engine_block(d, s)?);
     }
     let path = a
         .input
@@ -172,7 +274,7 @@ fn volume(a: &VolumeArgs) -> Result<Volume> {
         if let Some(s) = spacing {
             v.spacing = crate::volume::check_spacing(s, "--spacing")?;
         }
-        Ok(v)
+        crop(a, v)
     } else {
         let Some(dims) = dims else {
             bail!(
@@ -184,7 +286,21 @@ fn volume(a: &VolumeArgs) -> Result<Volume> {
             bits: a.bits.unwrap_or(8),
             signed: a.signed,
         };
-        load::load_raw(path, dims, spacing.unwrap_or([1.0; 3]), format)
+        crop(
+            a,
+            load::load_raw(path, dims, spacing.unwrap_or([1.0; 3]), format)?,
+        )
+    }
+}
+
+/// The volume cropped to --crop, if given.
+fn crop(a: &VolumeArgs, v: Volume) -> Result<Volume> {
+    match &a.crop {
+        None => Ok(v),
+        Some(s) => {
+            let (lo, hi) = crop_box(s)?;
+            v.crop(lo, hi)
+        }
     }
 }
 
@@ -240,6 +356,9 @@ fn timing(
 ) -> Result<(Timing, String)> {
     let tf = report::scene_transfer(scene)?;
     let view = scene.view.direction;
+    // The shaders see the scene in the volume's axis frame, as in `report::render`.
+    let shading = p.vol.shading_scene(scene);
+    let scene = &shading;
     let model = ModelShader::new(cfg, scene);
     let on = CastOptions { skip: true, ..opts };
     let off = CastOptions {
@@ -303,13 +422,19 @@ fn timing(
 
 pub fn run(a: &VolumeArgs) -> Result<()> {
     let cfg = a.cfg.resolve()?;
-    let scene = scene(a)?;
+    let mut scene = scene(a)?;
     let opts = CastOptions {
         size: a.size,
         step: a.step,
         ert: a.ert,
         brick: a.brick,
         skip: !a.no_skip,
+        zoom: a.zoom,
+        up: a
+            .up
+            .as_deref()
+            .map(|u| triple::<f64>("--up", u))
+            .transpose()?,
     };
     opts.validate()?;
     if a.timing && a.repeat == 0 {
@@ -324,6 +449,7 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
     let t = Instant::now();
     let vol = volume(a)?;
     let load_ms = t.elapsed().as_secs_f64() * 1e3;
+    let chosen = transfer(a, &mut scene, &vol)?;
 
     let policy = a
         .force
@@ -333,7 +459,10 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
     let p = Prepared::try_new(&vol, cfg.grad_bits, opts.brick)?;
     let prepare_ms = t.elapsed().as_secs_f64() * 1e3;
     let rtl = if a.rtl {
-        Some(crate::rtl::verilated::VerilatedTop::build(&cfg, &scene)?)
+        Some(crate::rtl::verilated::VerilatedTop::build(
+            &cfg,
+            &vol.shading_scene(&scene),
+        )?)
     } else {
         None
     };
@@ -344,7 +473,13 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
         opts,
         rtl.as_ref()
             .map(|t| t as &dyn crate::model::IntensitySource),
+        a.model_only,
     )?;
+    let mut r = r;
+    r.format = a.png;
+    if let Some(text) = &chosen {
+        println!("{text}");
+    }
     report::check_covered(&r, &vol)?;
     if let Some(n) = r.rtl_mismatches() {
         if n > 0 {
@@ -363,11 +498,13 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
     };
     let dir = out.commit()?;
     println!("{} -> {}", r.summary(), dir.display());
+    let float = r
+        .reference_ms
+        .map_or(String::new(), |t| format!(", float render {t:.1} ms"));
     println!(
-        "  {}: load {load_ms:.1} ms, gradients and bricks {prepare_ms:.1} ms, model render {:.1} ms, float render {:.1} ms (skipping {})",
+        "  {}: load {load_ms:.1} ms, gradients and bricks {prepare_ms:.1} ms, model render {:.1} ms{float} (skipping {})",
         vol.info.source,
         r.model_ms,
-        r.reference_ms,
         if opts.skip { "on" } else { "off" }
     );
     if let Some(text) = timing {

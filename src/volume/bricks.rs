@@ -12,6 +12,13 @@
 //! Trilinear interpolation is a convex combination, so every sample's value lies in the
 //! range up to the rounding of the caster's nested `a + (b - a) * t` (a few f32 ulps); the
 //! range is widened by 2^-18 of its largest magnitude (32 ulps) to cover that.
+//!
+//! For a transfer function with a gradient-magnitude ramp, each brick also keeps the largest
+//! magnitude of its voxels' quantised gradients (same voxels), plus [`GRAD_MARGIN`]: a
+//! sample's gradient is a convex combination of eight of them (no longer than the longest)
+//! rounded per component (at most 0.5 each, sqrt(3)/2 in all). A brick whose largest value
+//! opacity times the ramp's largest factor up to that magnitude is below the minimum opacity
+//! (or zero) holds no visible sample either.
 
 use super::Volume;
 use crate::scene::transfer::Tf;
@@ -19,6 +26,10 @@ use rayon::prelude::*;
 
 /// Relative widening of a brick's range.
 pub const WIDEN: f32 = 1.0 / (1 << 18) as f32;
+
+/// Added to a brick's largest gradient magnitude (LSBs): the rounding of an interpolated
+/// gradient (sqrt(3)/2) and of the f32 magnitude, with room to spare.
+pub const GRAD_MARGIN: f32 = 1.0;
 
 #[derive(Clone, Debug)]
 pub struct Bricks {
@@ -28,11 +39,15 @@ pub struct Bricks {
     pub counts: [usize; 3],
     /// (min, max) of each brick, x fastest.
     pub ranges: Vec<(f32, f32)>,
+    /// Largest quantised gradient magnitude of each brick's voxels plus [`GRAD_MARGIN`].
+    pub grad_max: Vec<f32>,
 }
 
 impl Bricks {
-    /// Brick ranges for bricks of `size` cells per side, a power of two.
-    pub fn new(vol: &Volume, size: usize) -> Bricks {
+    /// Brick ranges for bricks of `size` cells per side, a power of two; `grads` are the
+    /// volume's quantised gradients, one per voxel.
+    pub fn new(vol: &Volume, size: usize, grads: &[[i16; 3]]) -> Bricks {
+        assert_eq!(grads.len(), vol.data.len(), "one gradient per voxel");
         assert!(size.is_power_of_two(), "brick size {size}");
         let counts = vol.dims.map(|n| (n - 1).div_ceil(size));
         let [cx, cy, cz] = counts;
@@ -42,7 +57,7 @@ impl Bricks {
                 ((b + 1) * size + 1).min(n - 1),
             )
         };
-        let ranges = (0..cx * cy * cz)
+        let both: Vec<((f32, f32), f32)> = (0..cx * cy * cz)
             .into_par_iter()
             .map(|i| {
                 let (bx, by, bz) = (i % cx, (i / cx) % cy, i / (cx * cy));
@@ -50,6 +65,7 @@ impl Bricks {
                 let (y0, y1) = span(by, vol.dims[1]);
                 let (z0, z1) = span(bz, vol.dims[2]);
                 let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+                let mut g2 = 0i64;
                 for z in z0..=z1 {
                     for y in y0..=y1 {
                         let row = vol.index(0, y, z);
@@ -57,16 +73,22 @@ impl Bricks {
                             lo = lo.min(v);
                             hi = hi.max(v);
                         }
+                        for g in &grads[row + x0..=row + x1] {
+                            let [a, b, c] = g.map(|c| c as i64);
+                            g2 = g2.max(a * a + b * b + c * c);
+                        }
                     }
                 }
                 let e = lo.abs().max(hi.abs()) * WIDEN + f32::MIN_POSITIVE;
-                (lo - e, hi + e)
+                ((lo - e, hi + e), (g2 as f64).sqrt() as f32 + GRAD_MARGIN)
             })
             .collect();
+        let (ranges, grad_max) = both.into_iter().unzip();
         Bricks {
             size,
             counts,
             ranges,
+            grad_max,
         }
     }
 
@@ -78,11 +100,12 @@ impl Bricks {
         b[0] + self.counts[0] * (b[1] + self.counts[1] * b[2])
     }
 
-    /// For each brick, whether the transfer function is zero over its whole range.
+    /// For each brick, whether the transfer function is transparent over its whole range.
     pub fn empty(&self, tf: &Tf) -> Vec<bool> {
         self.ranges
             .iter()
-            .map(|&(lo, hi)| tf.zero_on(lo, hi))
+            .zip(&self.grad_max)
+            .map(|(&(lo, hi), &g)| tf.transparent_on(lo, hi, g))
             .collect()
     }
 }
@@ -110,7 +133,7 @@ mod tests {
             },
         )
         .unwrap();
-        let b = Bricks::new(&v, 4);
+        let b = Bricks::new(&v, 4, &vec![[0; 3]; v.data.len()]);
         assert_eq!(b.counts, [3, 1, 1]);
         let want = [(0.0, 5.0), (3.0, 9.0), (7.0, 9.0)];
         for (&(lo, hi), (wlo, whi)) in b.ranges.iter().zip(want) {
@@ -121,10 +144,7 @@ mod tests {
         }
         assert_eq!(b.of_cell([5, 2, 2]), 1);
         assert_eq!(b.of_cell([8, 0, 0]), 2);
-        let tf = Transfer {
-            points: vec![[5.5, 0.0], [6.0, 1.0]],
-        }
-        .compile(1.0);
+        let tf = Transfer::new(vec![[5.5, 0.0], [6.0, 1.0]]).compile(1.0, 1.0);
         assert_eq!(b.empty(&tf), vec![true, false, false]);
     }
 
@@ -143,17 +163,11 @@ mod tests {
             },
         )
         .unwrap();
-        let b = Bricks::new(&v, 8);
-        let tf = Transfer {
-            points: vec![[1100.0, 0.0], [1200.0, 1.0]],
-        }
-        .compile(1.0);
+        let b = Bricks::new(&v, 8, &vec![[0; 3]; v.data.len()]);
+        let tf = Transfer::new(vec![[1100.0, 0.0], [1200.0, 1.0]]).compile(1.0, 1.0);
         assert!(tf.opacity(f32::from_bits(1100.0f32.to_bits() + 1)) > 0.0);
         assert_eq!(b.empty(&tf), vec![false]);
-        let below = Transfer {
-            points: vec![[1101.0, 0.0], [1200.0, 1.0]],
-        }
-        .compile(1.0);
+        let below = Transfer::new(vec![[1101.0, 0.0], [1200.0, 1.0]]).compile(1.0, 1.0);
         assert_eq!(b.empty(&below), vec![true]);
     }
 }

@@ -28,22 +28,85 @@ pub struct Camera {
     pub distance: f64,
 }
 
+/// Checks an image-up direction against the view: finite, non-zero and not parallel to the
+/// view (within about 0.06 degrees); returns it as a unit vector.
+pub fn check_up(up: [f64; 3], view: DVec3) -> Result<DVec3> {
+    let v = DVec3::from_array(up);
+    if !v.is_finite() {
+        bail!("--up {up:?} is not finite; give three finite numbers");
+    }
+    let Some(u) = crate::geometry::unit_direction(v) else {
+        bail!("--up {up:?} has zero length; an up direction needs a non-zero component");
+    };
+    if u.cross(view).length() < 1e-3 {
+        bail!(
+            "--up {up:?} is parallel to the view direction {:?}; give an up direction across the view",
+            view.to_array()
+        );
+    }
+    Ok(u)
+}
+
+/// How the image frames the volume beyond the view direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Framing {
+    /// World direction shown as up in the image (projected across the view); `None` for
+    /// world +z (+y when the view is within about 8 degrees of the z axis).
+    pub up: Option<[f64; 3]>,
+    /// Magnification about the box's centre: 2 shows the middle half of the default frame.
+    pub zoom: f64,
+    /// World direction of each voxel axis (rows; orthonormal): voxel (x, y, z) sits at
+    /// `x sx axes[0] + y sy axes[1] + z sz axes[2]`. The camera works in the voxel-axis
+    /// frame; its vectors are the world ones expressed there.
+    pub axes: [[f64; 3]; 3],
+}
+
+impl Default for Framing {
+    fn default() -> Self {
+        Framing {
+            up: None,
+            zoom: 1.0,
+            axes: IDENTITY,
+        }
+    }
+}
+
+/// Voxel axes along world x, y and z.
+pub const IDENTITY: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+
+/// A world vector in the voxel-axis frame (exact for [`IDENTITY`]).
+pub fn to_axes(axes: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
+    axes.map(|a| a[0] * v[0] + a[1] * v[1] + a[2] * v[2])
+}
+
 impl Camera {
-    /// A camera framing the world box `lo..=hi`, looking along `-view`.
-    pub fn new(lo: [f64; 3], hi: [f64; 3], view: [f64; 3], size: u32) -> Result<Camera> {
+    /// A camera framing the box `lo..=hi` (in the voxel-axis frame of `framing.axes`),
+    /// looking along `-view` (a world direction).
+    pub fn new(
+        lo: [f64; 3],
+        hi: [f64; 3],
+        view: [f64; 3],
+        size: u32,
+        framing: &Framing,
+    ) -> Result<Camera> {
         let Some(view) = crate::geometry::unit_direction(DVec3::from_array(view)) else {
             bail!("view direction {view:?} must be a finite, non-zero vector");
         };
         if size == 0 {
             bail!("image size must be at least 1");
         }
-        let hint = if view.z.abs() > 0.99 {
-            DVec3::Y
-        } else {
-            DVec3::Z
+        if !(framing.zoom.is_finite() && framing.zoom > 0.0) {
+            bail!("--zoom {} must be a finite number > 0", framing.zoom);
+        }
+        let hint = match framing.up {
+            Some(u) => check_up(u, view)?,
+            None if view.z.abs() > 0.99 => DVec3::Y,
+            None => DVec3::Z,
         };
         let right = hint.cross(view).normalize();
         let up = view.cross(right);
+        let axes = |v: DVec3| DVec3::from_array(to_axes(&framing.axes, v.to_array()));
+        let (view, right, up) = (axes(view), axes(right), axes(up));
         let (lo, hi) = (DVec3::from_array(lo), DVec3::from_array(hi));
         let extent = hi - lo;
         let centre = (lo + hi) * 0.5;
@@ -57,7 +120,7 @@ impl Camera {
             hw = hw.max(corner.dot(right).abs());
             hh = hh.max(corner.dot(up).abs());
         }
-        let half = hw.max(hh).max(1e-9) * 1.02;
+        let half = hw.max(hh).max(1e-9) * 1.02 / framing.zoom;
         Ok(Camera {
             size,
             view,
@@ -87,7 +150,14 @@ mod tests {
 
     #[test]
     fn default_view_matches_the_sphere_orientation() {
-        let c = Camera::new([0.0; 3], [10.0, 10.0, 4.0], [0.0, 0.0, 1.0], 10).unwrap();
+        let c = Camera::new(
+            [0.0; 3],
+            [10.0, 10.0, 4.0],
+            [0.0, 0.0, 1.0],
+            10,
+            &Framing::default(),
+        )
+        .unwrap();
         assert_eq!((c.right, c.up), (DVec3::X, DVec3::Y));
         // The top-right pixel's ray starts at high x, high y, above the box, going down.
         let (o, d) = c.ray(9, 0);
@@ -100,7 +170,14 @@ mod tests {
 
     #[test]
     fn oblique_views_keep_z_up_and_are_right_handed() {
-        let c = Camera::new([0.0; 3], [8.0, 8.0, 16.0], [-0.5, -0.7, 0.5], 64).unwrap();
+        let c = Camera::new(
+            [0.0; 3],
+            [8.0, 8.0, 16.0],
+            [-0.5, -0.7, 0.5],
+            64,
+            &Framing::default(),
+        )
+        .unwrap();
         assert!(c.up.z > 0.0 && c.right.z.abs() < 1e-12);
         assert!((c.right.cross(c.up) - c.view).length() < 1e-12);
         // Every corner of the box projects inside the image.
@@ -113,19 +190,72 @@ mod tests {
             ) - c.centre;
             assert!(p.dot(c.right).abs() <= half && p.dot(c.up).abs() <= half);
         }
-        assert!(Camera::new([0.0; 3], [8.0; 3], [0.0, 0.0, 0.0], 64).is_err());
-        assert!(Camera::new([0.0; 3], [8.0; 3], [f64::NAN, 0.0, 1.0], 64).is_err());
+        assert!(Camera::new([0.0; 3], [8.0; 3], [0.0, 0.0, 0.0], 64, &Framing::default()).is_err());
+        assert!(Camera::new(
+            [0.0; 3],
+            [8.0; 3],
+            [f64::NAN, 0.0, 1.0],
+            64,
+            &Framing::default()
+        )
+        .is_err());
         // Huge and tiny components give the view of the same direction.
-        let unit = Camera::new([0.0; 3], [8.0; 3], [1.0, 0.0, 0.0], 64).unwrap();
+        let unit =
+            Camera::new([0.0; 3], [8.0; 3], [1.0, 0.0, 0.0], 64, &Framing::default()).unwrap();
         for v in [[1e200, 0.0, 0.0], [1e308, 0.0, 0.0], [1e-310, 0.0, 0.0]] {
             assert_eq!(
-                Camera::new([0.0; 3], [8.0; 3], v, 64).unwrap(),
+                Camera::new([0.0; 3], [8.0; 3], v, 64, &Framing::default()).unwrap(),
                 unit,
                 "{v:?}"
             );
         }
         // A box away from the origin is centred.
-        let c = Camera::new([10.0, 20.0, 30.0], [12.0, 22.0, 32.0], [0.0, 0.0, 1.0], 8).unwrap();
+        let c = Camera::new(
+            [10.0, 20.0, 30.0],
+            [12.0, 22.0, 32.0],
+            [0.0, 0.0, 1.0],
+            8,
+            &Framing::default(),
+        )
+        .unwrap();
         assert_eq!(c.centre, DVec3::new(11.0, 21.0, 31.0));
+    }
+
+    #[test]
+    fn up_zoom_and_axes() {
+        let f = Framing::default();
+        let boxed = |v: [f64; 3], f: &Framing| Camera::new([0.0; 3], [8.0; 3], v, 64, f);
+        // Up along world +x for a view along +z: +x is up, so right is -y.
+        let c = boxed(
+            [0.0, 0.0, 1.0],
+            &Framing {
+                up: Some([2.0, 0.0, 0.0]),
+                ..f
+            },
+        )
+        .unwrap();
+        assert_eq!((c.up, c.right), (DVec3::X, -DVec3::Y));
+        // Zoom 2 halves the pixel.
+        let z = boxed([0.0, 0.0, 1.0], &Framing { zoom: 2.0, ..f }).unwrap();
+        let one = boxed([0.0, 0.0, 1.0], &f).unwrap();
+        assert_eq!(z.pixel * 2.0, one.pixel);
+        // Refused: up parallel to the view, zero or not finite; zoom <= 0 or not finite.
+        for (up, want) in [
+            ([0.0, 0.0, -3.0], "parallel"),
+            ([0.0, 0.0, 0.0], "zero length"),
+            ([f64::NAN, 0.0, 0.0], "not finite"),
+        ] {
+            let e = boxed([0.0, 0.0, 1.0], &Framing { up: Some(up), ..f }).unwrap_err();
+            assert!(e.to_string().contains(want), "{e}");
+        }
+        for zoom in [0.0, -1.0, f64::INFINITY] {
+            assert!(boxed([0.0, 0.0, 1.0], &Framing { zoom, ..f }).is_err());
+        }
+        // Voxel x along world z, y along world x, z along world y: the world view +z is
+        // the voxel frame's +x, and world up (+y here, as the view is along z) its +z.
+        let axes = [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let r = boxed([0.0, 0.0, 1.0], &Framing { axes, ..f }).unwrap();
+        assert_eq!((r.view, r.up), (DVec3::X, DVec3::Z));
+        assert_eq!(to_axes(&IDENTITY, [0.3, -2.0, 1e-300]), [0.3, -2.0, 1e-300]);
     }
 }

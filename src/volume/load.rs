@@ -5,8 +5,10 @@
 //! and `gzip` encodings, `byte skip` (including -1 for raw data) and `line skip`, both byte
 //! orders, three dimensions. Types: signed/unsigned 8-, 16- and 32-bit integers, `float` and
 //! `double`, all converted to f32 (exact for integers up to 2^24). The voxel spacing comes
-//! from `spacings` or from the lengths of `space directions` (orientation is ignored: the
-//! volume is rendered in its index frame). Anything else is refused with an error naming it.
+//! from `spacings` or from the lengths of `space directions`, whose directions give the
+//! volume's orientation ([`Volume::axes`]: the camera's view and up are world directions,
+//! so a scan renders upright with world +z up). Sheared (non-orthogonal) directions and
+//! anything else unsupported are refused with an error naming it.
 //!
 //! Bounds: the volume must fit [`super::MEMORY_BUDGET`] (checked from the header, before any
 //! data is read, with the size it needs); the data is streamed in chunks, never held whole,
@@ -424,8 +426,8 @@ pub fn parse_header(bytes: &[u8], what: &str) -> Result<(NrrdHeader, Option<usiz
     Ok((h, data))
 }
 
-/// Parses `space directions` into the length of each axis's vector.
-fn direction_lengths(v: &str, what: &str) -> Result<Vec<f64>> {
+/// Parses `space directions` into each axis's vector.
+fn direction_vectors(v: &str, what: &str) -> Result<Vec<Vec<f64>>> {
     let mut out = Vec::new();
     let mut rest = v.trim();
     while !rest.is_empty() {
@@ -444,10 +446,49 @@ fn direction_lengths(v: &str, what: &str) -> Result<Vec<f64>> {
             .collect();
         let comps =
             comps.map_err(|_| anyhow::anyhow!("{what}: cannot read space directions '{v}'"))?;
-        out.push(comps.iter().map(|c| c * c).sum::<f64>().sqrt());
+        out.push(comps);
         rest = r[close + 1..].trim_start();
     }
     Ok(out)
+}
+
+/// The spacing (lengths) and unit world directions of three `space directions` vectors;
+/// refuses vectors that are not 3-D, not finite, zero or not orthogonal (a sheared grid,
+/// which the caster's axis-aligned cells cannot represent).
+pub fn spacing_and_axes(vs: &[Vec<f64>], what: &str) -> Result<([f64; 3], [[f64; 3]; 3])> {
+    if vs.len() != 3 {
+        bail!(
+            "{what}: space directions has {} vectors for dimension 3",
+            vs.len()
+        );
+    }
+    let mut spacing = [0.0; 3];
+    let mut axes = [[0.0; 3]; 3];
+    for (a, v) in vs.iter().enumerate() {
+        let Ok(v) = <[f64; 3]>::try_from(v.as_slice()) else {
+            bail!(
+                "{what}: space direction {} has {} components; rmapgen needs 3-D space directions",
+                a + 1,
+                v.len()
+            );
+        };
+        let len = v.iter().map(|c| c * c).sum::<f64>().sqrt();
+        let len = check_spacing([len; 3], what)?[0];
+        spacing[a] = len;
+        axes[a] = v.map(|c| c / len);
+    }
+    for (i, j) in [(0, 1), (0, 2), (1, 2)] {
+        let d: f64 = (0..3).map(|k| axes[i][k] * axes[j][k]).sum();
+        if d.abs() > 1e-6 {
+            bail!(
+                "{what}: space directions {} and {} are not orthogonal (at {:.3} degrees); a sheared grid is not supported",
+                i + 1,
+                j + 1,
+                d.clamp(-1.0, 1.0).acos().to_degrees()
+            );
+        }
+    }
+    Ok((spacing, axes))
 }
 
 /// Loads an NRRD volume (`.nrrd` with attached data or `.nhdr` with a detached data file).
@@ -508,15 +549,11 @@ pub fn load_nrrd(path: &Path) -> Result<Volume> {
         Some(e) => bail!("{what}: endian '{e}' is neither little nor big"),
     };
 
+    let mut axes = super::camera::IDENTITY;
     let spacing = if let Some(sd) = &h.space_directions {
-        let l = direction_lengths(sd, &what)?;
-        if l.len() != 3 {
-            bail!(
-                "{what}: space directions has {} vectors for dimension 3",
-                l.len()
-            );
-        }
-        [l[0], l[1], l[2]]
+        let (s, a) = spacing_and_axes(&direction_vectors(sd, &what)?, &what)?;
+        axes = a;
+        s
     } else if let Some(sp) = &h.spacings {
         let s: Vec<f64> = sp
             .split_whitespace()
@@ -666,7 +703,9 @@ pub fn load_nrrd(path: &Path) -> Result<Volume> {
         source: path.display().to_string(),
         voxel_type: t.name().to_string(),
     };
-    Volume::new(dims, spacing, values, info)
+    let mut v = Volume::new(dims, spacing, values, info)?;
+    v.axes = axes;
+    Ok(v)
 }
 
 /// An attached NRRD file (raw or gzip encoding) of a volume, little-endian: what

@@ -6,22 +6,31 @@
 //!   file; raw and gzip encodings); [`synthetic`]: the built-in machined part.
 //! - [`gradient`]: central differences on the voxel grid, scaled once per volume and
 //!   quantised to `grad_bits` two's complement: the shader's input, as hardware receives it.
-//! - [`bricks`]: per-brick value ranges for empty-space skipping.
-//! - [`transfer`]: the opacity transfer function of the scene file.
+//! - [`bricks`]: per-brick value ranges and largest gradient magnitudes for empty-space
+//!   skipping.
+//! - [`crate::scene::transfer`]: the opacity transfer function of the scene file (value
+//!   breakpoints, gradient-magnitude ramp, minimum opacity); [`histogram`]: a default one
+//!   from the data when none is given.
 //! - [`prepared`]: a volume's gradients and bricks, computed once for every view.
 //! - [`camera`] and [`cast`]: orthographic ray casting with trilinear sampling, front-to-back
 //!   compositing, empty-space skipping and early ray termination; each sample is shaded by a
 //!   [`cast::shader::Shader`] (the float reference or the bit-accurate model), or its
 //!   gradients are collected for a batch shader (an RTL simulation, through
 //!   [`crate::model::IntensitySource`]).
-//! - [`report`]: one render with every shader, the images, the error statistics and
-//!   `metrics.json`.
+//! - [`report`]: one render with every shader (or the model alone), the images, the error
+//!   statistics and `metrics.json`; [`picture`]: the images' pixel formats.
+//!
+//! Orientation: a volume's [`Volume::axes`] (NRRD `space directions`) place it in the world.
+//! The caster works in the voxel-axis frame; the camera turns the world view and up into it,
+//! and the shaders see the scene turned the same way ([`Volume::shading_scene`]).
 
 pub mod bricks;
 pub mod camera;
 pub mod cast;
 pub mod gradient;
+pub mod histogram;
 pub mod load;
+pub mod picture;
 pub mod prepared;
 pub mod report;
 pub mod synthetic;
@@ -69,6 +78,10 @@ pub struct Volume {
     pub spacing: [f64; 3],
     /// Voxel values in the file's own units (integers up to 2^24 are exact in f32).
     pub data: Vec<f32>,
+    /// World direction of each voxel axis, orthonormal rows (NRRD `space directions`;
+    /// [`camera::IDENTITY`] otherwise): voxel (x, y, z) sits at `x sx axes[0] + y sy axes[1]
+    /// + z sz axes[2]`.
+    pub axes: [[f64; 3]; 3],
     /// Where the volume came from and its voxel type, for reports.
     pub info: VolumeInfo,
 }
@@ -155,6 +168,7 @@ impl Volume {
             dims,
             spacing,
             data,
+            axes: camera::IDENTITY,
             info,
         })
     }
@@ -185,6 +199,57 @@ impl Volume {
                 || (f32::INFINITY, f32::NEG_INFINITY),
                 |a, b| (a.0.min(b.0), a.1.max(b.1)),
             )
+    }
+
+    /// The voxels `lo[a]..=hi[a]` along each axis, as a volume of their own (same spacing
+    /// and axes); refuses a box outside the volume or under 2 voxels along an axis.
+    pub fn crop(&self, lo: [usize; 3], hi: [usize; 3]) -> Result<Volume> {
+        for a in 0..3 {
+            let name = ["x", "y", "z"][a];
+            if hi[a] >= self.dims[a] {
+                bail!(
+                    "--crop: {name} range {}:{} ends outside the volume (voxels 0:{} along {name})",
+                    lo[a],
+                    hi[a],
+                    self.dims[a] - 1
+                );
+            }
+            if lo[a] >= hi[a] {
+                bail!(
+                    "--crop: {name} range {}:{} holds fewer than 2 voxels; give first:last with first < last",
+                    lo[a],
+                    hi[a]
+                );
+            }
+        }
+        let dims = [0, 1, 2].map(|a| hi[a] - lo[a] + 1);
+        let mut data = Vec::with_capacity(dims[0] * dims[1] * dims[2]);
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                let i = self.index(0, y, z);
+                data.extend_from_slice(&self.data[i + lo[0]..=i + hi[0]]);
+            }
+        }
+        let mut info = self.info.clone();
+        info.source = format!(
+            "{} [{}:{},{}:{},{}:{}]",
+            info.source, lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]
+        );
+        let mut v = Volume::new(dims, self.spacing, data, info)?;
+        v.axes = self.axes;
+        Ok(v)
+    }
+
+    /// The scene the shaders see: its view and light directions in the voxel-axis frame,
+    /// where the gradients are (equal to `scene` for [`camera::IDENTITY`]). Dot products
+    /// are unchanged by the orthonormal axes, so the shading is the world scene's.
+    pub fn shading_scene(&self, scene: &crate::scene::Scene) -> crate::scene::Scene {
+        let mut s = scene.clone();
+        s.view.direction = camera::to_axes(&self.axes, s.view.direction);
+        for l in &mut s.lights {
+            l.direction = camera::to_axes(&self.axes, l.direction);
+        }
+        s
     }
 
     /// The smallest spacing: the unit of sample steps and of transfer-function opacities.
@@ -246,5 +311,17 @@ mod tests {
         assert_eq!(v.at(1, 2, 3), 23.0);
         assert_eq!(v.range(), (0.0, 23.0));
         assert_eq!(v.unit(), 0.5);
+        let c = v.crop([1, 1, 2], [1, 2, 3]);
+        assert!(c.unwrap_err().to_string().contains("fewer than 2"));
+        let c = v.crop([0, 1, 2], [1, 2, 3]).unwrap();
+        assert_eq!(
+            (c.dims, c.at(0, 0, 0), c.at(1, 1, 1)),
+            ([2, 2, 2], 14.0, 23.0)
+        );
+        assert!(v
+            .crop([0, 0, 0], [1, 3, 3])
+            .unwrap_err()
+            .to_string()
+            .contains("outside"));
     }
 }

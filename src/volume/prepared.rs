@@ -16,20 +16,16 @@ pub struct Prepared<'a> {
 
 impl<'a> Prepared<'a> {
     pub fn new(vol: &'a Volume, grad_bits: u32, brick: usize) -> Prepared<'a> {
-        Prepared {
-            vol,
-            grads: super::gradient::gradients(vol, grad_bits),
-            bricks: Bricks::new(vol, brick),
-        }
+        let grads = super::gradient::gradients(vol, grad_bits);
+        let bricks = Bricks::new(vol, brick, &grads.data);
+        Prepared { vol, grads, bricks }
     }
 
     /// [`Prepared::new`], refusing with an error a volume whose gradients the machine has no
     /// memory for.
     pub fn try_new(vol: &'a Volume, grad_bits: u32, brick: usize) -> anyhow::Result<Prepared<'a>> {
-        Ok(Prepared {
-            vol,
-            grads: super::gradient::try_gradients(vol, grad_bits)?,
-            bricks: Bricks::new(vol, brick),
-        })
+        let grads = super::gradient::try_gradients(vol, grad_bits)?;
+        let bricks = Bricks::new(vol, brick, &grads.data);
+        Ok(Prepared { vol, grads, bricks })
     }
 }

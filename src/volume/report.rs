@@ -9,18 +9,19 @@ use super::cast::frame::{Frame, Stats};
 use super::cast::options::CastOptions;
 use super::cast::shader::ModelShader;
 use super::cast::Caster;
+use super::picture::{self, PixelFormat};
 use super::prepared::Prepared;
 use super::VolumeInfo;
 use crate::config::Config;
 use crate::model::IntensitySource;
 use crate::output::StagedDir;
 use crate::reference::Reference;
-use crate::render::images::{display8, error50, png};
+use crate::render::images::error50;
 use crate::render::{metrics, Metrics};
 use crate::scene::transfer::Transfer;
 use crate::scene::Scene;
 use anyhow::{bail, Result};
-use image::GrayImage;
+use image::{DynamicImage, GrayImage};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -32,17 +33,22 @@ pub struct VolumeRender {
     pub opts: CastOptions,
     /// Pixels whose ray accumulated some opacity, raster order.
     pub covered: Vec<bool>,
-    pub reference: Vec<u32>,
+    /// Accumulated opacity per pixel (the same for every shader).
+    pub alpha: Vec<f32>,
+    /// The float reference's image; `None` with `--model-only`.
+    pub reference: Option<Vec<u32>>,
     pub model: Vec<u32>,
     pub rtl: Option<Vec<u32>>,
-    /// The model against the reference over the covered pixels.
-    pub metrics: Metrics,
+    /// The model against the reference over the covered pixels; `None` without a reference.
+    pub metrics: Option<Metrics>,
     /// Work of the model render.
     pub stats: Stats,
     pub context: Context,
     /// Wall-clock times of the model and the reference render, in ms.
     pub model_ms: f64,
-    pub reference_ms: f64,
+    pub reference_ms: Option<f64>,
+    /// The pixel format of the shaded images.
+    pub format: PixelFormat,
 }
 
 /// What was rendered, for `metrics.json`.
@@ -85,8 +91,10 @@ struct Skipping {
 struct Report<'a> {
     generator: String,
     size: u32,
-    #[serde(flatten)]
-    metrics: &'a Metrics,
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    metrics: Option<&'a Metrics>,
+    model_only: bool,
+    png: PixelFormat,
     worst: Option<WorstPixel>,
     #[serde(skip_serializing_if = "Option::is_none")]
     rtl_equals_model: Option<bool>,
@@ -121,14 +129,13 @@ pub fn check_covered(r: &VolumeRender, vol: &super::Volume) -> Result<()> {
     }
     let t = scene_transfer(&r.scene)?;
     let [min, p1, p50, p99, max] = percentiles(vol);
-    let points: Vec<String> = t
-        .points
-        .iter()
-        .map(|p| format!("{}:{}", p[0], p[1]))
-        .collect();
+    let mut extra = String::new();
+    if t.gradient.is_some() || t.min_opacity.is_some() {
+        extra = " (with its gradient-magnitude ramp and minimum opacity)".to_string();
+    }
     bail!(
-        "nothing covered: the transfer function makes every sample of the volume transparent (0 of {n}x{n} pixels); the data's values are min {min}, p1 {p1}, p50 {p50}, p99 {p99}, max {max}, and the transfer function's breakpoints (value:opacity) are {}; give breakpoints with opacity > 0 inside the data's range (--transfer or the scene's [transfer])",
-        points.join(","),
+        "nothing covered: the transfer function{extra} makes every sample of the volume transparent (0 of {n}x{n} pixels); the data's values are min {min}, p1 {p1}, p50 {p50}, p99 {p99}, max {max}, and the transfer function's breakpoints (value:opacity) are {}; give breakpoints with opacity > 0 inside the data's range (--transfer or the scene's [transfer])",
+        t.points_text(),
         n = r.opts.size
     )
 }
@@ -150,25 +157,33 @@ pub fn percentiles(vol: &super::Volume) -> [f32; 5] {
     [min, p1, p50, p99, max]
 }
 
-/// Renders a prepared volume with the scene's view direction and transfer function.
+/// Renders a prepared volume with the scene's view direction and transfer function; the
+/// float reference too unless `model_only`. The shaders see the scene in the volume's
+/// voxel-axis frame ([`super::Volume::shading_scene`]).
 pub fn render(
     p: &Prepared,
     cfg: &Config,
     scene: &Scene,
     opts: CastOptions,
     rtl: Option<&dyn IntensitySource>,
+    model_only: bool,
 ) -> Result<VolumeRender> {
     scene.validate()?;
     let transfer = scene_transfer(scene)?;
+    let shading = p.vol.shading_scene(scene);
     let t = Instant::now();
-    let model_shader = ModelShader::new(cfg, scene);
+    let model_shader = ModelShader::new(cfg, &shading);
     let caster = Caster::new(p, transfer, scene.view.direction, opts)?;
     let model_frame = caster.render(&model_shader);
     let model_ms = ms(t);
-    let t = Instant::now();
-    let reference_frame =
-        Caster::new(p, transfer, scene.view.direction, opts)?.render(&Reference::new(cfg, scene));
-    let reference_ms = ms(t);
+    let (reference_frame, reference_ms) = if model_only {
+        (None, None)
+    } else {
+        let t = Instant::now();
+        let f = Caster::new(p, transfer, scene.view.direction, opts)?
+            .render(&Reference::new(cfg, &shading));
+        (Some(f), Some(ms(t)))
+    };
     let rtl = match rtl {
         None => None,
         Some(src) => Some(batch(&caster, src, cfg)?),
@@ -177,7 +192,7 @@ pub fn render(
     let covered: Vec<bool> = model_frame.alpha.iter().map(|&a| a > 0.0).collect();
     let max = cfg.map_max();
     let model = model_frame.pixels(max);
-    let reference = reference_frame.pixels(max);
+    let reference = reference_frame.map(|f| f.pixels(max));
     let pick = |v: &[u32]| {
         v.iter()
             .zip(&covered)
@@ -185,7 +200,9 @@ pub fn render(
             .map(|c| *c.0)
             .collect::<Vec<u32>>()
     };
-    let metrics = metrics(&pick(&model), &pick(&reference), max);
+    let metrics = reference
+        .as_ref()
+        .map(|r| metrics(&pick(&model), &pick(r), max));
     let (lo, hi) = p.vol.range();
     let cam = caster.camera();
     let context = Context {
@@ -205,6 +222,7 @@ pub fn render(
         scene: scene.clone(),
         opts,
         covered,
+        alpha: model_frame.alpha,
         reference,
         model,
         rtl,
@@ -213,6 +231,7 @@ pub fn render(
         context,
         model_ms,
         reference_ms,
+        format: PixelFormat::default(),
     })
 }
 
@@ -241,14 +260,14 @@ pub fn batch(caster: &Caster, src: &dyn IntensitySource, cfg: &Config) -> Result
 impl VolumeRender {
     /// The worst pixel of the model against the reference.
     pub fn worst(&self) -> Option<WorstPixel> {
-        let k = self.metrics.worst_index?;
+        let k = self.metrics.as_ref()?.worst_index?;
         let i = self.covered.iter().enumerate().filter(|c| *c.1).nth(k)?.0;
         let n = self.opts.size as usize;
         Some(WorstPixel {
             x: (i % n) as u32,
             y: (i / n) as u32,
             model: self.model[i],
-            reference: self.reference[i],
+            reference: self.reference.as_ref()?[i],
         })
     }
 
@@ -259,33 +278,38 @@ impl VolumeRender {
     }
 
     pub fn image_names(&self) -> Vec<&'static str> {
-        let mut v = vec!["reference.png", "model.png", "error50.png"];
+        let mut v = vec![];
+        if self.reference.is_some() {
+            v.push("reference.png");
+        }
+        v.push("model.png");
+        if self.reference.is_some() {
+            v.push("error50.png");
+        }
         if self.rtl.is_some() {
             v.push("rtl.png");
         }
         v
     }
 
-    /// The images by file name: intensities shown as 8-bit grey (background black), and the
-    /// error |model - reference| in LSBs times 50.
-    pub fn images(&self) -> Vec<(&'static str, GrayImage)> {
+    /// The images by file name: intensities in [`VolumeRender::format`] (background black
+    /// or transparent), and the error |model - reference| in LSBs times 50 (8-bit grey).
+    pub fn images(&self) -> Vec<(&'static str, DynamicImage)> {
         let n = self.opts.size;
         let m = self.cfg.map_bits;
-        let img = |px: Vec<u8>| GrayImage::from_raw(n, n, px).expect("n x n pixels");
-        let shown = |v: &[u32]| img(v.iter().map(|&i| display8(i, m)).collect());
-        let mut v = vec![
-            ("reference.png", shown(&self.reference)),
-            ("model.png", shown(&self.model)),
-            (
-                "error50.png",
-                img(self
-                    .model
-                    .iter()
-                    .zip(&self.reference)
-                    .map(|(&a, &b)| error50(a, b))
-                    .collect()),
-            ),
-        ];
+        let shown = |v: &[u32]| picture::shown(v, &self.alpha, n, m, self.format);
+        let mut v = vec![("model.png", shown(&self.model))];
+        if let Some(r) = &self.reference {
+            v.insert(0, ("reference.png", shown(r)));
+            let e = self
+                .model
+                .iter()
+                .zip(r)
+                .map(|(&a, &b)| error50(a, b))
+                .collect();
+            let e = GrayImage::from_raw(n, n, e).expect("n x n pixels");
+            v.push(("error50.png", DynamicImage::ImageLuma8(e)));
+        }
         if let Some(rtl) = &self.rtl {
             v.push(("rtl.png", shown(rtl)));
         }
@@ -297,7 +321,9 @@ impl VolumeRender {
         let report = Report {
             generator: format!("rmapgen {}", env!("CARGO_PKG_VERSION")),
             size: self.opts.size,
-            metrics: &self.metrics,
+            metrics: self.metrics.as_ref(),
+            model_only: self.reference.is_none(),
+            png: self.format,
             worst: self.worst(),
             rtl_equals_model: mismatches.map(|n| n == 0),
             rtl_mismatches: mismatches,
@@ -318,25 +344,30 @@ impl VolumeRender {
     /// Writes the images and `metrics.json`.
     pub fn write(&self, out: &StagedDir) -> Result<()> {
         for (name, img) in self.images() {
-            out.write_bytes(name, &png(&img)?)?;
+            out.write_bytes(name, &picture::png(&img)?)?;
         }
         out.write_text("metrics.json", &self.metrics_json()?)
     }
 
     /// One line: what was rendered and the model's error against the reference.
     pub fn summary(&self) -> String {
-        let m = &self.metrics;
-        let psnr = m.psnr_db.map_or("inf".to_string(), |p| format!("{p:.2}"));
         let d = self.context.dims;
+        let px = self.covered.iter().filter(|&&c| c).count();
+        let error = match &self.metrics {
+            Some(m) => format!(
+                "max abs error {} LSB, RMSE {:.3} LSB, PSNR {} dB",
+                m.max_abs_error,
+                m.rmse,
+                m.psnr_db.map_or("inf".to_string(), |p| format!("{p:.2}"))
+            ),
+            None => "model only (no float reference, no error statistics)".to_string(),
+        };
         let mut s = format!(
-            "{}x{}x{} volume, {n}x{n} image, {px} covered pixels: max abs error {e} LSB, RMSE {r:.3} LSB, PSNR {psnr} dB; {sk:.1}% of samples skipped",
+            "{}x{}x{} volume, {n}x{n} image, {px} covered pixels: {error}; {sk:.1}% of samples skipped",
             d[0],
             d[1],
             d[2],
             n = self.opts.size,
-            px = m.pixels,
-            e = m.max_abs_error,
-            r = m.rmse,
             sk = 100.0 * self.stats.skipped_fraction()
         );
         if let Some(n) = self.rtl_mismatches() {
@@ -387,21 +418,34 @@ mod tests {
             ..CastOptions::default()
         };
         let s = scene();
-        let r = render(&p, &cfg, &s, o, Some(&AsModel(ModelShader::new(&cfg, &s)))).unwrap();
+        let r = render(
+            &p,
+            &cfg,
+            &s,
+            o,
+            Some(&AsModel(ModelShader::new(&cfg, &s))),
+            false,
+        )
+        .unwrap();
         assert_eq!(r.rtl_mismatches(), Some(0));
         assert!(
-            r.metrics.pixels > 64 * 64 / 4 && r.metrics.pixels < 64 * 64,
+            r.metrics.as_ref().unwrap().pixels > 64 * 64 / 4
+                && r.metrics.as_ref().unwrap().pixels < 64 * 64,
             "{}",
-            r.metrics.pixels
+            r.metrics.as_ref().unwrap().pixels
         );
         // The model is close to the reference but not identical.
         assert!(
-            r.metrics.max_abs_error >= 1 && r.metrics.max_abs_error <= 12,
+            r.metrics.as_ref().unwrap().max_abs_error >= 1
+                && r.metrics.as_ref().unwrap().max_abs_error <= 12,
             "{:?}",
-            r.metrics
+            r.metrics.as_ref().unwrap()
         );
         let w = r.worst().unwrap();
-        assert_eq!(w.model.abs_diff(w.reference), r.metrics.max_abs_error);
+        assert_eq!(
+            w.model.abs_diff(w.reference),
+            r.metrics.as_ref().unwrap().max_abs_error
+        );
         let j: serde_json::Value = serde_json::from_str(&r.metrics_json().unwrap()).unwrap();
         for k in [
             "max_abs_error",
@@ -424,21 +468,21 @@ mod tests {
             r.image_names()
         );
         // Background stays black; the error image is 50 per LSB.
-        assert_eq!(imgs[1].1.get_pixel(0, 0).0[0], 0);
-        let e = &imgs[2].1;
+        assert_eq!(imgs[1].1.to_luma8().get_pixel(0, 0).0[0], 0);
+        let e = imgs[2].1.to_luma8();
         let (x, y) = (w.x, w.y);
         assert_eq!(
             e.get_pixel(x, y).0[0] as u32,
-            (50 * r.metrics.max_abs_error).min(255)
+            (50 * r.metrics.as_ref().unwrap().max_abs_error).min(255)
         );
 
         // A batch shader that disagrees is reported; one that is out of range is refused.
-        let other = render(&p, &cfg, &s, o, Some(&Fixed(3))).unwrap();
+        let other = render(&p, &cfg, &s, o, Some(&Fixed(3)), false).unwrap();
         assert!(
             other.rtl_mismatches().unwrap() > 0
                 && other.summary().contains("differs from the model")
         );
-        assert!(render(&p, &cfg, &s, o, Some(&Fixed(256)))
+        assert!(render(&p, &cfg, &s, o, Some(&Fixed(256)), false)
             .unwrap_err()
             .to_string()
             .contains("wider than"));
@@ -454,6 +498,7 @@ mod tests {
             &Scene::standard(),
             CastOptions::default(),
             None,
+            false,
         )
         .unwrap_err();
         assert!(e.to_string().contains("no [transfer] section"));

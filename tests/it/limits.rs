@@ -837,6 +837,7 @@ fn readme_limits_table_quotes_the_constants() {
             rmapgen::volume::cast::options::MAX_STEP
         ),
         format!("`2..={}`", rmapgen::volume::cast::options::MAX_BRICK),
+        format!("`(0, {}]`", rmapgen::volume::cast::options::MAX_ZOOM),
         format!("`1..={}`", rmapgen::cmd::volume::MAX_REPEAT),
         format!("`(0, {}]` MHz", rmapgen::cmd::fpga::MAX_FREQ_MHZ),
         format!("`{}` bytes each", rmapgen::vectors::MAX_MAP_FILE_BYTES),

@@ -157,12 +157,19 @@ impl Caster<'_> {
             }
             st.evaluated += 1;
             let i = self.vol.index(cell[0], cell[1], cell[2]);
-            let a = self.tf.alpha(self.value(i, f));
-            if skip && a == 0.0 {
+            let o = self.tf.value_opacity(self.value(i, f));
+            if skip && o == 0.0 {
                 k += 1;
                 continue;
             }
             let g = self.gradient(i, f);
+            // The gradient-magnitude ramp only lowers the opacity, so a sample the value
+            // makes transparent stays so and the test above skips nothing visible.
+            let a = self.tf.correct(self.tf.with_gradient(o, g));
+            if skip && a == 0.0 {
+                k += 1;
+                continue;
+            }
             let w = (1.0 - acc) * a;
             if !skip || g != [0; 3] {
                 st.shaded += 1;

@@ -15,10 +15,13 @@
 //! composited intensity rounded to an integer in 0..=2^M - 1.
 //!
 //! **Skipping** (on by default) changes how much work is done, never the image:
-//! - empty-space skipping: a sample in a brick whose value range the transfer function
-//!   maps to zero opacity ([`super::bricks`]) jumps to the first sample past the brick;
+//! - empty-space skipping: a sample in a brick the transfer function makes transparent
+//!   (its value range maps to zero opacity, or below the minimum opacity once the
+//!   gradient-magnitude ramp's largest factor for the brick's gradients is applied;
+//!   [`super::bricks`]) jumps to the first sample past the brick;
 //! - early ray termination: the ray stops once A is 1 (after it, weights are 0);
-//! - a sample with zero opacity is not shaded, nor is a zero gradient (the shader's zero
+//! - a sample with zero opacity (after the ramp and the minimum) is not shaded, nor is a
+//!   zero gradient (the shader's zero
 //!   case gives intensity 0 in the model and the reference alike).
 //!
 //! With skipping off every sample on the ray is interpolated and shaded and composited with
@@ -38,7 +41,7 @@ pub mod options;
 pub mod shader;
 
 use super::bricks::Bricks;
-use super::camera::Camera;
+use super::camera::{Camera, Framing};
 use super::prepared::Prepared;
 use super::Volume;
 use crate::scene::transfer::{Tf, Transfer};
@@ -69,7 +72,8 @@ pub struct Caster<'a> {
 }
 
 impl<'a> Caster<'a> {
-    /// `view` points from the volume towards the viewer, as the scene's view direction.
+    /// `view` points from the volume towards the viewer, as the scene's view direction (a
+    /// world direction; the caster works in the volume's voxel-axis frame).
     pub fn new(
         p: &'a Prepared,
         transfer: &Transfer,
@@ -84,11 +88,16 @@ impl<'a> Caster<'a> {
             p.bricks.size,
             opts.brick
         );
-        let tf = transfer.compile(opts.step as f32);
+        let tf = transfer.compile(opts.step as f32, p.grads.scale);
         let empty = p.bricks.empty(&tf);
         let s = p.vol.spacing;
         let hi = [0, 1, 2].map(|a| (p.vol.dims[a] - 1) as f64 * s[a]);
-        let camera = Camera::new([0.0; 3], hi, view, opts.size)?;
+        let framing = Framing {
+            up: opts.up,
+            zoom: opts.zoom,
+            axes: p.vol.axes,
+        };
+        let camera = Camera::new([0.0; 3], hi, view, opts.size, &framing)?;
         Ok(Caster {
             vol: p.vol,
             grads: &p.grads.data,
@@ -220,9 +229,7 @@ mod tests {
     use shader::ModelShader;
 
     fn transfer() -> Transfer {
-        Transfer {
-            points: vec![[1100.0, 0.0], [1900.0, 1.0]],
-        }
+        Transfer::new(vec![[1100.0, 0.0], [1900.0, 1.0]])
     }
 
     fn opts(size: u32, skip: bool) -> CastOptions {
@@ -249,8 +256,24 @@ mod tests {
             ([1.0, 1.0, 1.5], 0.37, 0.95, 2),
             ([0.8, 1.0, 1.0], 1.0, 1.0, 16),
         ];
-        for (spacing, step, ert, brick) in cases {
-            let vol = synthetic::engine_block([64, 64, 32], spacing).unwrap();
+        // The value ramp alone, and with a gradient-magnitude ramp and a minimum opacity,
+        // zoomed, with an up direction and voxel axes that are not the world's.
+        let classified = Transfer {
+            points: vec![[900.0, 0.0], [1900.0, 1.0]],
+            gradient: Some(vec![[0.0, 0.0], [150.0, 0.0], [700.0, 1.0]]),
+            min_opacity: Some(0.2),
+        };
+        let axes = [[0.0, 1.0, 0.0], [0.0, 0.0, -1.0], [-1.0, 0.0, 0.0]];
+        let kinds = [
+            (transfer(), 1.0, None, crate::volume::camera::IDENTITY),
+            (classified, 1.6, Some([0.3, 1.0, 0.2]), axes),
+        ];
+        for ((spacing, step, ert, brick), (tf, zoom, up, axes)) in cases
+            .into_iter()
+            .flat_map(|c| kinds.clone().into_iter().map(move |k| (c, k)))
+        {
+            let mut vol = synthetic::engine_block([64, 64, 32], spacing).unwrap();
+            vol.axes = axes;
             let p = Prepared::new(&vol, cfg.grad_bits, brick);
             for view in views {
                 let o = CastOptions {
@@ -259,11 +282,11 @@ mod tests {
                     ert,
                     brick,
                     skip: true,
+                    zoom,
+                    up,
                 };
-                let on = Caster::new(&p, &transfer(), view, o)
-                    .unwrap()
-                    .render(&model);
-                let off = Caster::new(&p, &transfer(), view, CastOptions { skip: false, ..o })
+                let on = Caster::new(&p, &tf, view, o).unwrap().render(&model);
+                let off = Caster::new(&p, &tf, view, CastOptions { skip: false, ..o })
                     .unwrap()
                     .render(&model);
                 let what = format!("view {view:?} options {o:?}");
@@ -279,6 +302,77 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn skipping_on_noise_with_a_gradient_ramp() {
+        // Smoothed noise, a ramp on gradient magnitudes around its typical ones and a
+        // minimum opacity: many bricks are transparent for the ramp alone, rays see through
+        // them (no termination), so a brick wrongly marked empty changes the image.
+        let n = 24;
+        let mut seed = 12345u64;
+        let mut d: Vec<f32> = (0..n * n * n)
+            .map(|_| {
+                seed = seed
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (seed >> 40) as f32 / (1u64 << 24) as f32 * 100.0
+            })
+            .collect();
+        // Two box blurs along x give gradients of all sizes; the lower half is flat
+        // (opaque by value, transparent by the ramp).
+        for _ in 0..2 {
+            let c = d.clone();
+            for i in 1..d.len() - 1 {
+                d[i] = (c[i - 1] + c[i] + c[i + 1]) / 3.0;
+            }
+        }
+        for v in &mut d[..n * n * n / 2] {
+            *v = 60.0;
+        }
+        let info = VolumeInfo {
+            source: "noise".into(),
+            voxel_type: "float".into(),
+        };
+        let vol = Volume::new([n, n, n], [1.0; 3], d, info).unwrap();
+        let cfg = Config::default();
+        let model = ModelShader::new(&cfg, &Scene::standard());
+        let p = Prepared::new(&vol, cfg.grad_bits, 2);
+        let tf = Transfer {
+            points: vec![[30.0, 0.0], [70.0, 1.0]],
+            gradient: Some(vec![[8.0, 0.0], [20.0, 1.0]]),
+            min_opacity: Some(0.3),
+        };
+        let mut empty_by_ramp = 0.0;
+        for view in [[0.2, 0.3, 1.0], [-1.0, 0.5, 0.1]] {
+            let o = CastOptions {
+                size: 40,
+                ert: 1.0,
+                brick: 2,
+                ..CastOptions::default()
+            };
+            let c = Caster::new(&p, &tf, view, o).unwrap();
+            let on = c.render(&model);
+            let off = Caster::new(&p, &tf, view, CastOptions { skip: false, ..o })
+                .unwrap()
+                .render(&model);
+            assert_eq!(on.value, off.value, "{view:?}");
+            assert_eq!(on.alpha, off.alpha, "{view:?}");
+            assert!(
+                on.stats.shaded > 1000 && on.stats.empty_skipped > 0,
+                "{:?}",
+                on.stats
+            );
+            let no_ramp = Transfer {
+                gradient: None,
+                ..tf.clone()
+            };
+            empty_by_ramp = c.empty_brick_fraction()
+                - Caster::new(&p, &no_ramp, view, o)
+                    .unwrap()
+                    .empty_brick_fraction();
+        }
+        assert!(empty_by_ramp > 0.05, "{empty_by_ramp}");
     }
 
     #[test]
@@ -351,9 +445,7 @@ mod tests {
         )
         .unwrap();
         let p = Prepared::new(&vol, 12, 2);
-        let tf = Transfer {
-            points: vec![[400.0, 0.0], [600.0, 1.0]],
-        };
+        let tf = Transfer::new(vec![[400.0, 0.0], [600.0, 1.0]]);
         let c = Caster::new(
             &p,
             &tf,

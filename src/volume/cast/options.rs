@@ -16,6 +16,8 @@ pub const DEFAULT_BRICK: usize = 8;
 pub const MIN_STEP: f64 = 0.05;
 /// Largest sample step in voxels: beyond it samples skip whole cells.
 pub const MAX_STEP: f64 = 4.0;
+/// Largest `--zoom`: beyond it a pixel is far below a voxel.
+pub const MAX_ZOOM: f64 = 1000.0;
 /// Largest brick side in cells (`--brick`): larger bricks are rarely empty.
 pub const MAX_BRICK: usize = 64;
 
@@ -32,6 +34,11 @@ pub struct CastOptions {
     pub brick: usize,
     /// Skip empty space, terminate early and shade only contributing samples.
     pub skip: bool,
+    /// Magnification about the volume's centre (> 0).
+    pub zoom: f64,
+    /// World direction shown as image up; `None` for world +z (see [`crate::volume::camera`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub up: Option<[f64; 3]>,
 }
 
 impl Default for CastOptions {
@@ -42,6 +49,8 @@ impl Default for CastOptions {
             ert: DEFAULT_ERT,
             brick: DEFAULT_BRICK,
             skip: true,
+            zoom: 1.0,
+            up: None,
         }
     }
 }
@@ -68,6 +77,11 @@ impl CastOptions {
             (2..=MAX_BRICK).contains(&self.brick) && self.brick.is_power_of_two(),
             "brick {} is not allowed; give a power of two in 2..={MAX_BRICK}",
             self.brick
+        );
+        ensure!(
+            self.zoom.is_finite() && self.zoom > 0.0 && self.zoom <= MAX_ZOOM,
+            "zoom {} is out of range; allowed (0, {MAX_ZOOM}]",
+            self.zoom
         );
         Ok(())
     }
@@ -105,6 +119,13 @@ mod tests {
             ..CastOptions::default()
         })
         .contains("power of two"));
+        for zoom in [0.0, -2.0, f64::NAN, 1e4] {
+            assert!(bad(CastOptions {
+                zoom,
+                ..CastOptions::default()
+            })
+            .contains("zoom"));
+        }
         CastOptions {
             brick: 16,
             ..CastOptions::default()
