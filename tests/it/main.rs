@@ -4,6 +4,7 @@ mod alloc;
 mod bench;
 mod cmd_render;
 mod cmd_sim;
+mod ecp5;
 mod errors;
 mod fast;
 mod fit;
