@@ -22,8 +22,9 @@ module {= h.module =}{= h.params =} (
 {= h.ports =}
 );
 
-  localparam L = {= l =};  // lanes
 {%- if handshake %}
+
+  localparam L = {= l =};  // lanes
 
   // The beat's valid, taken by every lane; each lane's own bit rides on its side_i.
   wire beat_valid;

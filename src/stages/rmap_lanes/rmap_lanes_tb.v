@@ -107,6 +107,11 @@ module {= t.module =}_tb;
 {%- endif %}
   reg [VL-1:0] vs;
   reg [DL-1:0] bs;
+  // The next beat's data inputs, assembled lane by lane and then driven whole (Verilator
+  // 5.006 missed a part-select write into an input read by the design's always @* logic).
+{%- for f in t.in_fields %}
+  reg [{= f.bits * t.lanes - 1 =}:0] nx_{= f.name =};
+{%- endfor %}
 {%- include "tb/map2_decls.v" %}
 
   // Reads the next vector into slot nread mod VDEPTH, or sets eof.
@@ -128,21 +133,21 @@ module {= t.module =}_tb;
     end
   endtask
 
-  // Vector slot vs on the inputs of lane lk.
+  // Vector slot vs into lane lk of the next beat.
   task drive_lane;
     begin
 {%- for f in t.in_fields %}
-      {= f.port =}[lk*{= f.bits =} +: {= f.bits =}] = v_{= f.name =}[vs];
+      nx_{= f.name =}[lk*{= f.bits =} +: {= f.bits =}] = v_{= f.name =}[vs];
 {%- endfor %}
     end
   endtask
 
-  // Random values on the inputs of lane lk, which has no valid sample.
+  // Random values into lane lk of the next beat, which has no valid sample there.
   task drive_garbage;
     begin
 {%- for f in t.in_fields %}
       rnd = $random(seed);
-      {= f.port =}[lk*{= f.bits =} +: {= f.bits =}] = rnd[{= f.bits - 1 =}:0];
+      nx_{= f.name =}[lk*{= f.bits =} +: {= f.bits =}] = rnd[{= f.bits - 1 =}:0];
 {%- endfor %}
     end
   endtask
@@ -392,6 +397,9 @@ module {= t.module =}_tb;
           end
           if (!cur_mask[lk]) drive_garbage;
         end
+{%- for f in t.in_fields %}
+        {= f.port =} = nx_{= f.name =};
+{%- endfor %}
         valid_i = cur_mask;
         present = (cur_mask != {L{1'b0}});
       end
