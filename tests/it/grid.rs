@@ -14,7 +14,6 @@ use crate::hdl::{self, require};
 use crate::helpers;
 use rmapgen::config::{Target, PIPELINE_DEPTHS, RANGES};
 use rmapgen::grid::{self, GridRow};
-use rmapgen::stages::Unit;
 use std::path::Path;
 
 /// Random top-level vectors streamed through each row's Verilated testbench, besides the
