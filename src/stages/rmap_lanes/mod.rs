@@ -130,7 +130,7 @@ fn ports(cfg: &Config) -> Vec<Port> {
                 p.width = Width::Bits(b * cfg.lanes);
                 p.note = match p.name {
                     "valid_i" if cfg.handshake => {
-                        "one bit per lane; the beat (every lane) is accepted with |valid_i && ready_o"
+                        "one bit per lane; the beat (every lane) is accepted with valid_i != 0 && ready_o"
                     }
                     "valid_i" => "one bit per lane: lane k's sample is accepted when valid_i[k]",
                     "valid_o" if cfg.handshake => {
@@ -143,7 +143,7 @@ fn ports(cfg: &Config) -> Vec<Port> {
                 p.note = match p.name {
                     "swap_i" => "every lane's map buffers swap together",
                     "wr_en_i" => "host write into the back buffer of every lane",
-                    "ready_i" => "the beat's results leave at a rising edge with |valid_o && ready_i",
+                    "ready_i" => "the beat's results leave at a rising edge with valid_o != 0 && ready_i",
                     "ready_o" => "the lanes accept a beat (a register; low in reset)",
                     _ => p.note,
                 };
