@@ -64,6 +64,13 @@ pub struct Config {
     /// `generic` (the default).
     #[serde(skip_serializing_if = "Target::is_generic")]
     pub target: Target,
+    /// Parallel lanes ([`LANES`]): the design's top becomes `rmap_lanes`
+    /// (src/stages/rmap_lanes), which takes `lanes` gradients a clock and returns `lanes`
+    /// results a clock, one rmap_top per lane behind one host write port and one `swap_i`.
+    /// 1 (the default) is the single pipeline, rmap_top on top. Left out of the TOML and JSON
+    /// when 1, so a design without lanes is written as before the field existed.
+    #[serde(skip_serializing_if = "is_one")]
+    pub lanes: u32,
 }
 
 /// How the memories are written (docs/ARCHITECTURE.md, "Targets"). The arithmetic, the ports
@@ -112,6 +119,13 @@ fn is_false(b: &bool) -> bool {
 fn is_zero(v: &u32) -> bool {
     *v == 0
 }
+
+fn is_one(v: &u32) -> bool {
+    *v == 1
+}
+
+/// Allowed values of [`Config::lanes`].
+pub const LANES: (u32, u32) = (1, 8);
 
 /// Widest `tuser` of [`Config::axis_user`].
 pub const AXIS_USER_MAX: u32 = 64;
@@ -196,10 +210,14 @@ impl ConfigError {
     }
 }
 
-/// The allowed range of a width field from [`RANGES`], or of `pipeline_depth` or `axis_user`.
+/// The allowed range of a width field from [`RANGES`], or of `pipeline_depth`, `axis_user`
+/// or `lanes`.
 pub fn range_of(field: &str) -> Option<(u32, u32)> {
     if field == "pipeline_depth" {
         return Some(PIPELINE_DEPTHS);
+    }
+    if field == "lanes" {
+        return Some(LANES);
     }
     if field == "axis_user" {
         return Some((0, AXIS_USER_MAX));
@@ -233,6 +251,7 @@ impl Default for Config {
             axis: false,
             axis_user: 0,
             target: Target::Generic,
+            lanes: 1,
         }
     }
 }
@@ -305,6 +324,21 @@ impl Config {
                 min: 0,
                 max: AXIS_USER_MAX,
             });
+        }
+        let (min, max) = LANES;
+        if self.lanes < min || self.lanes > max {
+            return Err(ConfigError::OutOfRange {
+                field: "lanes",
+                value: self.lanes,
+                min,
+                max,
+            });
+        }
+        if self.lanes > 1 && self.axis {
+            return c(&["lanes", "axis"], format!(
+                "lanes = {} with axis: the AXI4-Stream top has one lane; use lanes = 1 with --axis, or leave out --axis",
+                self.lanes
+            ));
         }
         if self.axis && !self.handshake {
             return c(&["axis", "handshake"], "axis = true needs handshake = true (AXI4-Stream is a valid/ready interface); add --handshake".into());
@@ -472,11 +506,15 @@ impl Config {
     pub fn bank_total_bits(&self) -> u64 {
         self.bank_count() as u64 * self.bank_entries() as u64 * self.map_bits as u64
     }
-    /// Bits that travel through the top beside each sample with `axis`: `{tuser, tlast}`
-    /// (axis_user + 1); 0 without it (the top then has no `side_i` / `side_o`).
+    /// Bits that travel through the top beside each sample: with `axis` `{tuser, tlast}`
+    /// (axis_user + 1); with lanes and the handshake the lane's own valid bit (every lane's
+    /// rmap_top takes the beat's valid, so that their flow control runs in step: see
+    /// src/stages/rmap_lanes); else 0 (the top then has no `side_i` / `side_o`).
     pub fn side_bits(&self) -> u32 {
         if self.axis {
             self.axis_user + 1
+        } else if self.lanes > 1 && self.handshake {
+            1
         } else {
             0
         }
@@ -517,6 +555,10 @@ impl Config {
             self.handshake as u8
         ) + &if self.axis {
             format!(" axis user={}", self.axis_user)
+        } else {
+            String::new()
+        } + &if self.lanes > 1 {
+            format!(" lanes={}", self.lanes)
         } else {
             String::new()
         }
@@ -649,8 +691,57 @@ mod tests {
     }
 
     #[test]
+    fn lanes_are_in_range_and_not_with_axis() {
+        for l in [1, 2, 4, 8] {
+            Config {
+                lanes: l,
+                ..Config::default()
+            }
+            .validate()
+            .unwrap();
+        }
+        for l in [0, 9] {
+            let e = Config {
+                lanes: l,
+                ..Config::default()
+            }
+            .validate()
+            .unwrap_err();
+            assert_eq!(e.fields(), ["lanes"]);
+            assert!(e.to_string().contains("1..=8"), "{e}");
+        }
+        let e = Config {
+            lanes: 2,
+            handshake: true,
+            axis: true,
+            ..Config::default()
+        }
+        .validate()
+        .unwrap_err();
+        assert_eq!(e.fields(), ["lanes", "axis"]);
+        let hs = Config {
+            lanes: 2,
+            handshake: true,
+            ..Config::default()
+        };
+        assert_eq!(hs.side_bits(), 1);
+        assert_eq!(
+            Config {
+                lanes: 2,
+                ..Config::default()
+            }
+            .side_bits(),
+            0
+        );
+        assert!(hs.summary().ends_with(" lanes=2"), "{}", hs.summary());
+        let t = toml::to_string(&hs).unwrap();
+        assert!(t.contains("lanes = 2"), "{t}");
+    }
+
+    #[test]
     fn axis_off_leaves_the_toml_as_it_was() {
         let t = toml::to_string(&Config::default()).unwrap();
         assert!(!t.contains("axis"), "{t}");
+        assert!(!t.contains("lanes"), "{t}");
     }
 }

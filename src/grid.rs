@@ -8,7 +8,7 @@
 //! both ends of its range (recip_bits at its smallest legal value, frac_bits + 1), each of the
 //! eight combinations of compensation, interpolation and colour, every pipeline depth, and the
 //! handshake on and off, both memory targets, mixed so that the ends meet each other and the
-//! optional stages, and the AXI4-Stream top.
+//! optional stages, the AXI4-Stream top, and 2 and 4 lanes with and without the handshake.
 
 use crate::config::{Config, Target, RANGES};
 
@@ -30,7 +30,7 @@ macro_rules! grid {
     ($( $name:ident: $g:literal $r:literal $w:literal $f:literal $i:literal $p:literal $m:literal
         $comp:literal $interp:literal $color:literal $depth:literal $hs:literal $icarus:literal
         $ice40:literal
-        $(axis $user:literal)? $covers:literal; )*) => {
+        $(axis $user:literal)? $(lanes $lanes:literal)? $covers:literal; )*) => {
         /// Every row, in the order below.
         pub fn rows() -> Vec<GridRow> {
             vec![$(GridRow {
@@ -44,6 +44,7 @@ macro_rules! grid {
                     target: if $ice40 == 1 { Target::Ice40 } else { Target::Generic },
                     axis: false $(|| { let _: u32 = $user; true })?,
                     axis_user: 0 $(+ $user)?,
+                    lanes: 1 $(- 1 + $lanes)?,
                 },
                 icarus: $icarus == 1,
                 covers: $covers,
@@ -54,7 +55,8 @@ macro_rules! grid {
 
 // G grad, R reduced, W reciprocal entry, F fraction, I index, P interpolation fraction, M map
 // entry bits; comp(ensation), interp(olation), color, pipeline depth, handshake, run in Icarus,
-// --target ice40 (else generic); `axis U`: the AXI4-Stream top rmap_axis with a U-bit tuser.
+// --target ice40 (else generic); `axis U`: the AXI4-Stream top rmap_axis with a U-bit tuser;
+// `lanes L`: the lanes top rmap_lanes with L lanes (its testbench runs in place of rmap_top's).
 grid! {
 //                  G  R  W  F  I  P  M  comp interp color depth hs icarus ice40
     paper:          12 8  10 8  3  3  8  1    1      0     2     0  1  0
@@ -109,6 +111,14 @@ grid! {
         "the largest map without interpolation (the widest bank address), under backpressure";
     axis_color:     12 8  10 8  3  3  8  1    1      1     2     1  1  0  axis 3
         "the AXI4-Stream top (rmap_axis: byte-padded tdata, 3-bit tuser, tlast) around the handshake top with colour";
+    lanes2:         12 8  10 8  3  3  8  1    1      0     2     0  0  0  lanes 2
+        "two lanes of the paper's design, per-lane valid bits";
+    lanes2_hs:      12 8  10 8  3  3  8  1    1      1     2     1  0  1  lanes 2
+        "two lanes with colour under whole-beat backpressure, memories for the iCE40";
+    lanes4:         12 8  10 8  3  0  8  0    0      0     0     0  0  0  lanes 4
+        "four lanes of the smallest design (neither optional stage, compact registers)";
+    lanes4_hs:      12 8  10 8  3  0  8  1    0      0     1     1  0  0  lanes 4
+        "four lanes under whole-beat backpressure, nearest entry";
 }
 
 /// The row called `name`.

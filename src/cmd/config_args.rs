@@ -55,6 +55,8 @@ pub struct ConfigArgs {
     pub axis: bool,
     #[arg(long, value_name = "BITS", value_parser = parse::field("axis_user"), help = parse::field_help("axis_user", "tuser width passed through with each sample (0: no tuser)", ", needs --axis"))]
     pub axis_user: Option<u32>,
+    #[arg(long, value_name = "L", value_parser = parse::field("lanes"), help = parse::field_help("lanes", "Parallel lanes: L samples in and L results out per clock (the top becomes rmap_lanes, one rmap_top per lane)", ""))]
+    pub lanes: Option<u32>,
 }
 
 impl ConfigArgs {
@@ -82,6 +84,9 @@ impl ConfigArgs {
         }
         if cfg.axis_user != d.axis_user {
             f.extend(["--axis-user".into(), cfg.axis_user.to_string()]);
+        }
+        if cfg.lanes != d.lanes {
+            f.extend(["--lanes".into(), cfg.lanes.to_string()]);
         }
         for (on, flag) in [
             (!cfg.compensation, "--no-compensation"),
@@ -134,7 +139,8 @@ impl ConfigArgs {
             index_bits,
             map_bits,
             pipeline_depth,
-            axis_user
+            axis_user,
+            lanes
         );
         if self.no_compensation {
             c.compensation = false;

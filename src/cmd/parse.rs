@@ -92,6 +92,7 @@ pub fn field_help(name: &str, what: &str, note: &str) -> String {
     let default = match name {
         "pipeline_depth" => d.pipeline_depth,
         "axis_user" => d.axis_user,
+        "lanes" => d.lanes,
         _ => d.field(name),
     };
     format!("{what} [{min}..={max}{note}, default {default}]")

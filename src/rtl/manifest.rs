@@ -6,6 +6,7 @@ use super::ports;
 use crate::config::Config;
 use crate::stages;
 use crate::stages::rmap_axis::AxisInfo;
+use crate::stages::rmap_lanes::LanesInfo;
 use crate::stages::rmap_top::{self, SidebandDelays};
 pub use crate::stages::unit::Memory;
 use serde::Serialize;
@@ -17,7 +18,8 @@ pub struct Manifest {
     pub rmapgen_version: &'static str,
     pub config: Config,
     pub config_summary: String,
-    /// The design's top module ([`stages::top`]: rmap_axis with `axis`, else rmap_top), with
+    /// The design's top module ([`stages::top`]: rmap_axis with `axis`, rmap_lanes with
+    /// `lanes` > 1, else rmap_top), with
     /// the configuration's prefix, as every name here.
     pub top: String,
     /// Clock cycles from accepting a sample to its result at the top's outputs.
@@ -32,6 +34,10 @@ pub struct Manifest {
     /// The AXI4-Stream `tdata` layouts and `tuser` width (`axis` only; absent without it).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub axis: Option<AxisInfo>,
+    /// The lanes: their number, the per-lane ports' packing, the memory bits of one lane
+    /// (`lanes` > 1 only; absent without it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lanes: Option<LanesInfo>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -81,6 +87,7 @@ impl Manifest {
             memories,
             files,
             axis: AxisInfo::new(cfg),
+            lanes: LanesInfo::new(cfg),
         }
     }
 
@@ -109,5 +116,22 @@ mod tests {
             m.memory_bits,
             cfg.rom_total_bits() + 1536 + cfg.bank_total_bits()
         );
+    }
+
+    #[test]
+    fn every_lane_costs_a_whole_top_in_memory() {
+        for l in [2, 4] {
+            let cfg = Config {
+                lanes: l,
+                ..Config::default()
+            };
+            let m = Manifest::new(&cfg, vec![]);
+            let one = Manifest::new(&Config::default(), vec![]).memory_bits;
+            assert_eq!(m.memory_bits, l as u64 * one);
+            assert_eq!(m.lanes.as_ref().unwrap().memory_bits_per_lane, one);
+            assert_eq!(m.top, "rmap_lanes");
+            assert_eq!(m.latency, 24);
+        }
+        assert!(Manifest::new(&Config::default(), vec![]).lanes.is_none());
     }
 }

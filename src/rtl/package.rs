@@ -17,7 +17,7 @@ use crate::stages::map_bank::MapBank;
 use crate::stages::rmap_top::{latency_list, top_latency};
 use crate::stages::testbench::TbFile;
 use crate::stages::unit::{file_params, FileParam};
-use crate::stages::{self, rmap_axis, Unit, TOP};
+use crate::stages::{self, rmap_axis, rmap_lanes, Unit, Vectors, TOP};
 use anyhow::{Context, Result};
 use askama::Template;
 
@@ -100,6 +100,61 @@ struct Readme {
     c_count: String,
     /// The `## AXI4-Stream` section (`axis` only).
     axis: Option<AxisReadme>,
+    /// The `## Lanes` section (`lanes` > 1 only).
+    lanes: Option<LanesReadme>,
+}
+
+/// What the README's `## Lanes` section prints: rmap_lanes' ports, the packing of the
+/// per-lane ports and the memory cost of a lane, from [`rmap_lanes`].
+struct LanesReadme {
+    top: String,
+    l: u32,
+    last: u32,
+    ports: Vec<(String, &'static str, u32, String)>,
+    /// (port, direction, bits per lane, lane 0's bits, lane L-1's bits).
+    packing: Vec<(&'static str, &'static str, u32, String, String)>,
+    packing_rule: &'static str,
+    memories_per_lane: usize,
+    bits_per_lane: u64,
+    bits_total: u64,
+    tb_file: String,
+}
+
+impl LanesReadme {
+    fn new(cfg: &Config) -> Option<LanesReadme> {
+        let info = rmap_lanes::LanesInfo::new(cfg)?;
+        let dir = |d: Dir| match d {
+            Dir::Input => "in",
+            Dir::Output => "out",
+        };
+        let last = cfg.lanes - 1;
+        Some(LanesReadme {
+            top: rmap_lanes::RmapLanes.module(cfg),
+            l: cfg.lanes,
+            last,
+            ports: rmap_lanes::RmapLanes
+                .ports(cfg)
+                .into_iter()
+                .map(|p| {
+                    let w = match p.width {
+                        Width::Bits(b) => b,
+                        Width::Param(_) => unreachable!("the lanes top's ports have fixed widths"),
+                    };
+                    (p.name.to_string(), dir(p.dir), w, describe(p.name, p.note))
+                })
+                .collect(),
+            packing: info
+                .ports
+                .iter()
+                .map(|p| (p.port, dir(p.dir), p.bits, p.range(0), p.range(last)))
+                .collect(),
+            packing_rule: info.packing,
+            memories_per_lane: TOP.memories(cfg).len(),
+            bits_per_lane: info.memory_bits_per_lane,
+            bits_total: info.memory_bits_per_lane * cfg.lanes as u64,
+            tb_file: rmap_lanes::RmapLanes.testbench_file(cfg),
+        })
+    }
 }
 
 /// What the README's `## AXI4-Stream` section prints: the wrapper's ports and the `tdata`
@@ -329,6 +384,7 @@ pub fn readme(design: &Design) -> Result<String> {
         c_array: map_stream::c_array(cfg),
         c_count: map_stream::c_count(cfg),
         axis: AxisReadme::new(cfg),
+        lanes: LanesReadme::new(cfg),
     }
     .render()
     .context("cannot render templates/pkg/README.md")?;

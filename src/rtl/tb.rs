@@ -90,6 +90,8 @@ pub fn data(cfg: &Config, stage: &dyn Vectors) -> Result<TbData> {
         bail!("{} has ready_i but no ready_o", stage.name());
     }
 
+    // A lanes module's per-sample ports carry every lane: `lanes` times the field's width.
+    let lanes = stage.lanes(cfg);
     let mut fields = Vec::new();
     for f in stage.fields(cfg) {
         let port = match stage.port(&f) {
@@ -107,7 +109,7 @@ pub fn data(cfg: &Config, stage: &dyn Vectors) -> Result<TbData> {
                 } else {
                     ports::Dir::Output
                 };
-                if p.dir != want || bits_of(p)? != f.bits {
+                if p.dir != want || bits_of(p)? != f.bits * lanes {
                     bail!(
                         "port {pn} of {} is {:?} {:?}; vector field {} needs {:?} of {} bits",
                         stage.name(),
@@ -115,7 +117,7 @@ pub fn data(cfg: &Config, stage: &dyn Vectors) -> Result<TbData> {
                         p.width,
                         f.name,
                         want,
-                        f.bits
+                        f.bits * lanes
                     );
                 }
                 pn
@@ -178,6 +180,7 @@ pub fn data(cfg: &Config, stage: &dyn Vectors) -> Result<TbData> {
 
     // The ring must hold every sample in flight plus the one being read.
     let depth = (latency + 4).next_power_of_two().max(16);
+    let vdepth = (depth * lanes).next_power_of_two();
     let reset_at = stage.reset_at(cfg);
     let tb_file = stage.testbench_file(cfg);
     Ok(TbData {
@@ -195,6 +198,9 @@ pub fn data(cfg: &Config, stage: &dyn Vectors) -> Result<TbData> {
         latency,
         depth,
         depth_bits: depth.trailing_zeros(),
+        lanes,
+        vdepth,
+        vdepth_bits: vdepth.trailing_zeros(),
         full_speed: FULL_SPEED,
         reset_at,
         timeout: 1000 + 8 * latency,
@@ -209,7 +215,7 @@ pub fn data(cfg: &Config, stage: &dyn Vectors) -> Result<TbData> {
                 .collect::<Vec<_>>()
                 .join(", ")
         ),
-        outs_bits: out_fields.iter().map(|f| f.bits).sum(),
+        outs_bits: out_fields.iter().map(|f| f.bits * lanes).sum(),
         scan_format: join(fields.iter().map(|_| "%h".to_string()).collect(), " "),
         scan_args: join(fields.iter().map(|f| format!("s_{}", f.name)).collect(), ", "),
         in_format: fmt_of(&in_all),

@@ -182,8 +182,11 @@ pub fn run(
         say,
         outcome: Outcome::default(),
     };
+    // The testbenches that read the top's vectors, and so take the stream: the top's, and
+    // the lanes top's (rmap_lanes reads the same file).
+    let streamed = |m: &String| *m == top_tb || *m == format!("{}_tb", design.top);
     let simulating = opts.icarus || opts.verilator || opts.gate;
-    let tb_stream = if opts.tb_stream > 0 && simulating && tbs.contains(&top_tb) {
+    let tb_stream = if opts.tb_stream > 0 && simulating && tbs.iter().any(streamed) {
         Some(r.stream(opts.tb_stream, "tb_stream.hex")?)
     } else {
         None
@@ -217,7 +220,7 @@ pub fn run(
                     let vcd = r.show(&vcd.display().to_string());
                     r.say(&format!("  vcd: {vcd}"));
                 }
-                if let (true, Some(s)) = (m == &top_tb, &tb_stream) {
+                if let (true, Some(s)) = (streamed(m), &tb_stream) {
                     let run = icarus::simulate(&dir, &vvp, &[stream_arg(s)]);
                     let log = dir.join(format!("{m}.stream.log"));
                     r.simulation(&format!("icarus {m} (stream)"), run, &log)?;
@@ -232,7 +235,7 @@ pub fn run(
                 let exe = mdir.join(verilator::BINARY_EXE);
                 let run = executable(&mdir, &exe, &[stream_arg(&vectors)]);
                 r.simulation(&format!("verilator {m}"), run, &mdir.join("run.log"))?;
-                if let (true, Some(s)) = (m == &top_tb, &tb_stream) {
+                if let (true, Some(s)) = (streamed(m), &tb_stream) {
                     let run = executable(&mdir, &exe, &[stream_arg(s)]);
                     let log = mdir.join("stream.log");
                     r.simulation(&format!("verilator {m} (stream)"), run, &log)?;

@@ -7,7 +7,8 @@
 //! | folder | module | instantiated by | has vectors and a testbench |
 //! |---|---|---|---|
 //! | `rmap_axis` | the AXI4-Stream top (`axis`) | — | — (the cocotb test, tb/cocotb/) |
-//! | `rmap_top` | the top (the shading pipeline; inside rmap_axis with `axis`) | rmap_axis | yes |
+//! | `rmap_lanes` | the lanes top (`lanes` > 1): one rmap_top per lane | — | yes (the top's vectors) |
+//! | `rmap_top` | the top (the shading pipeline; inside rmap_axis with `axis`, once per lane in rmap_lanes) | rmap_axis, rmap_lanes | yes |
 //! | `zero_detect` | zero detect | rmap_top | yes |
 //! | `sort_shift` | sort & shift | rmap_top | yes |
 //! | `normalise` | normalise | rmap_top | yes |
@@ -35,6 +36,7 @@ pub mod pipe_delay;
 pub mod position;
 pub mod recip_rom;
 pub mod rmap_axis;
+pub mod rmap_lanes;
 pub mod rmap_top;
 pub mod sort_shift;
 pub mod testbench;
@@ -49,10 +51,13 @@ pub use unit::{Head, Memory, Unit, Vectors};
 pub const TOP: &dyn Unit = &rmap_top::RmapTop;
 
 /// The design's outermost module: [`rmap_axis::RmapAxis`] (which instantiates [`TOP`]) with
-/// `axis`, else [`TOP`]. The manifest's `top`, lint, synthesis and the FPGA flow start here.
+/// `axis`, [`rmap_lanes::RmapLanes`] (one [`TOP`] per lane) with `lanes` > 1, else [`TOP`].
+/// The manifest's `top`, lint, synthesis and the FPGA flow start here.
 pub fn top(cfg: &Config) -> &'static dyn Unit {
     if cfg.axis {
         &rmap_axis::RmapAxis
+    } else if cfg.lanes > 1 {
+        &rmap_lanes::RmapLanes
     } else {
         TOP
     }
@@ -89,14 +94,19 @@ pub fn parents(cfg: &Config) -> Vec<(&'static str, Option<&'static str>)> {
     v
 }
 
-/// The modules with their own vectors and testbench, in pipeline order, the top last.
+/// The modules with their own vectors and testbench, in pipeline order, then the top, then
+/// the design's top if it is another module with vectors (rmap_lanes).
 pub fn checked(cfg: &Config) -> Vec<&'static dyn Vectors> {
+    let outer = top(cfg);
     let mut v: Vec<&'static dyn Vectors> = modules(cfg)
         .into_iter()
-        .filter(|m| m.name() != TOP.name())
+        .filter(|m| m.name() != TOP.name() && m.name() != outer.name())
         .filter_map(|m| m.vectors())
         .collect();
     v.extend(TOP.vectors());
+    if outer.name() != TOP.name() {
+        v.extend(outer.vectors());
+    }
     v
 }
 

@@ -42,6 +42,12 @@ pub struct TbData {
     pub latency: u32,
     pub depth: u32,
     pub depth_bits: u32,
+    /// Samples a clock ([`crate::stages::Vectors::lanes`]): 1, or the lanes of rmap_lanes.
+    pub lanes: u32,
+    /// The ring of vectors read but not yet checked, with lanes: `lanes` per beat of the
+    /// `depth` ring (a power of two), and its log2.
+    pub vdepth: u32,
+    pub vdepth_bits: u32,
     pub full_speed: u32,
     pub reset_at: u32,
     pub timeout: u32,

@@ -308,6 +308,12 @@ pub trait Vectors: Unit {
         RESET_AT
     }
 
+    /// Samples a clock: the module's per-sample ports are this many fields wide, lane k in
+    /// bits `[k*W +: W]` (`rmap_lanes`); 1 for every other module.
+    fn lanes(&self, _cfg: &Config) -> u32 {
+        1
+    }
+
     /// `vectors/<module>.hex`, relative to the output directory.
     fn vector_file(&self, cfg: &Config) -> String {
         format!("vectors/{}.hex", self.module(cfg))

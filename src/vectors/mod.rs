@@ -165,7 +165,14 @@ pub fn stage_text(
 /// second map.
 pub fn write_all(design: &Design, out: &StagedDir, random: usize, seed: u64) -> Result<()> {
     check_stage_vectors(random, "--vectors")?;
+    // rmap_lanes reads the top's file: each file is written once.
+    let mut written: Vec<String> = Vec::new();
     for stage in stages::checked(design.cfg()) {
+        let file = stage.vector_file(design.cfg());
+        if written.contains(&file) {
+            continue;
+        }
+        written.push(file);
         out.write_text(
             &stage.vector_file(design.cfg()),
             &stage_text(stage, &design.model, &design.maps, random, seed),

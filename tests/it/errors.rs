@@ -468,6 +468,48 @@ fn axis_without_the_handshake_is_refused() {
     assert!(o.join("rmap_axis.v").is_file());
 }
 
+/// Issue 15 §1: lanes out of range, and lanes with the AXI4-Stream top (not supported yet),
+/// from flags or from the file; one line, exit 2, nothing written.
+#[test]
+fn bad_lanes_are_refused() {
+    let t = tempdir();
+    let o = t.path().join("o");
+    let o_ = o.to_str().unwrap();
+    let c = t.path().join("c.toml");
+    std::fs::write(&c, "lanes = 9\n").unwrap();
+    let c_ = c.to_str().unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &["generate", "--lanes", "9", "--out", o_],
+            "--lanes must be in 1..=8, not 9",
+        ),
+        (
+            &["generate", "--lanes", "0", "--out", o_],
+            "--lanes must be in 1..=8, not 0",
+        ),
+        (
+            &[
+                "generate",
+                "--lanes",
+                "2",
+                "--handshake",
+                "--axis",
+                "--out",
+                o_,
+            ],
+            "lanes = 2 with axis: the AXI4-Stream top has one lane",
+        ),
+        (
+            &["generate", "--config", c_, "--out", o_],
+            "lanes = 9 is out of range; allowed 1..=8",
+        ),
+    ];
+    for (args, needle) in cases {
+        assert_error(&run(args), needle);
+    }
+    assert!(!o.exists());
+}
+
 #[test]
 fn a_directory_is_not_a_toml_file() {
     let t = tempdir();

@@ -39,7 +39,7 @@ tests! {
     paper, paper_depth0, paper_depth1, paper_hs, color, no_comp, no_interp, bare, no_comp_color,
     no_interp_color, bare_color, narrowest, narrowest_bare, widest, widest_depth0, grad16_red6,
     grad8_red8, no_truncation, frac4_recip20, frac12_recip13, index6_interp1, index2_interp5,
-    map12, map6_nearest, index6_nearest, axis_color,
+    map12, map6_nearest, index6_nearest, axis_color, lanes2, lanes2_hs, lanes4, lanes4_hs,
 }
 
 #[test]
@@ -64,11 +64,19 @@ fn check(name: &str) {
     let dir = tmp.path().join(name);
     hdl::generate_config(&dir, &r.config, VECTORS);
 
-    hdl::assert_lint_clean(name, &dir);
+    // The design's top: rmap_lanes with lanes, whose testbench checks every lane against the
+    // top's vectors (each lane is an rmap_top), else rmap_top.
+    let top = rmapgen::stages::top(&r.config);
+    let checked = if r.config.lanes > 1 {
+        top.module(&r.config)
+    } else {
+        "rmap_top".to_string()
+    };
+    hdl::assert_lint_clean_top(name, &dir, &top.module(&r.config));
     synthesise(name, &dir, &tmp.path().join("synth"));
 
     // Exact agreement in Verilator: the testbench's own vectors, then a long random stream.
-    let sim = hdl::verilator(&dir, "rmap_top", tmp.path());
+    let sim = hdl::verilator(&dir, &checked, tmp.path());
     let n = hdl::vector_count(&dir, "rmap_top");
     hdl::assert_passed(name, &hdl::sim(&dir, &sim, hdl::NO_ARGS), n);
     let stream = tmp.path().join("stream.hex");
@@ -181,4 +189,14 @@ fn grid_covers_every_range_end_and_switch() {
     assert!(ic.iter().any(|r| r.config.handshake) && ic.iter().any(|r| !r.config.interpolation));
     assert!(ic.iter().any(|r| r.config.target == Target::Ice40));
     assert!(ic.iter().any(|r| r.config.axis && r.config.axis_user > 0));
+    // Lanes: 2 and 4, each with and without the handshake.
+    for lanes in [2, 4] {
+        for hs in [false, true] {
+            assert!(
+                rows.iter()
+                    .any(|r| r.config.lanes == lanes && r.config.handshake == hs),
+                "no row with {lanes} lanes and handshake {hs}"
+            );
+        }
+    }
 }

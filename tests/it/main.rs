@@ -14,6 +14,7 @@ mod helpers;
 mod hexfile;
 mod host_docs;
 mod init_files;
+mod lanes;
 mod layout;
 mod limits;
 mod map_fit;

@@ -259,9 +259,22 @@ fn manifest_agrees_with_the_files_and_the_latency_function() {
                 m["axis"]["s_tdata"]["bits"].as_u64().unwrap() % 8 == 0,
                 "{name}"
             );
+        } else if cfg.lanes > 1 {
+            // The lanes top: one rmap_top per lane, each with its own memories.
+            assert_eq!(listed[..2], ["rmap_lanes", "rmap_top"], "{name}");
+            assert_eq!(m["lanes"]["lanes"], cfg.lanes, "{name}");
+            assert_eq!(
+                m["memory_bits"].as_u64().unwrap(),
+                cfg.lanes as u64 * m["lanes"]["memory_bits_per_lane"].as_u64().unwrap(),
+                "{name}"
+            );
+            assert!(m.get("axis").is_none(), "{name}");
         } else {
             assert_eq!(listed[0], "rmap_top");
-            assert!(m.get("axis").is_none(), "{name}");
+            assert!(
+                m.get("axis").is_none() && m.get("lanes").is_none(),
+                "{name}"
+            );
         }
         // Exactly the listed modules have files.
         let mut files: Vec<String> = listed.iter().map(|n| format!("{n}.v")).collect();

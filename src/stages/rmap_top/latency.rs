@@ -63,8 +63,9 @@ pub struct SidebandDelays {
     pub rgb: Option<u32>,
     /// The intensity beside color_mul (colour only).
     pub intensity: Option<u32>,
-    /// `side_i` (tuser and tlast with `axis`), from acceptance to the output register's
-    /// input: the whole pipeline (`axis` only; left out of the manifest without it).
+    /// `side_i` (tuser and tlast with `axis`, the lane's valid bit with lanes and the
+    /// handshake), from acceptance to the output register's input: the whole pipeline (only
+    /// with [`Config::side_bits`] > 0; left out of the manifest without it).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub side: Option<u32>,
 }
@@ -87,7 +88,7 @@ pub fn sideband_delays(cfg: &Config) -> SidebandDelays {
         zero: top_latency(cfg) - OUTPUT_LATENCY - lat(cfg, &ZeroDetect),
         rgb: color.map(|_| before_color),
         intensity: color,
-        side: cfg.axis.then(|| top_latency(cfg) - OUTPUT_LATENCY),
+        side: (cfg.side_bits() > 0).then(|| top_latency(cfg) - OUTPUT_LATENCY),
     }
 }
 

@@ -96,6 +96,8 @@ struct Verilog {
     i_delay: u32,
     /// Width of side_i / side_o (0: absent).
     sd: u32,
+    /// What side_i carries: {tuser, tlast} with `axis`, else a lane's valid bit.
+    axis: bool,
     side_delay: u32,
 }
 
@@ -155,7 +157,11 @@ impl Unit for RmapTop {
             v.push(i(
                 "side_i",
                 cfg.side_bits(),
-                "{tuser, tlast} of the sample (axis): leaves unchanged on side_o with its result",
+                if cfg.axis {
+                    "{tuser, tlast} of the sample (axis): leaves unchanged on side_o with its result"
+                } else {
+                    "the lane's valid bit (lanes): leaves unchanged on side_o with its result"
+                },
             ));
         }
         if cfg.handshake {
@@ -251,6 +257,7 @@ impl Unit for RmapTop {
             rgb_delay: d.rgb.unwrap_or(0),
             i_delay: d.intensity.unwrap_or(0),
             sd: cfg.side_bits(),
+            axis: cfg.axis,
             side_delay: d.side.unwrap_or(0),
         }
         .render()

@@ -33,7 +33,7 @@ module {= h.module =}{= h.params =} (
   localparam C   = {= c =};  // colour channel width
 {%- endif %}
 {%- if sd > 0 %}
-  localparam SD  = {= sd =};  // side_i width: {tuser, tlast} of the AXI4-Stream top
+  localparam SD  = {= sd =};  // side_i width: {% if axis %}{tuser, tlast} of the AXI4-Stream top{% else %}the lane's valid bit (rmap_lanes){% endif %}
 {%- endif %}
 
   // Sideband delays, from rmapgen::stages::rmap_top (the stage latencies above).
