@@ -1,9 +1,11 @@
 // prove_front.cpp: the front of the top (the modules that read the gradient: zero detect and
-// sort & shift), Verilated inside the wrapper prove_front.v that `rmapgen prove` generates, as
-// a shared object that rmapgen loads and drives (src/prove/ffi.rs). rmapgen chooses the
-// inputs and compares with the model; this file only applies them, one per clock, and
-// returns what the hardware outputs, in order.
+// sort & shift), Verilated inside the wrapper prove_front.v that `rmapgen prove` generates
+// (RP_LANES copies side by side, ports named in prove_front_lanes.h), as a shared object that
+// rmapgen loads and drives (src/prove/ffi.rs). rmapgen chooses the inputs and compares with
+// the model; this file only applies them, RP_LANES per clock, and returns what the hardware
+// outputs, in order.
 #include "Vprove_front.h"
+#include "prove_front_lanes.h"
 #include "verilated.h"
 
 #include <cstddef>
@@ -23,6 +25,9 @@ static void tick(Front* f) {
 
 extern "C" {
 
+// The number of gradients applied per clock; rp_front_run takes a multiple of it.
+size_t rp_front_lanes() { return RP_LANES; }
+
 // A model after reset.
 void* rp_front_new() {
     auto* f = new Front;
@@ -38,29 +43,32 @@ void* rp_front_new() {
 
 void rp_front_free(void* h) { delete static_cast<Front*>(h); }
 
-// Applies n gradients back to back (g[3k], g[3k+1], g[3k+2]: gx, gy, gz as G-bit fields),
-// then flushes the pipeline. zero[k] and ss[k] receive the k-th output each module flagged
-// valid. Returns 0, or -1 if a module delivered more or fewer than n outputs.
+// Applies n gradients (n a multiple of RP_LANES; g[3k], g[3k+1], g[3k+2]: gx, gy, gz as
+// G-bit fields), RP_LANES per clock back to back, then flushes the pipeline. zero[k] and
+// ss[k] receive the k-th result of each module, in order. Returns 0, or -1 if n is not a
+// multiple of RP_LANES or a module delivered more or fewer than n results.
 int rp_front_run(void* h, const uint16_t* g, size_t n, uint8_t* zero, uint64_t* ss) {
     auto* f = static_cast<Front*>(h);
     auto& t = f->top;
+    if (n % RP_LANES != 0) return -1;
     size_t nz = 0, ns = 0;
     auto collect = [&] {
-        if (t.zero_detect_valid_o) {
+        if (RP_ZERO_VALID(t)) {
             if (nz == n) return false;
-            zero[nz++] = t.zero_detect_o;
+            RP_ZEROS(t, (zero + nz));
+            nz += RP_LANES;
         }
-        if (t.sort_shift_valid_o) {
+        if (RP_SORT_VALID(t)) {
             if (ns == n) return false;
-            ss[ns++] = t.sort_shift_o;
+            RP_SORTS(t, (ss + ns));
+            ns += RP_LANES;
         }
         return true;
     };
-    for (size_t k = 0; k < n; ++k) {
+    for (size_t k = 0; k < n; k += RP_LANES) {
         t.valid_i = 1;
-        t.gx_i = g[3 * k];
-        t.gy_i = g[3 * k + 1];
-        t.gz_i = g[3 * k + 2];
+        const uint16_t* p = g + 3 * k;
+        RP_APPLY(t, p);
         tick(f);
         if (!collect()) return -1;
     }

@@ -58,6 +58,7 @@ impl Library {
 }
 
 type New = unsafe extern "C" fn() -> *mut c_void;
+type Lanes = unsafe extern "C" fn() -> usize;
 type Free = unsafe extern "C" fn(*mut c_void);
 type FrontRun = unsafe extern "C" fn(*mut c_void, *const u16, usize, *mut u8, *mut u64) -> c_int;
 type TopRun = unsafe extern "C" fn(*mut c_void, *const u32, usize, *mut u32) -> c_int;
@@ -67,6 +68,8 @@ pub struct Front {
     model: *mut c_void,
     run: FrontRun,
     free: Free,
+    /// [`Front::run`] takes a multiple of this many gradients.
+    pub lanes: usize,
 }
 
 impl Front {
@@ -76,19 +79,21 @@ impl Front {
             let new: New = std::mem::transmute::<*mut c_void, New>(lib.symbol("rp_front_new")?);
             let run = std::mem::transmute::<*mut c_void, FrontRun>(lib.symbol("rp_front_run")?);
             let free = std::mem::transmute::<*mut c_void, Free>(lib.symbol("rp_front_free")?);
+            let lanes = std::mem::transmute::<*mut c_void, Lanes>(lib.symbol("rp_front_lanes")?)();
             Ok(Front {
                 model: new(),
                 run,
                 free,
+                lanes,
             })
         }
     }
 
-    /// Applies `g` (gx, gy, gz per sample) one per clock; `zero` and `ss` receive each
-    /// module's outputs in order.
+    /// Applies `g` (gx, gy, gz per sample; a multiple of [`Front::lanes`] samples),
+    /// `lanes` per clock; `zero` and `ss` receive each module's outputs in order.
     pub fn run(&mut self, g: &[u16], zero: &mut [u8], ss: &mut [u64]) -> Result<()> {
         let n = g.len() / 3;
-        assert!(zero.len() >= n && ss.len() >= n && g.len() == 3 * n);
+        assert!(zero.len() >= n && ss.len() >= n && g.len() == 3 * n && n % self.lanes == 0);
         // SAFETY: the buffers hold n samples each, as rp_front_run reads and writes.
         let r = unsafe {
             (self.run)(
