@@ -10,6 +10,7 @@ pub mod lint;
 pub mod map_args;
 pub mod maps;
 pub mod parse;
+pub mod prove;
 pub mod render;
 pub mod roms;
 pub mod sim;
