@@ -39,9 +39,10 @@ roms: build
 # Also the handshake design's top testbench under random backpressure (sim-handshake), the
 # AXI4-Stream top under cocotb (axis-test: makes the venv first), the default design placed
 # and routed (fpga-check: block RAMs and the Fmax target, ~20 s), the formal proofs of the
-# handshake top with their planted faults (formal, ~1 min) and the default design's
+# handshake top with their planted faults (formal, ~1 min), the multiplier proofs (formal-mult,
+# ~1 min) and the default design's
 # synth_ice40 netlist simulated with the top testbench (gate-sim, ~2 min).
-test: tools cargo-test lint synth sim-all sim-handshake axis-test formal fpga-check gate-sim
+test: tools cargo-test lint synth sim-all sim-handshake axis-test formal formal-mult fpga-check gate-sim
 	@echo "make test: all checks passed"
 
 # ---- Simulation (rmapgen sim, src/sim/): every testbench of the design generated with
@@ -156,6 +157,22 @@ formal: build venv
 	$(RMAPGEN) generate --out $(FORMAL_OUT) $(FORMAL_FLAGS)
 	$(VENV)/bin/python formal/run_formal.py $(FORMAL_OUT) --build $(FORMAL_BUILD)
 	$(VENV)/bin/python formal/run_formal.py $(FORMAL_OUT) --build $(FORMAL_BUILD) $(addprefix --plant ,$(FORMAL_PLANTS))
+
+# ---- Multipliers (rmapgen prove --mult, src/rtl/mult_proof.rs): Yosys sat proves that every
+# adder tree of a generated design equals the product its plan states (a * b + c) on every
+# input: the default design ($(OUT), 5 trees, ~40 s) and the narrowest design with every tree
+# stage ($(MULT_OUT), 11 trees, ~7 s). The planted faults are in the cargo tests
+# (tests/it/mult_proof.rs). Logs in $(MULT_BUILD)/<design>.
+MULT_OUT   ?= build/rtl_mult
+MULT_BUILD ?= build/prove-mult
+MULT_FLAGS ?= --grad-bits 8 --red-bits 6 --recip-bits 5 --frac-bits 4 --index-bits 2 --interp-bits 1 --map-bits 6 --color --pipeline-depth 0
+
+.PHONY: formal-mult
+
+formal-mult: build
+	$(RMAPGEN) generate --out $(MULT_OUT) $(MULT_FLAGS)
+	YOSYS=$(YOSYS) $(RMAPGEN) prove --mult $(OUT) --logs $(MULT_BUILD)/$(notdir $(OUT))
+	YOSYS=$(YOSYS) $(RMAPGEN) prove --mult $(MULT_OUT) --logs $(MULT_BUILD)/$(notdir $(MULT_OUT))
 
 # ---- FPGA (src/rtl/fpga.rs): Yosys synth_ice40 and nextpnr-ice40 on the default design built
 # for the iCE40 (--target ice40; rtl_out/ is the portable --target generic): post-route Fmax,
