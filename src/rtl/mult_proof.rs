@@ -278,3 +278,39 @@ pub fn results(jobs: &[Job], log: &str) -> Vec<TreeResult> {
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grid;
+
+    /// Every row of the grid has its trees stated: two in normalise, two in linear_index (no
+    /// compensation), three in interpolate, six in color_mul; each specification's sum is a
+    /// tree node of its own name and its miter names no node but that sum.
+    #[test]
+    fn every_tree_of_every_row_has_a_specification() {
+        for r in grid::rows() {
+            let c = &r.config;
+            let want = 2
+                + 2 * !c.compensation as usize
+                + 3 * c.interpolation as usize
+                + 6 * c.color as usize;
+            let jobs = jobs(c);
+            assert_eq!(jobs.len(), want, "{}", r.name);
+            for j in &jobs {
+                let t = &j.spec.tree;
+                assert!(
+                    j.spec.sum.sig.name.starts_with(&format!("{t}_l")),
+                    "{}",
+                    j.name()
+                );
+                let w = wrapper(j);
+                // The tree's nodes are `<tree>_l<k>...`: only the sum may appear.
+                let nodes = w.matches(&format!("{t}_l")).count();
+                let own = w.matches(&j.spec.sum.sig.name).count();
+                assert_eq!(nodes, own, "{}: {w}", j.name());
+                assert!(!j.cases().is_empty());
+            }
+        }
+    }
+}
