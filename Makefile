@@ -158,7 +158,7 @@ formal: build venv
 	$(VENV)/bin/python formal/run_formal.py $(FORMAL_OUT) --build $(FORMAL_BUILD)
 	$(VENV)/bin/python formal/run_formal.py $(FORMAL_OUT) --build $(FORMAL_BUILD) $(addprefix --plant ,$(FORMAL_PLANTS))
 
-# ---- Multipliers (rmapgen prove --mult, src/rtl/mult_proof.rs): Yosys sat proves that every
+# ---- Multipliers (rmapgen prove-mult, src/rtl/mult_proof.rs): Yosys sat proves that every
 # adder tree of a generated design equals the product its plan states (a * b + c) on every
 # input: the default design ($(OUT), 5 trees, ~40 s) and the narrowest design with every tree
 # stage ($(MULT_OUT), 11 trees, ~7 s). The planted faults are in the cargo tests
@@ -171,8 +171,8 @@ MULT_FLAGS ?= --grad-bits 8 --red-bits 6 --recip-bits 5 --frac-bits 4 --index-bi
 
 formal-mult: build
 	$(RMAPGEN) generate --out $(MULT_OUT) $(MULT_FLAGS)
-	YOSYS=$(YOSYS) $(RMAPGEN) prove --mult $(OUT) --logs $(MULT_BUILD)/$(notdir $(OUT))
-	YOSYS=$(YOSYS) $(RMAPGEN) prove --mult $(MULT_OUT) --logs $(MULT_BUILD)/$(notdir $(MULT_OUT))
+	YOSYS=$(YOSYS) $(RMAPGEN) prove-mult $(OUT) --logs $(MULT_BUILD)/$(notdir $(OUT))
+	YOSYS=$(YOSYS) $(RMAPGEN) prove-mult $(MULT_OUT) --logs $(MULT_BUILD)/$(notdir $(MULT_OUT))
 
 # ---- FPGA (src/rtl/fpga.rs): Yosys synth_ice40 and nextpnr-ice40 on the default design built
 # for the iCE40 (--target ice40; rtl_out/ is the portable --target generic): post-route Fmax,

@@ -18,7 +18,7 @@ use crate::stages;
 
 /// Maps every flip-flop kind `proc` and `opt` leave to a wire from D to Q: the registers of a
 /// pipelined tree become transparent, and the tree one combinational sum.
-pub const TRANSPARENT: &str = r#"// rmapgen prove --mult: every flip-flop becomes a wire from D to Q: the value it would
+pub const TRANSPARENT: &str = r#"// rmapgen prove-mult: every flip-flop becomes a wire from D to Q: the value it would
 // take at an enabled clock edge with no reset (a synchronous reset that opt_dff found in
 // the logic in front of it is kept: it is part of that value).
 (* techmap_celltype = "$dff $dffe $adff $adffe $aldff $aldffe $dffsr $dffsre" *)
@@ -126,7 +126,7 @@ pub fn wrapper(job: &Job) -> String {
     let inputs = t.inputs();
     let mut v = String::new();
     v.push_str(&format!(
-        "// rmapgen prove --mult: {} = {} (generated from the plan's specification)\n",
+        "// rmapgen prove-mult: {} = {} (generated from the plan's specification)\n",
         job.name(),
         t.title
     ));

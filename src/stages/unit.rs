@@ -254,7 +254,7 @@ pub trait Unit: Sync {
     }
 
     /// What each of its adder trees computes, from its plan: the specifications the formal
-    /// proof of the multipliers checks the generated trees against (`rmapgen prove --mult`).
+    /// proof of the multipliers checks the generated trees against (`rmapgen prove-mult`).
     fn trees(&self, _cfg: &Config) -> Vec<crate::rtl::tree_spec::TreeSpec> {
         Vec::new()
     }

@@ -1,4 +1,4 @@
-//! `rmapgen prove --mult`: the Yosys proof that every adder tree equals its product passes on
+//! `rmapgen prove-mult`: the Yosys proof that every adder tree equals its product passes on
 //! a generated design with every tree stage, and fails, naming the tree, for each fault
 //! planted in a copy of the generated Verilog.
 
@@ -63,7 +63,7 @@ const PLANTS: &[(&str, &str, &str, &str, &str)] = &[
 
 fn prove(dir: &Path, logs: &Path) -> (bool, String, String) {
     let out = rmapgen()
-        .args(["prove", "--mult"])
+        .arg("prove-mult")
         .arg(dir)
         .arg("--logs")
         .arg(logs)
@@ -100,7 +100,7 @@ fn every_tree_is_proved_and_every_planted_fault_is_caught() {
         "color_mul.pb",
     ] {
         assert!(
-            out.contains(&format!("prove --mult: {tree} = ")),
+            out.contains(&format!("prove-mult: {tree} = ")),
             "{tree}: {out}"
         );
     }
@@ -122,7 +122,7 @@ fn every_tree_is_proved_and_every_planted_fault_is_caught() {
         let (ok, out, err) = prove(&bad, &tmp.path().join(format!("logs{k}")));
         assert!(!ok, "{what} must make the proof fail: {out}{err}");
         assert!(
-            err.contains(&format!("prove --mult: {tree} = ")) && err.contains("FAILED"),
+            err.contains(&format!("prove-mult: {tree} = ")) && err.contains("FAILED"),
             "{what}: the failure must name {tree}: {err}"
         );
         // Only the tree with the fault fails.

@@ -1,4 +1,4 @@
-//! `rmapgen prove --mult`: the formal proof that every adder tree of a generated design
+//! `rmapgen prove-mult`: the formal proof that every adder tree of a generated design
 //! equals the plain product its plan says it builds (`a * b + c`), on every input, with
 //! Yosys's SAT solver on the generated modules ([`crate::rtl::mult_proof`]).
 //!
@@ -16,14 +16,10 @@ use std::path::PathBuf;
 use std::process::{Command, ExitCode};
 
 #[derive(Args, Debug)]
-pub struct ProveArgs {
+pub struct ProveMultArgs {
     /// The generated design directory (`rmapgen generate --out DIR`).
     #[arg(value_name = "DIR")]
     pub dir: PathBuf,
-    /// Prove the multipliers: every adder tree against `a * b + c` (the only proof so far;
-    /// required, so that later proofs get their own flag).
-    #[arg(long, required = true)]
-    pub mult: bool,
     /// Directory for the Yosys script, the miters and yosys.log (replaced whole, also when
     /// the proof fails, so its log can be read).
     #[arg(long, value_name = "DIR", default_value = "build/prove-mult")]
@@ -32,7 +28,7 @@ pub struct ProveArgs {
     pub force: ForceArg,
 }
 
-pub fn run(a: &ProveArgs) -> Result<ExitCode> {
+pub fn run(a: &ProveMultArgs) -> Result<ExitCode> {
     let design = DesignDir::open(&a.dir)?;
     if !toolchain::installed(&yosys::yosys()) {
         bail!("{} not found (make tools installs it)", yosys::yosys());
@@ -40,7 +36,7 @@ pub fn run(a: &ProveArgs) -> Result<ExitCode> {
     let jobs = mult_proof::jobs(&design.config);
     let shown = a.dir.display();
     if jobs.is_empty() {
-        println!("prove --mult: {shown} has no adder tree");
+        println!("prove-mult: {shown} has no adder tree");
         return Ok(ExitCode::SUCCESS);
     }
     let staged = StagedDir::new(&a.logs, &a.force.policy(&[Some(design.path())]))?;
@@ -76,7 +72,7 @@ pub fn run(a: &ProveArgs) -> Result<ExitCode> {
     let log = shown_logs.join(yosys::LOG);
     if !ran.success() {
         eprintln!(
-            "prove --mult: {shown}: yosys failed ({}): {} (log: {})",
+            "prove-mult: {shown}: yosys failed ({}): {} (log: {})",
             ran.exit(),
             toolchain::complaint(&ran.output),
             log.display()
@@ -91,14 +87,14 @@ pub fn run(a: &ProveArgs) -> Result<ExitCode> {
     let cases: usize = results.iter().map(|r| r.cases).sum();
     if failed.is_empty() {
         println!(
-            "prove --mult: {shown}: all {} trees proved equal to their products ({cases} SAT cases, {:.1} s)",
+            "prove-mult: {shown}: all {} trees proved equal to their products ({cases} SAT cases, {:.1} s)",
             results.len(),
             ran.seconds
         );
         Ok(ExitCode::SUCCESS)
     } else {
         eprintln!(
-            "prove --mult: {shown}: FAILED: {} (log: {})",
+            "prove-mult: {shown}: FAILED: {} (log: {})",
             failed.join(" "),
             log.display()
         );
@@ -110,7 +106,7 @@ fn report(jobs: &[Job], results: &[mult_proof::TreeResult]) {
     for (j, r) in jobs.iter().zip(results) {
         if r.passed() {
             println!(
-                "prove --mult: {} = {}: proved ({} case{})",
+                "prove-mult: {} = {}: proved ({} case{})",
                 r.name,
                 r.title,
                 r.cases,
@@ -118,7 +114,7 @@ fn report(jobs: &[Job], results: &[mult_proof::TreeResult]) {
             );
         } else if let Some(case) = &r.failed {
             eprintln!(
-                "prove --mult: {} = {}: FAILED: the sum {} differs from the product{}",
+                "prove-mult: {} = {}: FAILED: the sum {} differs from the product{}",
                 r.name,
                 r.title,
                 j.spec.sum.sig.name,
@@ -130,7 +126,7 @@ fn report(jobs: &[Job], results: &[mult_proof::TreeResult]) {
             );
         } else {
             eprintln!(
-                "prove --mult: {} = {}: not proved ({} of {} cases ran)",
+                "prove-mult: {} = {}: not proved ({} of {} cases ran)",
                 r.name, r.title, r.proved, r.cases
             );
         }
