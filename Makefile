@@ -48,10 +48,10 @@ roms: build
 # AXI4-Stream top under cocotb (axis-test: makes the venv first), the default design placed
 # and routed (fpga-check: block RAMs and the Fmax target, ~20 s) and the same on an ECP5
 # (fpga-check-ecp5, ~1-2 min), the formal proofs of the handshake top with their planted faults
-# (formal, ~1 min) and the default design's synth_ice40 netlist simulated with the top
-# testbench (gate-sim, ~2 min). The venv comes before the cargo tests, whose ECP5 flow tests
-# need its YoWASP tools.
-test: tools venv cargo-test lint synth sim-all sim-handshake axis-test formal fpga-check fpga-check-ecp5 gate-sim
+# (formal, ~1 min), the multiplier proofs (formal-mult, ~1 min) and the default design's
+# synth_ice40 netlist simulated with the top testbench (gate-sim, ~2 min). The venv comes
+# before the cargo tests, whose ECP5 flow tests need its YoWASP tools.
+test: tools venv cargo-test lint synth sim-all sim-handshake axis-test formal formal-mult fpga-check fpga-check-ecp5 gate-sim
 	@echo "make test: all checks passed"
 
 # ---- Simulation (rmapgen sim, src/sim/): every testbench of the design generated with
@@ -193,6 +193,22 @@ prove: build
 	$(RMAPGEN) prove --merge $$(seq -f "$(PROVE_BUILD)/shard-%g-of-$(PROVE_SHARDS).json" 1 $(PROVE_SHARDS)) || status=1; \
 	echo "make prove: $$(( $$(date +%s) - start )) s wall on $(PROVE_SHARDS) shards"; \
 	exit $$status
+
+# ---- Multipliers (rmapgen prove-mult, src/rtl/mult_proof.rs): Yosys sat proves that every
+# adder tree of a generated design equals the product its plan states (a * b + c) on every
+# input: the default design ($(OUT), 5 trees, ~40 s) and the narrowest design with every tree
+# stage ($(MULT_OUT), 11 trees, ~7 s). The planted faults are in the cargo tests
+# (tests/it/mult_proof.rs). Logs in $(MULT_BUILD)/<design>.
+MULT_OUT   ?= build/rtl_mult
+MULT_BUILD ?= build/prove-mult
+MULT_FLAGS ?= --grad-bits 8 --red-bits 6 --recip-bits 5 --frac-bits 4 --index-bits 2 --interp-bits 1 --map-bits 6 --color --pipeline-depth 0
+
+.PHONY: formal-mult
+
+formal-mult: build
+	$(RMAPGEN) generate --out $(MULT_OUT) $(MULT_FLAGS)
+	YOSYS=$(YOSYS) $(RMAPGEN) prove-mult $(OUT) --logs $(MULT_BUILD)/$(notdir $(OUT))
+	YOSYS=$(YOSYS) $(RMAPGEN) prove-mult $(MULT_OUT) --logs $(MULT_BUILD)/$(notdir $(MULT_OUT))
 
 # ---- FPGA (src/rtl/fpga.rs): Yosys synth_ice40 and nextpnr-ice40 on the default design built
 # for the iCE40 (--target ice40; rtl_out/ is the portable --target generic): post-route Fmax,

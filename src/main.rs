@@ -63,6 +63,10 @@ enum Command {
     /// Synthesise a generated design with Yosys as a check: no latch, the memories inferred;
     /// prints its cells, memory bits and block RAMs (exit 1 if Yosys fails on it).
     Synth(cmd::synth::SynthArgs),
+    /// Prove with Yosys (sat) that every adder tree of a generated design equals the plain
+    /// product its plan builds (`a * b + c`) on every input; exit 1 naming each tree
+    /// that is not.
+    ProveMult(cmd::prove_mult::ProveMultArgs),
     /// Lint a generated design with Verilator --lint-only -Wall (exit 1 on any warning).
     Lint(cmd::lint::LintArgs),
     /// Prove a generated design equal to its model on every gradient: its own netlist's
@@ -94,6 +98,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Volume(a) => done(cmd::volume::run(&a)),
         Command::Sim(a) => cmd::sim::run(&a),
         Command::Synth(a) => cmd::synth::run(&a),
+        Command::ProveMult(a) => cmd::prove_mult::run(&a),
         Command::Lint(a) => cmd::lint::run(&a),
         Command::Prove(a) => cmd::prove::run(&a),
     }

@@ -11,6 +11,7 @@ pub mod map_args;
 pub mod maps;
 pub mod parse;
 pub mod prove;
+pub mod prove_mult;
 pub mod render;
 pub mod roms;
 pub mod sim;

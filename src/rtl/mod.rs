@@ -6,9 +6,11 @@
 pub mod adder_tree;
 pub mod fpga;
 pub mod manifest;
+pub mod mult_proof;
 pub mod package;
 pub mod ports;
 pub mod tb;
+pub mod tree_spec;
 pub mod verilated;
 
 use crate::design::Design;

@@ -252,6 +252,12 @@ pub trait Unit: Sync {
     fn vectors(&self) -> Option<&dyn Vectors> {
         None
     }
+
+    /// What each of its adder trees computes, from its plan: the specifications the formal
+    /// proof of the multipliers checks the generated trees against (`rmapgen prove-mult`).
+    fn trees(&self, _cfg: &Config) -> Vec<crate::rtl::tree_spec::TreeSpec> {
+        Vec::new()
+    }
 }
 
 /// Accepted vectors before the mid-stream reset of a testbench.

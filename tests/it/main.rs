@@ -21,6 +21,7 @@ mod map_fit;
 mod map_flags;
 mod map_stream;
 mod model_stages;
+mod mult_proof;
 mod output_safety;
 mod prefix;
 mod prove;

@@ -5,12 +5,15 @@
 use super::model::constants;
 use crate::config::{Config, COLOR_BITS};
 use crate::rtl::adder_tree::{self, registered, registered_at, Sig, Step, Sum, Term, Tree};
+use crate::rtl::tree_spec::{Factor, Product, TreeSpec};
 
 pub struct Plan {
     pub steps: Vec<Step>,
     /// n * K per channel r, g, b.
     pub products: Vec<Sum>,
     pub latency: u32,
+    /// What each tree computes: n = 2 c i + D, then n * K (the formal proof's specification).
+    pub specs: Vec<TreeSpec>,
 }
 
 impl Plan {
@@ -61,7 +64,34 @@ impl Plan {
         let mut steps = b1.steps;
         steps.extend(b2.steps);
         let latency = registered(&steps);
+        let mut specs = Vec::new();
+        for (j, c) in chans.iter().enumerate() {
+            let i = Sig::new("i_i", cfg.map_bits);
+            let ch = Sig::new(format!("{c}_i"), COLOR_BITS);
+            let mut t =
+                TreeSpec::product(&format!("n{c}"), "2 c i + D", i, ch, dd, b1.sums[j].clone());
+            t.products[0].shift = 1;
+            specs.push(t);
+        }
+        for (j, c) in chans.iter().enumerate() {
+            let n = b1.sums[j].plain();
+            specs.push(TreeSpec {
+                tree: format!("p{c}"),
+                title: "n * K".into(),
+                products: vec![Product {
+                    a: n.clone(),
+                    b: Factor::Const(k as u128),
+                    shift: 0,
+                }],
+                constant: 0,
+                sum: b2.sums[j].clone(),
+                // n is the numerator tree's sum, proved above to be 2 c i + D <= n_max.
+                at_most: vec![(n, n_max)],
+                split: None,
+            });
+        }
         Plan {
+            specs,
             products: b2.sums,
             steps,
             latency,

@@ -8,6 +8,7 @@ use crate::config::Config;
 use crate::rtl::adder_tree::{
     self, clock_q, registered, registered_at, Sig, Step, Sum, Term, Tree,
 };
+use crate::rtl::tree_spec::{Factor, Product, Split, TreeSpec};
 
 pub struct Plan {
     pub in_reg: bool,
@@ -16,6 +17,9 @@ pub struct Plan {
     pub steps: Vec<Step>,
     pub sum_r: Sum,
     pub latency: u32,
+    /// What each tree computes: a0 = e00 (S - wu) + e10 wu + S/2, a1 likewise, r = a0 (S - wv)
+    /// + a1 wv (the formal proof's specification).
+    pub specs: Vec<TreeSpec>,
 }
 
 impl Plan {
@@ -101,7 +105,66 @@ impl Plan {
         let mut steps = bu.steps;
         steps.extend(bv.steps);
         let latency = in_reg as u32 + registered(&steps);
+        let w = |n: &str| Sig::new(sfx(n), p + 1);
+        let blend = |tree: &str, lo: Sig, hi: Sig, wt: Sig, wc: Sig, c: u128, sum: &Sum| TreeSpec {
+            tree: tree.into(),
+            title: format!("{} * (S - w) + {} * w + {c}", lo.name, hi.name),
+            products: vec![
+                Product {
+                    a: lo,
+                    b: Factor::Sig(wc.clone()),
+                    shift: 0,
+                },
+                Product {
+                    a: hi,
+                    b: Factor::Sig(wt.clone()),
+                    shift: 0,
+                },
+            ],
+            constant: c,
+            sum: sum.clone(),
+            at_most: vec![(wt.clone(), s)],
+            split: Some(Split {
+                sig: wt,
+                last: s,
+                complement: Some((wc, s)),
+            }),
+        };
+        let mut specs = vec![
+            blend(
+                "a0",
+                e("e00"),
+                e("e10"),
+                w("wu"),
+                w("wuc"),
+                s / 2,
+                &bu.sums[0],
+            ),
+            blend(
+                "a1",
+                e("e01"),
+                e("e11"),
+                w("wu"),
+                w("wuc"),
+                s / 2,
+                &bu.sums[1],
+            ),
+        ];
+        let (a0, a1) = (bu.sums[0].plain(), bu.sums[1].plain());
+        let mut r = blend(
+            "r",
+            a0.clone(),
+            a1.clone(),
+            wv.clone(),
+            wvc.clone(),
+            0,
+            &bv.sums[0],
+        );
+        // a0 and a1 are the u pass's sums, proved above to stay within their bound.
+        r.at_most.extend([(a0, a_max), (a1, a_max)]);
+        specs.push(r);
         Plan {
+            specs,
             in_reg,
             in_q: in_q.clone(),
             sum_r: bv.sums[0].clone(),

@@ -7,6 +7,7 @@ use crate::config::Config;
 use crate::rtl::adder_tree::{
     self, clock_q, registered, registered_at, Sig, Step, Sum, Term, Tree,
 };
+use crate::rtl::tree_spec::{Factor, Product, TreeSpec};
 
 pub struct Plan {
     pub pre_reg: bool,
@@ -16,6 +17,8 @@ pub struct Plan {
     pub sum_u: Sum,
     pub sum_v: Sum,
     pub latency: u32,
+    /// What each tree computes: x' * POS_MAX + 2^(F-1) with x' <= 2^F.
+    pub specs: Vec<TreeSpec>,
 }
 
 impl Plan {
@@ -41,7 +44,26 @@ impl Plan {
             registered_at(d, n, k)
         });
         let latency = pre_reg as u32 + registered(&b.steps);
+        let spec = |t: &str, x: &str, sum: &Sum| {
+            let x = Sig::new(format!("{x}_{sfx}"), cfg.frac_bits + 1);
+            TreeSpec {
+                tree: t.into(),
+                title: format!("{} * POS_MAX + 2^(F-1)", x.name),
+                products: vec![Product {
+                    a: x.clone(),
+                    b: Factor::Const(cfg.pos_max() as u128),
+                    shift: 0,
+                }],
+                constant: cfg.frac_half() as u128,
+                sum: sum.clone(),
+                // u' is u, or 2^F for the all-ones code.
+                at_most: vec![(x, 1u128 << cfg.frac_bits)],
+                split: None,
+            }
+        };
+        let specs = vec![spec("su", "ux", &b.sums[0]), spec("sv", "vx", &b.sums[1])];
         Plan {
+            specs,
             pre_reg,
             in_q: in_q.clone(),
             sum_u: b.sums[0].clone(),

@@ -111,6 +111,10 @@ impl Unit for Normalise {
     fn vectors(&self) -> Option<&dyn Vectors> {
         Some(self)
     }
+
+    fn trees(&self, cfg: &Config) -> Vec<crate::rtl::tree_spec::TreeSpec> {
+        Plan::new(cfg).specs
+    }
 }
 
 impl Vectors for Normalise {

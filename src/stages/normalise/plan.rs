@@ -7,6 +7,7 @@ use crate::config::Config;
 use crate::rtl::adder_tree::{
     self, clock_q, registered, registered_at, Built, Sig, Step, Sum, Term, Tree,
 };
+use crate::rtl::tree_spec::TreeSpec;
 
 pub struct Plan {
     pub rom_reg: bool,
@@ -21,6 +22,8 @@ pub struct Plan {
     pub a_max: Sig,
     pub b_max: Sig,
     pub latency: u32,
+    /// What each tree computes: x * recip + HALF (the formal proof's specification).
+    pub specs: Vec<TreeSpec>,
 }
 
 impl Plan {
@@ -60,7 +63,15 @@ impl Plan {
             &|k, _| registered_at(d, anchor, k),
         );
         let latency = 1 + rom_reg as u32 + registered(&steps) + 1;
+        let half = cfg.norm_half() as u128;
+        let spec = |t: &str, x: &str, sum: &Sum| {
+            let title = format!("{x} * recip + HALF");
+            let x = Sig::new(format!("{x}_{q}"), cfg.red_bits);
+            TreeSpec::product(t, &title, x, recip.clone(), half, sum.clone())
+        };
+        let specs = vec![spec("pa", "a", &sums[0]), spec("pb", "b", &sums[1])];
         Plan {
+            specs,
             rom_reg,
             tree_q: tree_q.clone(),
             sum_a: sums[0].clone(),

@@ -1,0 +1,135 @@
+//! `rmapgen prove-mult`: the Yosys proof that every adder tree equals its product passes on
+//! a generated design with every tree stage, and fails, naming the tree, for each fault
+//! planted in a copy of the generated Verilog.
+
+use crate::hdl::{generate, require};
+use crate::helpers::{rmapgen, tempdir};
+use std::path::Path;
+
+/// The narrowest widths with every tree stage (normalise, interpolate, color_mul) at depth 0,
+/// where most levels are unregistered and the sums are wires: 11 trees, 268 SAT cases.
+const FLAGS: &[&str] = &[
+    "--grad-bits",
+    "8",
+    "--red-bits",
+    "6",
+    "--recip-bits",
+    "5",
+    "--frac-bits",
+    "4",
+    "--index-bits",
+    "2",
+    "--interp-bits",
+    "1",
+    "--map-bits",
+    "6",
+    "--color",
+    "--pipeline-depth",
+    "0",
+];
+
+/// (name, file, the generated text, its faulty replacement, the tree that must fail).
+const PLANTS: &[(&str, &str, &str, &str, &str)] = &[
+    (
+        "a partial product left out",
+        "normalise.v",
+        "(a_q1[3] ? {{1{1'b0}}, recip_q1} : 6'd0)",
+        "6'd0",
+        "normalise.pa",
+    ),
+    (
+        "a wrong rounding constant",
+        "color_mul.v",
+        "assign ng_l1_0_d = {(8'd31 +",
+        "assign ng_l1_0_d = {(8'd30 +",
+        "color_mul.ng",
+    ),
+    (
+        "a wrong shift of one term",
+        "interpolate.v",
+        "(wu_i[1] ? {{1{1'b0}}, e11_i} : 7'd0)",
+        "(wu_i[1] ? {e11_i, 1'b0} : 7'd0)",
+        "interpolate.a1",
+    ),
+    (
+        "a carry dropped between levels",
+        "color_mul.v",
+        // Bit 8 of level 1's node is its carry out (the node reaches 441).
+        "{{5{1'b0}}, nr_l1_0_d[8:3]}",
+        "{{6{1'b0}}, nr_l1_0_d[7:3]}",
+        "color_mul.nr",
+    ),
+];
+
+fn prove(dir: &Path, logs: &Path) -> (bool, String, String) {
+    let out = rmapgen()
+        .arg("prove-mult")
+        .arg(dir)
+        .arg("--logs")
+        .arg(logs)
+        .output()
+        .expect("rmapgen runs");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn every_tree_is_proved_and_every_planted_fault_is_caught() {
+    if !require("yosys") {
+        return;
+    }
+    let tmp = tempdir();
+    let good = tmp.path().join("good");
+    generate(&good, FLAGS, 0);
+    let (ok, out, err) = prove(&good, &tmp.path().join("logs"));
+    assert!(ok, "the generated design must prove: {out}{err}");
+    for tree in [
+        "normalise.pa",
+        "normalise.pb",
+        "interpolate.a0",
+        "interpolate.a1",
+        "interpolate.r",
+        "color_mul.nr",
+        "color_mul.ng",
+        "color_mul.nb",
+        "color_mul.pr",
+        "color_mul.pg",
+        "color_mul.pb",
+    ] {
+        assert!(
+            out.contains(&format!("prove-mult: {tree} = ")),
+            "{tree}: {out}"
+        );
+    }
+    assert!(out.contains("all 11 trees proved"), "{out}");
+
+    for (k, (what, file, old, new, tree)) in PLANTS.iter().enumerate() {
+        let bad = tmp.path().join(format!("bad{k}"));
+        std::fs::create_dir(&bad).unwrap();
+        for e in std::fs::read_dir(&good).unwrap() {
+            let e = e.unwrap();
+            if e.file_type().unwrap().is_file() {
+                std::fs::copy(e.path(), bad.join(e.file_name())).unwrap();
+            }
+        }
+        let path = bad.join(file);
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(text.matches(old).count(), 1, "{what}: {old} in {file}");
+        std::fs::write(&path, text.replace(old, new)).unwrap();
+        let (ok, out, err) = prove(&bad, &tmp.path().join(format!("logs{k}")));
+        assert!(!ok, "{what} must make the proof fail: {out}{err}");
+        assert!(
+            err.contains(&format!("prove-mult: {tree} = ")) && err.contains("FAILED"),
+            "{what}: the failure must name {tree}: {err}"
+        );
+        // Only the tree with the fault fails.
+        let failed: Vec<&str> = err
+            .lines()
+            .filter(|l| l.contains(": FAILED: the sum"))
+            .collect();
+        assert_eq!(failed.len(), 1, "{what}: {err}");
+    }
+}
