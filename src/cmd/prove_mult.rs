@@ -6,41 +6,104 @@
 //! tree and the first failing case), 2 for bad input.
 
 use super::force::ForceArg;
+use super::parse;
+use super::sim::{generate_row, selected_rows};
 use crate::design_dir::DesignDir;
-use crate::output::{absolute, StagedDir};
+use crate::grid::GridRow;
+use crate::output::{absolute, Policy, StagedDir};
 use crate::rtl::mult_proof::{self, Job};
 use crate::toolchain::{self, yosys};
 use anyhow::{bail, Result};
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::Instant;
 
 #[derive(Args, Debug)]
 pub struct ProveMultArgs {
-    /// The generated design directory (`rmapgen generate --out DIR`).
-    #[arg(value_name = "DIR")]
-    pub dir: PathBuf,
+    /// The generated design directory (`rmapgen generate --out DIR`). With --matrix, where
+    /// each row's design is generated, as DIR/<row> [default: build/matrix].
+    #[arg(value_name = "DIR", required_unless_present = "matrix")]
+    pub dir: Option<PathBuf>,
     /// Directory for the Yosys script, the miters and yosys.log (replaced whole, also when
-    /// the proof fails, so its log can be read).
+    /// the proof fails, so its log can be read). With --matrix, LOGS/<row>.
     #[arg(long, value_name = "DIR", default_value = "build/prove-mult")]
     pub logs: PathBuf,
+    /// Generate every configuration of the parameter grid (src/grid.rs) into DIR/<row> and
+    /// prove every tree of each; exit 1 naming each row that fails.
+    #[arg(long)]
+    pub matrix: bool,
+    /// With --matrix: only these rows (repeat the flag or separate with commas).
+    #[arg(long, value_name = "NAME", requires = "matrix", value_delimiter = ',')]
+    pub row: Vec<String>,
+    /// With --matrix: Yosys processes side by side (default: JOBS, else the cores).
+    #[arg(long, value_name = "N", requires = "matrix", value_parser = parse::whole::<usize>(1, 64))]
+    pub jobs: Option<usize>,
     #[command(flatten)]
     pub force: ForceArg,
 }
 
 pub fn run(a: &ProveMultArgs) -> Result<ExitCode> {
-    let design = DesignDir::open(&a.dir)?;
+    // Bad input first (the rows, the directory), then the tool, then the runs.
+    let failed = if a.matrix {
+        let rows = selected_rows(&a.row)?;
+        need_yosys()?;
+        matrix(a, &rows)?
+    } else {
+        let dir = a
+            .dir
+            .as_deref()
+            .expect("clap requires DIR without --matrix");
+        let design = DesignDir::open(dir)?;
+        need_yosys()?;
+        let proof = prove(&design, &a.logs, &a.force.policy(&[Some(design.path())]))?;
+        print!("{}", proof.stdout);
+        eprint!("{}", proof.stderr);
+        !proof.passed
+    };
+    Ok(if failed {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+fn need_yosys() -> Result<()> {
     if !toolchain::installed(&yosys::yosys()) {
         bail!("{} not found (make tools installs it)", yosys::yosys());
     }
+    Ok(())
+}
+
+/// One design's proof: whether every tree was proved, what to print, the SAT cases and the
+/// seconds Yosys took.
+struct Proof {
+    passed: bool,
+    stdout: String,
+    stderr: String,
+    cases: usize,
+    seconds: f64,
+}
+
+/// Proves every tree of `design`, its script, miters and log staged into `logs`.
+fn prove(design: &DesignDir, logs: &Path, policy: &Policy) -> Result<Proof> {
     let jobs = mult_proof::jobs(&design.config);
-    let shown = a.dir.display();
+    let shown = design.path().display();
+    let mut p = Proof {
+        passed: true,
+        stdout: String::new(),
+        stderr: String::new(),
+        cases: 0,
+        seconds: 0.0,
+    };
     if jobs.is_empty() {
-        println!("prove-mult: {shown} has no adder tree");
-        return Ok(ExitCode::SUCCESS);
+        p.stdout = format!("prove-mult: {shown} has no adder tree\n");
+        return Ok(p);
     }
-    let staged = StagedDir::new(&a.logs, &a.force.policy(&[Some(design.path())]))?;
-    let logs = absolute(staged.path());
+    let staged = StagedDir::new(logs, policy)?;
+    let dir = absolute(staged.path());
     staged.write_text(mult_proof::TRANSPARENT_FILE, mult_proof::TRANSPARENT)?;
     let mut wrappers = Vec::new();
     for j in &jobs {
@@ -62,59 +125,125 @@ pub fn run(a: &ProveMultArgs) -> Result<ExitCode> {
     cmd.args(["-q", "-l"])
         .arg(yosys::LOG)
         .args(["-s", "mult.ys"])
-        .current_dir(&logs);
+        .current_dir(&dir);
     let ran = toolchain::capture(&mut cmd);
-    let log_text = std::fs::read_to_string(logs.join(yosys::LOG)).unwrap_or_default();
+    let log_text = std::fs::read_to_string(dir.join(yosys::LOG)).unwrap_or_default();
     let shown_logs = absolute(&staged.commit()?);
     let ran = ran?;
     let results = mult_proof::results(&jobs, &log_text);
-    report(&jobs, &results);
+    report(&jobs, &results, &mut p);
     let log = shown_logs.join(yosys::LOG);
+    p.seconds = ran.seconds;
+    p.cases = results.iter().map(|r| r.cases).sum();
     if !ran.success() {
-        eprintln!(
-            "prove-mult: {shown}: yosys failed ({}): {} (log: {})",
+        p.passed = false;
+        p.stderr += &format!(
+            "prove-mult: {shown}: yosys failed ({}): {} (log: {})\n",
             ran.exit(),
             toolchain::complaint(&ran.output),
             log.display()
         );
-        return Ok(ExitCode::FAILURE);
+        return Ok(p);
     }
     let failed: Vec<&str> = results
         .iter()
         .filter(|r| !r.passed())
         .map(|r| r.name.as_str())
         .collect();
-    let cases: usize = results.iter().map(|r| r.cases).sum();
     if failed.is_empty() {
-        println!(
-            "prove-mult: {shown}: all {} trees proved equal to their products ({cases} SAT cases, {:.1} s)",
+        p.stdout += &format!(
+            "prove-mult: {shown}: all {} trees proved equal to their products ({} SAT cases, {:.1} s)\n",
             results.len(),
+            p.cases,
             ran.seconds
         );
-        Ok(ExitCode::SUCCESS)
     } else {
-        eprintln!(
-            "prove-mult: {shown}: FAILED: {} (log: {})",
+        p.passed = false;
+        p.stderr += &format!(
+            "prove-mult: {shown}: FAILED: {} (log: {})\n",
             failed.join(" "),
             log.display()
         );
-        Ok(ExitCode::FAILURE)
     }
+    Ok(p)
 }
 
-fn report(jobs: &[Job], results: &[mult_proof::TreeResult]) {
+/// Every selected row of the grid: generated into DIR/<row>, then proved, `--jobs` rows at a
+/// time (each row is one Yosys process); each row's report printed whole as it finishes.
+/// Whether any failed.
+fn matrix(a: &ProveMultArgs, rows: &[GridRow]) -> Result<bool> {
+    let root = a.dir.clone().unwrap_or_else(|| "build/matrix".into());
+    let policy = a.force.policy(&[]);
+    // Generated first, in order, so that a bad directory stops the run before any proof.
+    let mut designs = Vec::new();
+    for r in rows {
+        designs.push(generate_row(r, &root.join(r.name), &policy)?);
+    }
+    let workers = a
+        .jobs
+        .unwrap_or_else(toolchain::jobs)
+        .min(rows.len())
+        .max(1);
+    let next = AtomicUsize::new(0);
+    let out: Mutex<Vec<Option<Result<Proof>>>> =
+        Mutex::new((0..rows.len()).map(|_| None).collect());
+    let start = Instant::now();
+    std::thread::scope(|s| {
+        for _ in 0..workers {
+            s.spawn(|| loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                let Some(r) = rows.get(i) else { break };
+                let proof = prove(&designs[i], &a.logs.join(r.name), &policy);
+                if let Ok(p) = &proof {
+                    // One row's lines together, under its name.
+                    let mut all =
+                        format!("==== {}: {} ({})\n", r.name, r.config.summary(), r.covers);
+                    all += &p.stdout;
+                    print!("{all}");
+                    eprint!("{}", p.stderr);
+                }
+                out.lock().expect("no worker panics")[i] = Some(proof);
+            });
+        }
+    });
+    let mut failed = Vec::new();
+    let (mut cases, mut cpu) = (0usize, 0.0f64);
+    for (r, p) in rows.iter().zip(out.into_inner().expect("no worker panics")) {
+        let p = p.expect("every row ran")?;
+        cases += p.cases;
+        cpu += p.seconds;
+        if !p.passed {
+            failed.push(r.name);
+        }
+    }
+    if failed.is_empty() {
+        println!(
+            "prove-mult: every row proved ({} row{}, {cases} SAT cases, {:.0} s of Yosys in {:.0} s on {workers} job{})",
+            rows.len(),
+            if rows.len() == 1 { "" } else { "s" },
+            cpu,
+            start.elapsed().as_secs_f64(),
+            if workers == 1 { "" } else { "s" }
+        );
+    } else {
+        println!("prove-mult: FAILED: {}", failed.join(" "));
+    }
+    Ok(!failed.is_empty())
+}
+
+fn report(jobs: &[Job], results: &[mult_proof::TreeResult], p: &mut Proof) {
     for (j, r) in jobs.iter().zip(results) {
         if r.passed() {
-            println!(
-                "prove-mult: {} = {}: proved ({} case{})",
+            p.stdout += &format!(
+                "prove-mult: {} = {}: proved ({} case{})\n",
                 r.name,
                 r.title,
                 r.cases,
                 if r.cases == 1 { "" } else { "s" }
             );
         } else if let Some(case) = &r.failed {
-            eprintln!(
-                "prove-mult: {} = {}: FAILED: the sum {} differs from the product{}",
+            p.stderr += &format!(
+                "prove-mult: {} = {}: FAILED: the sum {} differs from the product{}\n",
                 r.name,
                 r.title,
                 j.spec.sum.sig.name,
@@ -125,8 +254,8 @@ fn report(jobs: &[Job], results: &[mult_proof::TreeResult]) {
                 }
             );
         } else {
-            eprintln!(
-                "prove-mult: {} = {}: not proved ({} of {} cases ran)",
+            p.stderr += &format!(
+                "prove-mult: {} = {}: not proved ({} of {} cases ran)\n",
                 r.name, r.title, r.proved, r.cases
             );
         }

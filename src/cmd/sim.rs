@@ -12,7 +12,7 @@ use super::generate;
 use super::parse;
 use crate::design_dir::DesignDir;
 use crate::grid::{self, GridRow};
-use crate::output::{absolute, StagedDir};
+use crate::output::{absolute, Policy, StagedDir};
 use crate::scene::Scene;
 use crate::sim::{self, Options, Outcome};
 use crate::vectors::MAX_STREAM_VECTORS;
@@ -182,7 +182,7 @@ fn matrix(a: &SimArgs, opts: &Options, rows: &[GridRow]) -> Result<bool> {
     let mut failed = Vec::new();
     for r in rows {
         println!("==== {}: {} ({})", r.name, r.config.summary(), r.covers);
-        let design = generate_row(r, &root.join(r.name), a)?;
+        let design = generate_row(r, &root.join(r.name), &a.force.policy(&[]))?;
         if !simulate(&design, a, opts)?.failed.is_empty() {
             failed.push(r.name);
         }
@@ -197,7 +197,7 @@ fn matrix(a: &SimArgs, opts: &Options, rows: &[GridRow]) -> Result<bool> {
 
 /// The rows named (all when none is), in the grid's order; an unknown name is an error
 /// listing the rows.
-fn selected_rows(names: &[String]) -> Result<Vec<GridRow>> {
+pub(crate) fn selected_rows(names: &[String]) -> Result<Vec<GridRow>> {
     let rows = grid::rows();
     if let Some(n) = names
         .iter()
@@ -216,12 +216,12 @@ fn selected_rows(names: &[String]) -> Result<Vec<GridRow>> {
 }
 
 /// Generates a row's design (the standard scene, `generate`'s default vectors) into `dir`.
-fn generate_row(r: &GridRow, dir: &Path, a: &SimArgs) -> Result<DesignDir> {
+pub(crate) fn generate_row(r: &GridRow, dir: &Path, policy: &Policy) -> Result<DesignDir> {
     let (dir, _) = generate::write_dir(
         &r.config,
         &Scene::standard(),
         dir,
-        &a.force.policy(&[]),
+        policy,
         generate::DEFAULT_VECTORS,
         generate::DEFAULT_SEED,
         &[],

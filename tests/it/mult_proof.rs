@@ -133,3 +133,43 @@ fn every_tree_is_proved_and_every_planted_fault_is_caught() {
         assert_eq!(failed.len(), 1, "{what}: {err}");
     }
 }
+
+/// `--matrix` generates grid rows and proves each (here the narrowest row, 5 trees, ~5 s);
+/// an unknown row is bad input (one line, exit 2) before anything is generated.
+#[test]
+fn the_matrix_proves_the_rows_named_and_refuses_an_unknown_row() {
+    if !require("yosys") {
+        return;
+    }
+    let tmp = tempdir();
+    let out = rmapgen()
+        .arg("prove-mult")
+        .arg(tmp.path().join("designs"))
+        .args(["--matrix", "--row", "narrowest", "--jobs", "1", "--logs"])
+        .arg(tmp.path().join("logs"))
+        .output()
+        .expect("rmapgen runs");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(text.contains("==== narrowest: "), "{text}");
+    assert!(text.contains("all 5 trees proved"), "{text}");
+    assert!(text.contains("every row proved (1 row,"), "{text}");
+    assert!(tmp.path().join("logs/narrowest/yosys.log").is_file());
+
+    let bad = tmp.path().join("bad");
+    let out = rmapgen()
+        .arg("prove-mult")
+        .arg(&bad)
+        .args(["--matrix", "--row", "no_such_row"])
+        .output()
+        .expect("rmapgen runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(err.contains("no_such_row"), "{err}");
+    assert!(!bad.exists());
+}
