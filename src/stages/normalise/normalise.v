@@ -23,7 +23,7 @@ module {= h.module =}{= h.params =} (
   localparam F  = {= f =};  // fraction width
   localparam RA = {= ra =};  // reciprocal ROM address width
   localparam SH = {= sh =};  // a * recip >> SH is an F-bit fraction: R-1+W-F
-  localparam SW = {= sw =};  // a * recip + HALF (the multiplier's result)
+  localparam SW = {= sw =};  // a * recip + HALF ({% if infer %}the product and sum{% else %}the adder tree{% endif %}'s result)
   localparam LATENCY = {= latency =};
 
   // ---------------------------------------------------------------- ROM read and compare
