@@ -259,10 +259,10 @@ mod tests {
         let b = build("t", &[m], &[("f", Sig::new("f_q", 1))], &|_, _| true);
         assert_eq!(b.steps.len(), 2);
         let p = &b.steps[0].nodes[0];
-        assert_eq!((p.name.as_str(), p.width), ("p_l1", 18));
+        assert_eq!((p.name.as_str(), p.width), ("p_l1_0", 18));
         assert_eq!(p.expr, "{{10{1'b0}}, a} * {{8{1'b0}}, x}");
         let s = &b.steps[1].nodes[0];
-        assert_eq!(s.expr, "p_l1_q + 18'd256");
+        assert_eq!(s.expr, "p_l1_0_q + 18'd256");
         assert_eq!(b.sums[0].sig.name, "p_l2_q");
         assert_eq!(b.riders[0].name, "f_l2_q");
     }
@@ -290,9 +290,6 @@ mod tests {
         let b = build("t", &[lone, two], &[], &|_, _| true);
         assert_eq!(b.steps[0].nodes[0].expr, "{{3{1'b0}}, n} * 12'd5");
         assert_eq!(b.sums[0].sig.name, "q_l2_q");
-        assert_eq!(
-            b.steps[1].nodes[1].expr,
-            "{{1{1'b0}}, p_l1_q, {1{1'b0}}} + 10'd3"
-        );
+        assert_eq!(b.steps[1].nodes[1].expr, "{p_l1_0_q, {1{1'b0}}} + 9'd3");
     }
 }
