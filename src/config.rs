@@ -71,6 +71,42 @@ pub struct Config {
     /// when 1, so a design without lanes is written as before the field existed.
     #[serde(skip_serializing_if = "is_one")]
     pub lanes: u32,
+    /// How the multipliers are written: [`Mult`]. Left out of the TOML and JSON when `tree`
+    /// (the default), so a design without it is written as before the field existed.
+    #[serde(skip_serializing_if = "Mult::is_tree")]
+    pub mult: Mult,
+}
+
+/// How the multipliers are written (docs/ARCHITECTURE.md, "Multipliers"). The products, the
+/// ports and the results are the same for both; only the Verilog of each product and where
+/// its registers sit differ, each stage's `Plan` decides both and counts the latency.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum Mult {
+    /// Adder trees of partial products, one LUT level and one carry chain per level
+    /// (src/rtl/adder_tree.rs): for devices without multipliers (iCE40 HX).
+    #[default]
+    Tree,
+    /// Plain `a * b` products with explicit widths, registered in front of the sum so that a
+    /// DSP block (ECP5 MULT18X18D, iCE40 UltraPlus SB_MAC16) absorbs the product and its
+    /// register (src/rtl/infer.rs).
+    Infer,
+}
+
+impl Mult {
+    pub fn is_tree(&self) -> bool {
+        *self == Mult::Tree
+    }
+
+    /// `tree` or `infer`, as the flag and the TOML spell it.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Mult::Tree => "tree",
+            Mult::Infer => "infer",
+        }
+    }
 }
 
 /// How the memories are written (docs/ARCHITECTURE.md, "Targets"). The arithmetic, the ports
@@ -252,6 +288,7 @@ impl Default for Config {
             axis_user: 0,
             target: Target::Generic,
             lanes: 1,
+            mult: Mult::Tree,
         }
     }
 }
@@ -561,6 +598,10 @@ impl Config {
             format!(" lanes={}", self.lanes)
         } else {
             String::new()
+        } + &if self.mult.is_tree() {
+            String::new()
+        } else {
+            format!(" mult={}", self.mult.name())
         }
     }
 }
@@ -743,5 +784,19 @@ mod tests {
         let t = toml::to_string(&Config::default()).unwrap();
         assert!(!t.contains("axis"), "{t}");
         assert!(!t.contains("lanes"), "{t}");
+        assert!(!t.contains("mult"), "{t}");
+        assert!(!Config::default().summary().contains("mult"));
+        let infer = Config {
+            mult: Mult::Infer,
+            ..Config::default()
+        };
+        assert!(toml::to_string(&infer)
+            .unwrap()
+            .contains("mult = \"infer\""));
+        assert!(
+            infer.summary().ends_with(" mult=infer"),
+            "{}",
+            infer.summary()
+        );
     }
 }

@@ -8,9 +8,10 @@
 //! both ends of its range (recip_bits at its smallest legal value, frac_bits + 1), each of the
 //! eight combinations of compensation, interpolation and colour, every pipeline depth, and the
 //! handshake on and off, both memory targets, mixed so that the ends meet each other and the
-//! optional stages, the AXI4-Stream top, and 2 and 4 lanes with and without the handshake.
+//! optional stages, the AXI4-Stream top, 2 and 4 lanes with and without the handshake, and
+//! both multiplier styles (`--mult infer` at every depth, with and without the handshake).
 
-use crate::config::{Config, Target, RANGES};
+use crate::config::{Config, Mult, Target, RANGES};
 
 /// One configuration of the grid.
 #[derive(Clone, Debug, PartialEq)]
@@ -30,7 +31,7 @@ macro_rules! grid {
     ($( $name:ident: $g:literal $r:literal $w:literal $f:literal $i:literal $p:literal $m:literal
         $comp:literal $interp:literal $color:literal $depth:literal $hs:literal $icarus:literal
         $ice40:literal
-        $(axis $user:literal)? $(lanes $lanes:literal)? $covers:literal; )*) => {
+        $(axis $user:literal)? $(lanes $lanes:literal)? $(mult $mult:ident)? $covers:literal; )*) => {
         /// Every row, in the order below.
         pub fn rows() -> Vec<GridRow> {
             vec![$(GridRow {
@@ -45,6 +46,7 @@ macro_rules! grid {
                     axis: false $(|| { let _: u32 = $user; true })?,
                     axis_user: 0 $(+ $user)?,
                     lanes: 1 $(- 1 + $lanes)?,
+                    mult: *[Mult::Tree $(, Mult::$mult)?].last().expect("a style"),
                 },
                 icarus: $icarus == 1,
                 covers: $covers,
@@ -56,7 +58,8 @@ macro_rules! grid {
 // G grad, R reduced, W reciprocal entry, F fraction, I index, P interpolation fraction, M map
 // entry bits; comp(ensation), interp(olation), color, pipeline depth, handshake, run in Icarus,
 // --target ice40 (else generic); `axis U`: the AXI4-Stream top rmap_axis with a U-bit tuser;
-// `lanes L`: the lanes top rmap_lanes with L lanes (its testbench runs in place of rmap_top's).
+// `lanes L`: the lanes top rmap_lanes with L lanes (its testbench runs in place of rmap_top's);
+// `mult Infer`: inferred multipliers (`--mult infer`), else adder trees.
 grid! {
 //                  G  R  W  F  I  P  M  comp interp color depth hs icarus ice40
     paper:          12 8  10 8  3  3  8  1    1      0     2     0  1  0
@@ -119,6 +122,14 @@ grid! {
         "four lanes of the smallest design (neither optional stage, compact registers)";
     lanes4_hs:      12 8  10 8  3  0  8  1    0      0     1     1  0  0  lanes 4
         "four lanes under whole-beat backpressure, nearest entry";
+    paper_infer:    12 8  10 8  3  3  8  1    1      0     2     0  1  0  mult Infer
+        "the paper's design with inferred multipliers (--mult infer): plain products for DSP blocks";
+    color_infer:    12 8  10 8  3  3  8  0    1      1     0     0  1  0  mult Infer
+        "inferred multipliers in every multiplying stage (linear index, interpolation, colour), compact registers";
+    hs_infer:       12 8  10 8  3  3  8  1    1      1     1     1  0  0  mult Infer
+        "inferred multipliers with colour under backpressure, at the middle depth";
+    widest_infer:   16 12 20 12 6  5  12 1    1      1     2     1  0  1  mult Infer
+        "inferred multipliers at the widest widths (products wider than one 18 x 18 DSP), every stage, the handshake";
 }
 
 /// The row called `name`.

@@ -57,6 +57,10 @@ pub struct ConfigArgs {
     pub axis_user: Option<u32>,
     #[arg(long, value_name = "L", value_parser = parse::field("lanes"), help = parse::field_help("lanes", "Parallel lanes: L samples in and L results out per clock (the top becomes rmap_lanes, one rmap_top per lane)", ""))]
     pub lanes: Option<u32>,
+    /// Multipliers: tree (adder trees of partial products, for devices without multipliers)
+    /// or infer (plain `*` products registered so DSP blocks absorb them) [default: tree].
+    #[arg(long, value_enum, value_name = "M")]
+    pub mult: Option<crate::config::Mult>,
 }
 
 impl ConfigArgs {
@@ -104,6 +108,9 @@ impl ConfigArgs {
         }
         if !cfg.target.is_generic() {
             f.extend(["--target".into(), cfg.target.name().into()]);
+        }
+        if !cfg.mult.is_tree() {
+            f.extend(["--mult".into(), cfg.mult.name().into()]);
         }
         f
     }
@@ -176,6 +183,10 @@ impl ConfigArgs {
         if let Some(t) = self.target {
             c.target = t;
             flags.push(("target", format!("--target {}", t.name())));
+        }
+        if let Some(m) = self.mult {
+            c.mult = m;
+            flags.push(("mult", format!("--mult {}", m.name())));
         }
         let Err(e) = c.validate() else {
             return Ok(c);

@@ -5,6 +5,7 @@
 
 pub mod adder_tree;
 pub mod fpga;
+pub mod infer;
 pub mod manifest;
 pub mod mult_proof;
 pub mod package;

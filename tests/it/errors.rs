@@ -795,3 +795,29 @@ proptest! {
         load_both(&String::from_utf8_lossy(&bytes))?;
     }
 }
+
+/// Issue 15 §3: an unknown multiplier style, from the flag or from the file; one line, exit 2,
+/// nothing written.
+#[test]
+fn an_unknown_multiplier_style_is_refused() {
+    let t = tempdir();
+    let o = t.path().join("o");
+    let o_ = o.to_str().unwrap();
+    let c = t.path().join("c.toml");
+    std::fs::write(&c, "mult = \"dsp\"\n").unwrap();
+    let c_ = c.to_str().unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &["generate", "--mult", "dsp", "--out", o_],
+            "invalid value 'dsp' for '--mult <M>'",
+        ),
+        (
+            &["generate", "--config", c_, "--out", o_],
+            "mult: unknown variant `dsp`",
+        ),
+    ];
+    for (args, needle) in cases {
+        assert_error(&run(args), needle);
+    }
+    assert!(!o.exists());
+}

@@ -12,7 +12,7 @@
 
 use crate::hdl::{self, require};
 use crate::helpers;
-use rmapgen::config::{Target, PIPELINE_DEPTHS, RANGES};
+use rmapgen::config::{Mult, Target, PIPELINE_DEPTHS, RANGES};
 use rmapgen::grid::{self, GridRow};
 use std::path::Path;
 
@@ -40,6 +40,7 @@ tests! {
     no_interp_color, bare_color, narrowest, narrowest_bare, widest, widest_depth0, grad16_red6,
     grad8_red8, no_truncation, frac4_recip20, frac12_recip13, index6_interp1, index2_interp5,
     map12, map6_nearest, index6_nearest, axis_color, lanes2, lanes2_hs, lanes4, lanes4_hs,
+    paper_infer, color_infer, hs_infer, widest_infer,
 }
 
 #[test]
@@ -189,6 +190,28 @@ fn grid_covers_every_range_end_and_switch() {
     assert!(ic.iter().any(|r| r.config.handshake) && ic.iter().any(|r| !r.config.interpolation));
     assert!(ic.iter().any(|r| r.config.target == Target::Ice40));
     assert!(ic.iter().any(|r| r.config.axis && r.config.axis_user > 0));
+    // Inferred multipliers (--mult infer): the paper's design, colour, the widest widths, the
+    // handshake, every depth (each places the products' registers differently), in Icarus too.
+    let inf: Vec<&GridRow> = rows
+        .iter()
+        .filter(|r| r.config.mult == Mult::Infer)
+        .collect();
+    assert!(inf.iter().any(|r| r.config
+        == rmapgen::config::Config {
+            mult: Mult::Infer,
+            ..Default::default()
+        }));
+    assert!(inf.iter().any(|r| r.config.color) && inf.iter().any(|r| r.config.handshake));
+    assert!(inf.iter().any(|r| !r.config.compensation) && inf.iter().any(|r| r.icarus));
+    assert!(inf
+        .iter()
+        .any(|r| r.config.grad_bits == 16 && r.config.recip_bits == 20));
+    for depth in PIPELINE_DEPTHS.0..=PIPELINE_DEPTHS.1 {
+        assert!(
+            inf.iter().any(|r| r.config.pipeline_depth == depth),
+            "no row with --mult infer at depth {depth}"
+        );
+    }
     // Lanes: 2 and 4, each with and without the handshake.
     for lanes in [2, 4] {
         for hs in [false, true] {

@@ -173,3 +173,73 @@ fn the_matrix_proves_the_rows_named_and_refuses_an_unknown_row() {
     assert!(err.contains("no_such_row"), "{err}");
     assert!(!bad.exists());
 }
+
+/// `--mult infer`: the Verilog holds plain `*` products and no partial product (no gated
+/// term `sel ? x : 0` in a multiplying stage), the same specifications prove against the
+/// inferred products and their sums, and a planted fault in one sum is caught by name.
+#[test]
+fn inferred_products_are_plain_and_proved_and_a_planted_fault_is_caught() {
+    let tmp = tempdir();
+    let good = tmp.path().join("infer");
+    let flags: Vec<&str> = FLAGS.iter().copied().chain(["--mult", "infer"]).collect();
+    generate(&good, &flags, 0);
+    // The tree design of the same widths, where the same count finds partial products and
+    // no product: the check can fail.
+    let tree = tmp.path().join("tree");
+    generate(&tree, FLAGS, 0);
+    let count = |dir: &Path, file: &str| {
+        let text = std::fs::read_to_string(dir.join(file)).unwrap();
+        let assigns = || {
+            text.lines()
+                .filter(|l| l.trim_start().starts_with("assign"))
+        };
+        // A partial product is a gated term, `(sel ? x : N'd0)`.
+        let gated = assigns().filter(|l| l.contains(" ? ") && l.contains("'d0)"));
+        (
+            assigns().filter(|l| l.contains(" * ")).count(),
+            gated.count(),
+        )
+    };
+    for (file, products) in [("normalise.v", 2), ("interpolate.v", 6), ("color_mul.v", 6)] {
+        assert_eq!(
+            count(&good, file),
+            (products, 0),
+            "{file}: plain products only"
+        );
+        let (muls, gated) = count(&tree, file);
+        assert!(
+            muls == 0 && gated > 0,
+            "{file} of the tree design: {muls} {gated}"
+        );
+    }
+    if !require("yosys") {
+        return;
+    }
+    let (ok, out, err) = prove(&good, &tmp.path().join("logs"));
+    assert!(ok, "the inferred design must prove: {out}{err}");
+    assert!(out.contains("all 11 trees proved"), "{out}");
+    let bad = tmp.path().join("bad");
+    std::fs::create_dir(&bad).unwrap();
+    for e in std::fs::read_dir(&good).unwrap() {
+        let e = e.unwrap();
+        if e.file_type().unwrap().is_file() {
+            std::fs::copy(e.path(), bad.join(e.file_name())).unwrap();
+        }
+    }
+    let path = bad.join("color_mul.v");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let (old, new) = (
+        "assign ng_l2_d = {ng_l1_0_d, {1{1'b0}}} + 15'd63;",
+        "assign ng_l2_d = {ng_l1_0_d, {1{1'b0}}} + 15'd62;",
+    );
+    assert_eq!(text.matches(old).count(), 1, "{old}");
+    std::fs::write(&path, text.replace(old, new)).unwrap();
+    let (ok, out, err) = prove(&bad, &tmp.path().join("logs_bad"));
+    assert!(!ok, "a wrong constant must make the proof fail: {out}{err}");
+    let failed: Vec<&str> = err
+        .lines()
+        .filter(|l| l.contains(": FAILED: the sum"))
+        .collect();
+    assert_eq!(failed.len(), 1, "{err}");
+    assert!(failed[0].contains("prove-mult: color_mul.ng = "), "{err}");
+}

@@ -23,6 +23,8 @@ pub struct ColorMul;
 #[template(path = "color_mul/color_mul.v", syntax = "verilog")]
 struct Verilog {
     h: Head,
+    /// `mult = infer`: the comments describe plain products, not adder trees.
+    infer: bool,
     depth: u32,
     latency: u32,
     s: u32,
@@ -65,6 +67,7 @@ impl Unit for ColorMul {
         let pw = model::product_bits(cfg);
         Verilog {
             h,
+            infer: !cfg.mult.is_tree(),
             depth: cfg.pipeline_depth,
             latency: p.latency,
             s,

@@ -1,10 +1,12 @@
 //! Where color_mul's registers sit: the numerators 2 c i + D as adder trees of
 //! colour-bit-gated copies of the intensity, then n * K as a tree of shifted copies of n (one
-//! per set bit of K); every registered level is a clock.
+//! per set bit of K) (`mult = tree`), or inferred products (`mult = infer`); every registered
+//! level is a clock.
 
 use super::model::constants;
-use crate::config::{Config, COLOR_BITS};
+use crate::config::{Config, Mult, COLOR_BITS};
 use crate::rtl::adder_tree::{self, registered, registered_at, Sig, Step, Sum, Term, Tree};
+use crate::rtl::infer::{self, Mul};
 use crate::rtl::tree_spec::{Factor, Product, TreeSpec};
 
 pub struct Plan {
@@ -23,6 +25,7 @@ impl Plan {
         let dd = cfg.map_max() as u128;
         let n_max = 2 * ((1u128 << COLOR_BITS) - 1) * dd + dd;
         let chans = ["r", "g", "b"];
+        let (title1, title2) = ("numerators 2 c i + D", "products n * K");
         let num: Vec<Tree> = chans
             .iter()
             .map(|c| Tree {
@@ -38,10 +41,29 @@ impl Plan {
                 bound: Some(n_max),
             })
             .collect();
-        let n1 = adder_tree::levels(&num[0]);
-        let b1 = adder_tree::build("numerators 2 c i + D", &num, &[], &|kk, _| {
-            registered_at(d, n1, kk)
-        });
+        let b1 = match cfg.mult {
+            Mult::Tree => {
+                let n1 = adder_tree::levels(&num[0]);
+                adder_tree::build(title1, &num, &[], &|kk, _| registered_at(d, n1, kk))
+            }
+            Mult::Infer => {
+                let muls: Vec<Mul> = chans
+                    .iter()
+                    .map(|c| Mul {
+                        name: format!("n{c}"),
+                        products: vec![Product {
+                            a: Sig::new("i_i", cfg.map_bits),
+                            b: Factor::Sig(Sig::new(format!("{c}_i"), COLOR_BITS)),
+                            shift: 1,
+                        }],
+                        constant: dd,
+                        bound: Some(n_max),
+                    })
+                    .collect();
+                let n1 = muls[0].levels();
+                infer::build(title1, &muls, &[], &|kk, _| registered_at(d, n1, kk))
+            }
+        };
         let prod: Vec<Tree> = chans
             .iter()
             .zip(&b1.sums)
@@ -57,10 +79,30 @@ impl Plan {
                 bound: Some(n_max * k as u128),
             })
             .collect();
-        let n2 = adder_tree::levels(&prod[0]);
-        let b2 = adder_tree::build("products n * K", &prod, &[], &|kk, _| {
-            registered_at(d, n2, kk)
-        });
+        let b2 = match cfg.mult {
+            Mult::Tree => {
+                let n2 = adder_tree::levels(&prod[0]);
+                adder_tree::build(title2, &prod, &[], &|kk, _| registered_at(d, n2, kk))
+            }
+            Mult::Infer => {
+                let muls: Vec<Mul> = chans
+                    .iter()
+                    .zip(&b1.sums)
+                    .map(|(c, n)| Mul {
+                        name: format!("p{c}"),
+                        products: vec![Product {
+                            a: n.plain(),
+                            b: Factor::Const(k as u128),
+                            shift: 0,
+                        }],
+                        constant: 0,
+                        bound: Some(n_max * k as u128),
+                    })
+                    .collect();
+                let n2 = muls[0].levels();
+                infer::build(title2, &muls, &[], &|kk, _| registered_at(d, n2, kk))
+            }
+        };
         let mut steps = b1.steps;
         steps.extend(b2.steps);
         let latency = registered(&steps);

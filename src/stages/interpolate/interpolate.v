@@ -5,10 +5,16 @@
 //   a0 = e00 (S - wu) + e10 wu + S/2,  a1 = e01 (S - wu) + e11 wu + S/2   (u pass)
 //   r  = a0 (S - wv) + a1 wv,          i  = r >> 2P                        (v pass)
 // The S/2 of the u pass becomes the rounding constant S*S/2 of the v pass, so
+{%- if infer %}
+// i = (e00*S*S + (e10-e00)*wu*S + ...) rounded half up, as in the model. Each pass is two plain
+// products (DSP blocks with their output registers), all unsigned, then their sum, registered
+// as pipeline_depth = {= depth =} places them (rmapgen::stages::interpolate::Plan). Latency {= latency =}.
+{%- else %}
 // i = (e00*S*S + (e10-e00)*wu*S + ...) rounded half up, as in the model. Each pass is an adder
 // tree of weight-gated partial products (w[j] ? e << j : 0), all unsigned, one LUT level and
 // one carry chain per level, registered as pipeline_depth = {= depth =} places them
 // (rmapgen::stages::interpolate::Plan). Latency {= latency =}.
+{%- endif %}
 module {= h.module =} (
 {= h.ports =}
 );

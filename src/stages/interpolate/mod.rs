@@ -22,6 +22,8 @@ pub struct Interpolate;
 #[template(path = "interpolate/interpolate.v", syntax = "verilog")]
 struct Verilog {
     h: Head,
+    /// `mult = infer`: the comments describe plain products, not adder trees.
+    infer: bool,
     depth: u32,
     latency: u32,
     m: u32,
@@ -63,6 +65,7 @@ impl Unit for Interpolate {
         let p = Plan::new(cfg);
         Verilog {
             h,
+            infer: !cfg.mult.is_tree(),
             depth: cfg.pipeline_depth,
             latency: p.latency,
             m: cfg.map_bits,

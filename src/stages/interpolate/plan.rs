@@ -2,12 +2,13 @@
 //! inputs at depth >= 1), then the u pass a0 = e00 (S - wu) + e10 wu + S/2 and a1 likewise,
 //! then the v pass r = a0 (S - wv) + a1 wv, which carries the rounding constant S^2/2 in
 //! from the u pass; i = r >> 2P. Every pass is an adder tree of weight-gated partial
-//! products.
+//! products (`mult = tree`), or inferred products and their sum (`mult = infer`).
 
-use crate::config::Config;
+use crate::config::{Config, Mult};
 use crate::rtl::adder_tree::{
     self, clock_q, registered, registered_at, Sig, Step, Sum, Term, Tree,
 };
+use crate::rtl::infer::{self, Mul};
 use crate::rtl::tree_spec::{Factor, Product, Split, TreeSpec};
 
 pub struct Plan {
@@ -66,16 +67,43 @@ impl Plan {
             pass("a0", e("e00"), e("e10"), "wu", "wuc", s / 2, a_max),
             pass("a1", e("e01"), e("e11"), "wu", "wuc", s / 2, a_max),
         ];
-        let nu = adder_tree::levels(&u[0]);
-        let bu = adder_tree::build(
-            "u pass",
-            &u,
-            &[
-                ("wv", Sig::new(sfx("wv"), p + 1)),
-                ("wvc", Sig::new(sfx("wvc"), p + 1)),
-            ],
-            &|k, _| registered_at(d, nu, k),
-        );
+        let w = |n: &str| Sig::new(sfx(n), p + 1);
+        let blend_mul =
+            |name: &str, lo: Sig, hi: Sig, wt: Sig, wc: Sig, c: u128, bound: u128| Mul {
+                name: name.into(),
+                products: vec![
+                    Product {
+                        a: lo,
+                        b: Factor::Sig(wc),
+                        shift: 0,
+                    },
+                    Product {
+                        a: hi,
+                        b: Factor::Sig(wt),
+                        shift: 0,
+                    },
+                ],
+                constant: c,
+                bound: Some(bound),
+            };
+        let u_riders = [
+            ("wv", Sig::new(sfx("wv"), p + 1)),
+            ("wvc", Sig::new(sfx("wvc"), p + 1)),
+        ];
+        let bu = match cfg.mult {
+            Mult::Tree => {
+                let nu = adder_tree::levels(&u[0]);
+                adder_tree::build("u pass", &u, &u_riders, &|k, _| registered_at(d, nu, k))
+            }
+            Mult::Infer => {
+                let mu = [
+                    blend_mul("a0", e("e00"), e("e10"), w("wu"), w("wuc"), s / 2, a_max),
+                    blend_mul("a1", e("e01"), e("e11"), w("wu"), w("wuc"), s / 2, a_max),
+                ];
+                let nu = mu[0].levels();
+                infer::build("u pass", &mu, &u_riders, &|k, _| registered_at(d, nu, k))
+            }
+        };
         // The v pass gates a0 and a1 with the weights that rode along.
         let (wv, wvc) = (&bu.riders[0], &bu.riders[1]);
         let r_max = ((1u128 << m) - 1) * s * s + s * s / 2;
@@ -100,12 +128,21 @@ impl Plan {
             terms: v_terms,
             bound: Some(r_max),
         }];
-        let nv = adder_tree::levels(&v[0]);
-        let bv = adder_tree::build("v pass", &v, &[], &|k, _| registered_at(d, nv, k));
+        let bv = match cfg.mult {
+            Mult::Tree => {
+                let nv = adder_tree::levels(&v[0]);
+                adder_tree::build("v pass", &v, &[], &|k, _| registered_at(d, nv, k))
+            }
+            Mult::Infer => {
+                let (a0, a1) = (bu.sums[0].plain(), bu.sums[1].plain());
+                let mv = [blend_mul("r", a0, a1, wv.clone(), wvc.clone(), 0, r_max)];
+                let nv = mv[0].levels();
+                infer::build("v pass", &mv, &[], &|k, _| registered_at(d, nv, k))
+            }
+        };
         let mut steps = bu.steps;
         steps.extend(bv.steps);
         let latency = in_reg as u32 + registered(&steps);
-        let w = |n: &str| Sig::new(sfx(n), p + 1);
         let blend = |tree: &str, lo: Sig, hi: Sig, wt: Sig, wc: Sig, c: u128, sum: &Sum| TreeSpec {
             tree: tree.into(),
             title: format!("{} * (S - w) + {} * w + {c}", lo.name, hi.name),

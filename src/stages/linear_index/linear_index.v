@@ -4,9 +4,14 @@
 // Linear index, in place of the atan ROM when distortion compensation is off: the position
 // is the fraction scaled to 0..POS_MAX, p = (u * POS_MAX + 2^(F-1)) >> F (half up), and the
 // all-ones code (tan = 1) goes to the border exactly: it is read as u' = 2^F, which gives
+{%- if infer %}
+// p = POS_MAX. u' * POS_MAX is a plain product by the constant, then + 2^(F-1), registered as
+// pipeline_depth = {= depth =} places them (rmapgen::stages::linear_index::Plan). Latency {= latency =}.
+{%- else %}
 // p = POS_MAX. The constant POS_MAX = (2^I - 1) * 2^P makes u' * POS_MAX a sum of I shifted
 // copies of u', an adder tree registered as pipeline_depth = {= depth =} places it
 // (rmapgen::stages::linear_index::Plan). Latency {= latency =}.
+{%- endif %}
 module {= h.module =} (
 {= h.ports =}
 );

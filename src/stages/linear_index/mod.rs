@@ -22,6 +22,8 @@ pub struct LinearIndex;
 #[template(path = "linear_index/linear_index.v", syntax = "verilog")]
 struct Verilog {
     h: Head,
+    /// `mult = infer`: the comments describe plain products, not adder trees.
+    infer: bool,
     depth: u32,
     latency: u32,
     f: u32,
@@ -54,6 +56,7 @@ impl Unit for LinearIndex {
         let lw = p.sum_u.width();
         Verilog {
             h,
+            infer: !cfg.mult.is_tree(),
             depth: cfg.pipeline_depth,
             latency: p.latency,
             f: cfg.frac_bits,

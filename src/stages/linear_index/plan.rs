@@ -1,12 +1,14 @@
 //! Where linear_index's registers sit: u' = u, or 2^F for the all-ones code (so that the
 //! border comes out exactly as POS_MAX), registered at depth >= 1; then
 //! p = (u' * POS_MAX + 2^(F-1)) >> F with the constant POS_MAX = (2^I - 1) * 2^P as an adder
-//! tree of I shifted copies of u'.
+//! tree of I shifted copies of u' (`mult = tree`), or an inferred product and its sum
+//! (`mult = infer`).
 
-use crate::config::Config;
+use crate::config::{Config, Mult};
 use crate::rtl::adder_tree::{
     self, clock_q, registered, registered_at, Sig, Step, Sum, Term, Tree,
 };
+use crate::rtl::infer::{self, Mul};
 use crate::rtl::tree_spec::{Factor, Product, TreeSpec};
 
 pub struct Plan {
@@ -27,22 +29,41 @@ impl Plan {
         let pre_reg = d >= 1;
         let in_q = clock_q(1);
         let sfx = if pre_reg { in_q.as_str() } else { "d" };
-        let tree = |name: &str, x: &str| Tree {
-            name: name.into(),
-            terms: (0..cfg.index_bits)
-                .map(|b| Term::Plain {
-                    x: Sig::new(format!("{x}_{sfx}"), cfg.frac_bits + 1),
-                    shift: cfg.interp_bits + b,
-                })
-                .chain([Term::Const(cfg.frac_half() as u128)])
-                .collect(),
-            bound: Some((cfg.pos_max() as u128) << cfg.frac_bits | cfg.frac_half() as u128),
+        let title = "u' * POS_MAX and v' * POS_MAX";
+        let bound = (cfg.pos_max() as u128) << cfg.frac_bits | cfg.frac_half() as u128;
+        let b = match cfg.mult {
+            Mult::Tree => {
+                let tree = |name: &str, x: &str| Tree {
+                    name: name.into(),
+                    terms: (0..cfg.index_bits)
+                        .map(|b| Term::Plain {
+                            x: Sig::new(format!("{x}_{sfx}"), cfg.frac_bits + 1),
+                            shift: cfg.interp_bits + b,
+                        })
+                        .chain([Term::Const(cfg.frac_half() as u128)])
+                        .collect(),
+                    bound: Some(bound),
+                };
+                let trees = [tree("su", "ux"), tree("sv", "vx")];
+                let n = adder_tree::levels(&trees[0]);
+                adder_tree::build(title, &trees, &[], &|k, _| registered_at(d, n, k))
+            }
+            Mult::Infer => {
+                let mul = |name: &str, x: &str| Mul {
+                    name: name.into(),
+                    products: vec![Product {
+                        a: Sig::new(format!("{x}_{sfx}"), cfg.frac_bits + 1),
+                        b: Factor::Const(cfg.pos_max() as u128),
+                        shift: 0,
+                    }],
+                    constant: cfg.frac_half() as u128,
+                    bound: Some(bound),
+                };
+                let muls = [mul("su", "ux"), mul("sv", "vx")];
+                let n = muls[0].levels();
+                infer::build(title, &muls, &[], &|k, _| registered_at(d, n, k))
+            }
         };
-        let trees = [tree("su", "ux"), tree("sv", "vx")];
-        let n = adder_tree::levels(&trees[0]);
-        let b = adder_tree::build("u' * POS_MAX and v' * POS_MAX", &trees, &[], &|k, _| {
-            registered_at(d, n, k)
-        });
         let latency = pre_reg as u32 + registered(&b.steps);
         let spec = |t: &str, x: &str, sum: &Sum| {
             let x = Sig::new(format!("{x}_{sfx}"), cfg.frac_bits + 1);

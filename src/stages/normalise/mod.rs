@@ -30,6 +30,8 @@ struct Verilog {
     rom: String,
     /// Its init-file parameter, passed down to the ROM.
     rom_params: String,
+    /// `mult = infer`: the comments describe plain products, not adder trees.
+    infer: bool,
     depth: u32,
     latency: u32,
     r: u32,
@@ -89,6 +91,7 @@ impl Unit for Normalise {
             h,
             rom: RecipRom.module(cfg),
             rom_params: param_overrides(cfg, &RecipRom),
+            infer: !cfg.mult.is_tree(),
             depth: cfg.pipeline_depth,
             latency: p.latency,
             r: cfg.red_bits,

@@ -6,8 +6,13 @@
 //   u = min(2^F-1, (a*recip + 2^(SH-1)) >> SH).
 // A component equal to the max saturates to all ones, which the index stages read as exactly
 // 1. The first clock reads the ROM and compares;{% if rom_reg %} the next registers the ROM's output;{% endif %} then
+{%- if infer %}
+// a * recip is a plain product (a DSP block with its output register), then + HALF, registered
+// as pipeline_depth = {= depth =} places them
+{%- else %}
 // a * recip + HALF is an adder tree of the partial products (a[j] ? recip << j : 0), one LUT
 // level and one carry chain per level, registered as pipeline_depth = {= depth =} places them
+{%- endif %}
 // (rmapgen::stages::normalise::Plan); the last clock rounds and saturates. Latency {= latency =}.
 module {= h.module =}{= h.params =} (
 {= h.ports =}
@@ -18,7 +23,7 @@ module {= h.module =}{= h.params =} (
   localparam F  = {= f =};  // fraction width
   localparam RA = {= ra =};  // reciprocal ROM address width
   localparam SH = {= sh =};  // a * recip >> SH is an F-bit fraction: R-1+W-F
-  localparam SW = {= sw =};  // a * recip + HALF (the adder tree's result)
+  localparam SW = {= sw =};  // a * recip + HALF ({% if infer %}the product and sum{% else %}the adder tree{% endif %}'s result)
   localparam LATENCY = {= latency =};
 
   // ---------------------------------------------------------------- ROM read and compare

@@ -1,13 +1,15 @@
 //! Where normalise's registers sit for a `pipeline_depth`: the ROM read and the compares
 //! take a clock, the ROM output is registered again at depth >= 1, then a * recip + HALF and
-//! b * recip + HALF are adder trees of the partial products, then rounding and saturation go
-//! into the output register. The template renders this plan and the latency counts it.
+//! b * recip + HALF are adder trees of the partial products (`mult = tree`) or inferred
+//! products and their sums (`mult = infer`), then rounding and saturation go into the output
+//! register. The template renders this plan and the latency counts it.
 
-use crate::config::Config;
+use crate::config::{Config, Mult};
 use crate::rtl::adder_tree::{
     self, clock_q, registered, registered_at, Built, Sig, Step, Sum, Term, Tree,
 };
-use crate::rtl::tree_spec::TreeSpec;
+use crate::rtl::infer::{self, Mul};
+use crate::rtl::tree_spec::{Factor, Product, TreeSpec};
 
 pub struct Plan {
     pub rom_reg: bool,
@@ -33,37 +35,56 @@ impl Plan {
         let tree_q = clock_q(1 + rom_reg as u32);
         let q = &tree_q;
         let recip = Sig::new(format!("recip_{q}"), cfg.recip_bits);
-        let tree = |name: &str, x: &str| Tree {
-            name: name.into(),
-            terms: (0..cfg.red_bits)
-                .map(|j| Term::Gated {
-                    sel: format!("{x}_{q}[{j}]"),
-                    x: recip.clone(),
-                    shift: j,
-                })
-                .chain([Term::Const(cfg.norm_half() as u128)])
-                .collect(),
-            bound: None,
-        };
-        let trees = [tree("pa", "a"), tree("pb", "b")];
-        let n = adder_tree::levels(&trees[0]);
-        // The last level and the saturation share a clock, except at depth 2.
-        let anchor = if d >= 2 { n } else { n - 1 };
+        let riders = [
+            ("a_max", Sig::new(format!("a_max_{q}"), 1)),
+            ("b_max", Sig::new(format!("b_max_{q}"), 1)),
+        ];
+        let title = "a * recip and b * recip";
+        let half = cfg.norm_half() as u128;
         let Built {
             steps,
             sums,
             riders,
-        } = adder_tree::build(
-            "a * recip and b * recip",
-            &trees,
-            &[
-                ("a_max", Sig::new(format!("a_max_{q}"), 1)),
-                ("b_max", Sig::new(format!("b_max_{q}"), 1)),
-            ],
-            &|k, _| registered_at(d, anchor, k),
-        );
+        } = match cfg.mult {
+            Mult::Tree => {
+                let tree = |name: &str, x: &str| Tree {
+                    name: name.into(),
+                    terms: (0..cfg.red_bits)
+                        .map(|j| Term::Gated {
+                            sel: format!("{x}_{q}[{j}]"),
+                            x: recip.clone(),
+                            shift: j,
+                        })
+                        .chain([Term::Const(half)])
+                        .collect(),
+                    bound: None,
+                };
+                let trees = [tree("pa", "a"), tree("pb", "b")];
+                let n = adder_tree::levels(&trees[0]);
+                // The last level and the saturation share a clock, except at depth 2.
+                let anchor = if d >= 2 { n } else { n - 1 };
+                adder_tree::build(title, &trees, &riders, &|k, _| registered_at(d, anchor, k))
+            }
+            Mult::Infer => {
+                let mul = |name: &str, x: &str| Mul {
+                    name: name.into(),
+                    products: vec![Product {
+                        a: Sig::new(format!("{x}_{q}"), cfg.red_bits),
+                        b: Factor::Sig(recip.clone()),
+                        shift: 0,
+                    }],
+                    constant: half,
+                    bound: None,
+                };
+                let muls = [mul("pa", "a"), mul("pb", "b")];
+                let n = muls[0].levels();
+                // As the tree: the sum and the saturation share a clock, except at depth 2;
+                // the product is registered at every depth (the DSP's output register).
+                let anchor = if d >= 2 { n } else { n - 1 };
+                infer::build(title, &muls, &riders, &|k, _| registered_at(d, anchor, k))
+            }
+        };
         let latency = 1 + rom_reg as u32 + registered(&steps) + 1;
-        let half = cfg.norm_half() as u128;
         let spec = |t: &str, x: &str, sum: &Sum| {
             let title = format!("{x} * recip + HALF");
             let x = Sig::new(format!("{x}_{q}"), cfg.red_bits);
