@@ -16,6 +16,7 @@ pub mod pareto;
 pub mod plot;
 pub mod row;
 pub mod table;
+pub mod throughput;
 mod timing;
 
 use crate::config::Config;

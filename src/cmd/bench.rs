@@ -15,6 +15,10 @@ pub const MIN_SIZE: u32 = 16;
 /// figures, so 60 s each is already an hour.
 pub const MAX_SECONDS: f64 = 60.0;
 
+/// Most placer seeds of the throughput sweep (`--seeds`): one place and route of eight lanes
+/// on the ECP5 takes minutes, so a hundred seeds is already days.
+pub const MAX_SEEDS: u64 = 100;
+
 #[derive(Args, Debug)]
 pub struct BenchArgs {
     /// Output directory for bench.md, bench.csv, bench.json and the plots (replaced whole).
@@ -38,9 +42,28 @@ pub struct BenchArgs {
     /// (--map-fit) [default: the standard, two-lights and diffuse scenes, sample and lsq].
     #[command(flatten)]
     pub map: super::map_args::MapArgs,
+    /// Instead of the error/cost table: the FPGA throughput sweep (make fpga-throughput).
+    /// Each lane count x family is synthesised once and placed and routed per seed; the table
+    /// (throughput.md, .csv, .json in --out) gives the median post-route Fmax, samples/s =
+    /// lanes x Fmax, logic cells, block RAMs and DSP blocks, and the best row's critical path.
+    /// ECP5 rows are placed out of context (fpga --ooc). Slow: hours for the full sweep.
+    #[arg(long)]
+    pub throughput: bool,
+    /// Lane counts of the throughput sweep [default: 1,2,4,8].
+    #[arg(long, value_delimiter = ',', requires = "throughput", value_parser = super::parse::field("lanes"))]
+    pub lanes: Vec<u32>,
+    /// Families of the throughput sweep [default: ice40,ecp5].
+    #[arg(long, value_enum, value_delimiter = ',', requires = "throughput")]
+    pub family: Vec<crate::rtl::fpga::Family>,
+    /// Placer seeds of the throughput sweep, 1..=N [default: 5].
+    #[arg(long, value_name = "N", requires = "throughput", value_parser = super::parse::whole::<u64>(1, MAX_SEEDS))]
+    pub seeds: Option<u64>,
 }
 
 pub fn run(a: &BenchArgs) -> Result<()> {
+    if a.throughput {
+        return throughput(a);
+    }
     let max_size = crate::render::MAX_SIZE;
     anyhow::ensure!(
         (MIN_SIZE..=max_size).contains(&a.size),
@@ -85,6 +108,44 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     print!("{}", bench::table::markdown(&rows));
     eprintln!(
         "rmapgen: wrote bench.md, bench.csv, bench.json and plots to {}",
+        p.display()
+    );
+    Ok(())
+}
+
+/// `--throughput`: the FPGA sweep of [`bench::throughput`].
+fn throughput(a: &BenchArgs) -> Result<()> {
+    use bench::throughput::{self, Sweep};
+    let d = Sweep::default();
+    let sweep = Sweep {
+        lanes: if a.lanes.is_empty() {
+            d.lanes
+        } else {
+            a.lanes.clone()
+        },
+        families: if a.family.is_empty() {
+            d.families
+        } else {
+            a.family.clone()
+        },
+        seeds: a.seeds.map_or(d.seeds, |n| (1..=n).collect()),
+        freq_mhz: d.freq_mhz,
+    };
+    let out = StagedDir::new(&a.out, &a.force.policy(&[]))?;
+    let result = throughput::run(&sweep, &out, &|m| eprintln!("rmapgen: throughput: {m}"));
+    // The logs are kept also when a configuration fails, so that they can be read.
+    let rows = match result {
+        Ok(rows) => rows,
+        Err(e) => {
+            let p = out.commit()?;
+            return Err(e.context(format!("logs in {}", p.display())));
+        }
+    };
+    throughput::write(&rows, &out)?;
+    let p = out.commit()?;
+    print!("{}", throughput::markdown(&rows));
+    eprintln!(
+        "rmapgen: wrote throughput.md, throughput.csv, throughput.json and the logs to {}",
         p.display()
     );
     Ok(())

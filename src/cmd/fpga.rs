@@ -44,6 +44,12 @@ pub struct FpgaArgs {
     pub logs: PathBuf,
     #[command(flatten)]
     pub force: super::force::ForceArg,
+    /// Place and route out of context (ECP5 only): the top's ports are nets at the edge of a
+    /// block, not package pins, as an IP core is timed inside a larger design. No IO buffers,
+    /// no pin limit (eight lanes have more port bits than CABGA381 has pins), the clock on
+    /// general routing; the Fmax is the core's, register to register on clk_i. No bitstream.
+    #[arg(long)]
+    pub ooc: bool,
     /// Fail (exit 2) when the post-route Fmax is below --freq; without it a missed target is
     /// reported as a figure.
     #[arg(long)]
@@ -59,6 +65,11 @@ pub fn run(a: &FpgaArgs) -> Result<()> {
         a.freq > 0.0 && a.freq <= MAX_FREQ_MHZ,
         "freq {} is out of range; allowed (0, {MAX_FREQ_MHZ}] MHz",
         a.freq
+    );
+    // Refused before the log directory is made: bad input writes nothing.
+    anyhow::ensure!(
+        !a.ooc || a.family == Family::Ecp5,
+        "--ooc (out-of-context place and route) is for --family ecp5 only; nextpnr-ice40 has no such mode"
     );
     let logs = StagedDir::new(
         &a.logs,
@@ -110,6 +121,7 @@ fn flow(a: &FpgaArgs, logs: &Path) -> Result<fpga::FpgaReport> {
         freq_mhz: a.freq,
         seed: a.seed,
         logs: Some(logs.to_path_buf()),
+        out_of_context: a.ooc,
     };
     let (what, report) = match &a.dir {
         Some(d) => (d.display().to_string(), fpga::run_dir(d, &opts)?),
@@ -119,7 +131,7 @@ fn flow(a: &FpgaArgs, logs: &Path) -> Result<fpga::FpgaReport> {
             (cfg.summary(), fpga::report(&cfg, &opts)?)
         }
     };
-    print!("fpga: rmap_top of {what}\n{}", report.summary());
+    print!("fpga: {what}\n{}", report.summary());
     let json = serde_json::to_string_pretty(&report)?;
     let path = logs.join("report.json");
     std::fs::write(&path, json + "\n")

