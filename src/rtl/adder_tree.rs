@@ -71,8 +71,36 @@ pub struct Step {
     pub unused: Vec<String>,
 }
 
+/// A registered level `k` carries each rider through a node `<base>_l<k>` of its own; the
+/// rider is then read from that node's register. Shared by both builders (this one and
+/// [`super::infer`]), so riders line up with the products whichever builds the stage.
+pub(super) fn carry_riders(riders: &mut [(&str, Sig)], k: u32, nodes: &mut Vec<Node>) {
+    for (base, r) in riders.iter_mut() {
+        let name = format!("{base}_l{k}");
+        nodes.push(Node {
+            name: name.clone(),
+            width: r.width,
+            expr: r.name.clone(),
+            range: String::new(),
+        });
+        r.name = format!("{name}_q");
+    }
+}
+
+/// Pads every node's range to the widest of the step, so the declarations line up.
+pub(super) fn align_ranges(nodes: &mut [Node]) {
+    let rw = nodes
+        .iter()
+        .map(|n| range(n.width).len())
+        .max()
+        .unwrap_or(0);
+    for n in nodes.iter_mut() {
+        n.range = format!("{:rw$}", range(n.width));
+    }
+}
+
 /// The Verilog range of `width` bits, `[w-1:0]`, or empty for one bit.
-fn range(width: u32) -> String {
+pub(super) fn range(width: u32) -> String {
     if width == 1 {
         String::new()
     } else {
@@ -428,25 +456,9 @@ pub fn build(
             }
         }
         if reg {
-            for (base, r) in riders.iter_mut() {
-                let name = format!("{base}_l{k}");
-                nodes.push(Node {
-                    name: name.clone(),
-                    width: r.width,
-                    expr: r.name.clone(),
-                    range: String::new(),
-                });
-                r.name = format!("{name}_q");
-            }
+            carry_riders(&mut riders, k, &mut nodes);
         }
-        let rw = nodes
-            .iter()
-            .map(|n| range(n.width).len())
-            .max()
-            .unwrap_or(0);
-        for n in nodes.iter_mut() {
-            n.range = format!("{:rw$}", range(n.width));
-        }
+        align_ranges(&mut nodes);
         steps.push(Step {
             title: format!(
                 "{title}, level {k} of {n}{}",

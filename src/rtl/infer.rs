@@ -15,7 +15,7 @@
 //! riders), so a stage's template renders either with the same `steps.v`, and the plan counts
 //! the registered levels into its latency the same way.
 
-use super::adder_tree::{Built, Node, Sig, Step, Sum};
+use super::adder_tree::{align_ranges, carry_riders, Built, Node, Sig, Step, Sum};
 use super::tree_spec::{Factor, Product};
 
 /// A sum of products to build: its name (prefix of its nodes), products, constant and, when
@@ -30,14 +30,6 @@ pub struct Mul {
 
 fn bits(v: u128) -> u32 {
     (128 - v.leading_zeros()).max(1)
-}
-
-fn range(width: u32) -> String {
-    if width == 1 {
-        String::new()
-    } else {
-        format!("[{}:0]", width - 1)
-    }
 }
 
 /// `x` zero-extended to `w` bits.
@@ -188,25 +180,9 @@ pub fn build(
             });
         }
         if reg {
-            for (base, r) in riders.iter_mut() {
-                let name = format!("{base}_l{k}");
-                nodes.push(Node {
-                    name: name.clone(),
-                    width: r.width,
-                    expr: r.name.clone(),
-                    range: String::new(),
-                });
-                r.name = format!("{name}_q");
-            }
+            carry_riders(&mut riders, k, &mut nodes);
         }
-        let rw = nodes
-            .iter()
-            .map(|n| range(n.width).len())
-            .max()
-            .unwrap_or(0);
-        for nd in nodes.iter_mut() {
-            nd.range = format!("{:rw$}", range(nd.width));
-        }
+        align_ranges(&mut nodes);
         let what = if k == 1 { "products" } else { "sums" };
         steps.push(Step {
             title: format!(
