@@ -181,7 +181,10 @@ fn configuration(
                 None => return Err(e),
             },
         }
-        // Each seed's log and report kept beside the others.
+        // Each seed's log and report kept beside the others. `logs` lies inside the sweep's
+        // staging directory (`run`'s `out`, created empty by rmapgen and refused over a
+        // user's directory by its policy), and these two files were just written there by
+        // `fpga::place`; the seeds are distinct, so no earlier seed's file is replaced.
         for f in [
             crate::toolchain::nextpnr::LOG,
             crate::toolchain::nextpnr::REPORT,

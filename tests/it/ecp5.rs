@@ -210,6 +210,29 @@ fn out_of_context_is_refused_for_the_ice40_in_one_line_and_writes_nothing() {
     ]);
     helpers::assert_error(&o, "0");
     assert!(!out.exists(), "the sweep wrote its output");
+    // A user's directory as --out: refused before any synthesis, and left as it was (the
+    // sweep renames its per-seed logs only inside its own staging directory).
+    let user = tmp.path().join("user");
+    std::fs::create_dir(&user).unwrap();
+    std::fs::write(user.join("notes.txt"), "mine").unwrap();
+    let o = helpers::run(&[
+        "bench",
+        "--throughput",
+        "--lanes",
+        "1",
+        "--family",
+        "ice40",
+        "--seeds",
+        "1",
+        "--out",
+        user.to_str().unwrap(),
+    ]);
+    helpers::assert_error(&o, "notes.txt, which rmapgen did not write");
+    assert_eq!(helpers::entries(&user), ["notes.txt"]);
+    assert_eq!(
+        std::fs::read_to_string(user.join("notes.txt")).unwrap(),
+        "mine"
+    );
 }
 
 #[test]
