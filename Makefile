@@ -9,6 +9,13 @@ RMAPGEN   := target/release/rmapgen
 OUT       ?= rtl_out
 SCENE     ?= scenes/standard.toml
 
+# Every Verilator build under make (rmapgen sim, prove, the cargo tests, cocotb) compiles its
+# objects through scripts/objcache: ccache when installed (make tools installs it), cached in
+# build/ccache. Verilator's runtime library is most of a small model's build and the same for
+# every model, so make test's many builds share it. OBJCACHE= (empty) turns it off.
+export OBJCACHE   ?= $(CURDIR)/scripts/objcache
+export CCACHE_DIR ?= $(CURDIR)/build/ccache
+
 .PHONY: all build run test tools cargo-test golden roms
 
 all: run

@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
-# Installs the simulators and synthesis tools from Debian's packages when any is missing;
+# Installs the simulators and synthesis tools from Debian's packages when any is missing (and
+# ccache, which the Makefile's Verilator builds share their runtime objects through);
 # WITH_FPGA=1 also nextpnr-ice40 and fpga-icestorm (place and route, make fpga); WITH_FORMAL=1
 # also z3 (the SMT solver of make formal's SymbiYosys runs); WITH_VOLPACK=1 also
 # libvolpack1-dev (VolPack and its example MRI head, for make bench-volume only).
 # Fails loudly (exit 1) when it cannot: the tests must never skip a simulator silently.
 set -euo pipefail
 need=()
-for t in iverilog:iverilog vvp:iverilog verilator:verilator yosys:yosys; do
+for t in iverilog:iverilog vvp:iverilog verilator:verilator yosys:yosys ccache:ccache; do
   bin=${t%%:*}; pkg=${t##*:}
   command -v "$bin" >/dev/null 2>&1 || need+=("$pkg")
 done
@@ -33,7 +34,7 @@ fi
 $SUDO apt-get update -qq || { echo "install-tools: apt-get update failed" >&2; exit 1; }
 DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${need[@]}" >/dev/null \
   || { echo "install-tools: apt-get install ${need[*]} failed" >&2; exit 1; }
-check=(iverilog vvp verilator yosys)
+check=(iverilog vvp verilator yosys ccache)
 [ "${WITH_FPGA:-0}" = 1 ] && check+=(nextpnr-ice40 icepack)
 [ "${WITH_FORMAL:-0}" = 1 ] && check+=(z3)
 if [ "${WITH_VOLPACK:-0}" = 1 ] && [ ! -f /usr/include/volpack.h ]; then
