@@ -165,7 +165,7 @@ axis-test: build venv
 FORMAL_OUT    ?= build/rtl_formal
 FORMAL_BUILD  ?= build/formal
 FORMAL_FLAGS  ?= --handshake --axis --axis-user 3 --grad-bits 8 --red-bits 6 --recip-bits 5 --frac-bits 4 --index-bits 2 --no-interpolation --map-bits 6 --no-compensation --pipeline-depth 0
-FORMAL_PLANTS  = skid-drop skid-dup head-dup ready-early valid-drop head-overwrite swap-late wr-front buf-delay
+FORMAL_PLANTS  = skid-drop skid-dup head-dup ready-early valid-drop head-overwrite swap-late wr-front buf-delay skid-noreset latency-doc
 
 .PHONY: formal
 

@@ -14,6 +14,12 @@
 //              is the pipeline's clock enable register (ready_i reaches it only through a clock)
 //   a_rd_buf   the sample entering map_lookup reads the front buffer of its acceptance edge
 //              (swap_i in that clock included); a_wr_buf: host writes go to the back buffer
+//   a_live     bounded response: after LAT + 1 edges in a row with ready_i high, the samples in
+//              flight are exactly those accepted at the last LAT edges (LAT: the manifest's
+//              documented latency), so every sample leaves LAT edges after its acceptance
+//              while ready_i stays high; with a_order, none is ever stuck
+// rst_ni is free after the first clock: a reset in the middle of the stream must leave nothing
+// in flight (a_rdy_reset) and restart the tags at 0.
 // inv_* are the inductive invariants (the queue and the pipeline hold the samples in flight in
 // order; the front register is the model's); they are proven like the others.
 `default_nettype none
@@ -26,6 +32,7 @@ module rmap_formal #(
   parameter L    = 23,  // pipeline length, accept to the output register (SIDE_DELAY)
   parameter BUFD = 12,  // accept to map_lookup's input (BUF_DELAY)
   parameter FW   = 6,   // width of the in-flight count: 2^FW > L + 2
+  parameter LAT  = 24,  // documented latency, accept to valid_o (the manifest's "latency")
   parameter INV  = 1    // 1: assert the inductive invariants inv_* too (the proof); 0: only the
                         // properties (a bounded search for a planted fault reports those)
 ) (
@@ -106,13 +113,41 @@ module rmap_formal #(
     if (acc) rec_q[in_q] <= front_d;
   end
 
-  // Reset in the first clock only (a reset later loses the samples in flight, as documented).
+  // Reset in the first clock, and at any clock after it (documented to drop the samples in
+  // flight: a_rdy_reset says nothing is left of them).
   reg init_q = 1'b1;
   always @(posedge clk_i) begin
     init_q <= 1'b0;
   end
   always @* begin
-    assume (rst_ni == !init_q);
+    if (init_q) assume (!rst_ni);
+  end
+
+  // Bounded response: hi_q counts the edges in a row with ready_i high (saturating at LAT + 1),
+  // acc_h_q records which of the last LAT edges accepted a sample (bit 0 the last edge).
+  reg [FW-1:0]  hi_q;
+  reg [LAT-1:0] acc_h_q;
+  always @(posedge clk_i or negedge rst_ni) begin
+    if (!rst_ni) begin
+      hi_q    <= {FW{1'b0}};
+      acc_h_q <= {LAT{1'b0}};
+    end else begin
+      hi_q    <= !ready_i ? {FW{1'b0}} : (hi_q > LAT ? hi_q : hi_q + 1'b1);
+      acc_h_q <= {acc_h_q[LAT-2:0], acc};
+    end
+  end
+  reg [FW-1:0] recent;  // samples accepted at the last LAT edges
+  reg          live_v_ok;
+  integer      j;
+  always @* begin
+    recent = {FW{1'b0}};
+    for (j = 0; j < LAT; j = j + 1) recent = recent + acc_h_q[j];
+    // While ready_i has been high, stage k holds the sample accepted k + 1 edges ago (the
+    // invariant a_live follows from; the enable is high from the second such edge).
+    live_v_ok = 1'b1;
+    for (j = 0; j < L; j = j + 1) begin
+      if (hi_q >= j + 2 && j < LAT) live_v_ok = live_v_ok && p_v[j] == acc_h_q[j];
+    end
   end
 
   // The samples in flight, oldest first: head, skid, then the pipeline from its end.
@@ -163,6 +198,7 @@ module rmap_formal #(
       // In reset, and after the last edge in reset: nothing in flight, ready_o low.
       a_rdy_reset: assert (!ready_o && !valid_o && !p_skid && p_v == {L{1'b0}} && fly_q == {FW{1'b0}});
       if (INV) begin inv_front0:  assert (p_front == front_q && !p_head && in_q == out_q); end
+      if (INV) begin inv_live0:   assert (hi_q == {FW{1'b0}} && acc_h_q == {LAT{1'b0}}); end
     end else begin
       if (INV) begin inv_queue:   assert (inv_ok && n == fly_q && in_q == out_q + fly_q[SD-1:0]); end
       if (INV) begin inv_rd:      assert (rd_ok); end
@@ -173,6 +209,11 @@ module rmap_formal #(
       a_rd_buf:    assert (!p_v[BUFD-1] || p_rd == rec_q[p_s[(BUFD-1)*SD +: SD]]);
       a_rdy_en:    assert (ready_o == p_en);
       a_head:      assert (valid_o == p_head);
+      if (INV) begin inv_live_q:  assert (hi_q == {FW{1'b0}} || (!p_skid && p_en)); end
+      if (INV) begin inv_live_v:  assert (live_v_ok); end
+      if (hi_q > LAT) begin
+        a_live:      assert (fly_q == recent);
+      end
       if (!prev2_rst_q) begin
         a_rdy_first: assert (ready_o);
       end else begin

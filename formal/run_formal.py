@@ -23,10 +23,15 @@ an edit that finds nothing to change is an error):
   swap-late     the sample's buffer is the front register before swap_i (swap one clock late)
   wr-front      a write in the clock of swap_i goes to the new front buffer
   buf-delay     the buffer bit reaches map_lookup one clock after its sample
+  skid-noreset  the skid entry starts empty (initial value) but a reset does not clear it:
+                seen only with a reset in the middle of the stream
+  latency-doc   the manifest documents one clock more latency than the RTL has: only the
+                bounded response (a_live) sees it
 Exit 0 when every run did what it should, 1 otherwise; the last line is `N passed, M failed`.
 """
 
 import argparse
+import json
 import os
 import re
 import shutil
@@ -56,6 +61,16 @@ PLANTS = {
     "wr-front": (".wr_buf_i  (~front_d),", ".wr_buf_i  (~front_q),", "a_wr_buf"),
     "buf-delay": (re.compile(r"(localparam BUF_DELAY  = )(\d+);"),
                   lambda m: f"{m.group(1)}{int(m.group(2)) + 1};", "a_rd_buf"),
+    # Seen only with a reset in the middle of the stream: the skid entry starts empty (an
+    # initial value, as on an FPGA) but a reset does not clear it.
+    "skid-noreset": ([("      skid_valid_q <= 1'b0;\n", ""),
+                      ("reg         valid_q, skid_valid_q, en_q;",
+                       "reg         valid_q, en_q;\n  reg         skid_valid_q = 1'b0;")],
+                     None, "a_rdy_reset"),
+    # The RTL one clock faster than the latency its manifest documents (a host counting clocks
+    # would read the wrong result): only the bounded response sees it.
+    "latency-doc": (re.compile(r'^(  "latency": )(\d+),$', re.M),
+                    lambda m: f"{m.group(1)}{int(m.group(2)) + 1},", "a_live", "manifest.json"),
 }
 
 
@@ -99,6 +114,12 @@ def params(top):
         sys.exit(f"run_formal: {top}: no map_lookup stage")
     p["BUFD"] = sum(n for _, n in stages[:names.index("map_lookup")])
     p["FW"] = (p["L"] + 2).bit_length() + 1
+    # The documented latency (accept to valid_o, enabled clocks) from the manifest rmapgen wrote
+    # with the design, not from the Verilog: a_live holds the RTL to what the design promises.
+    manifest = json.loads((top.parent / "manifest.json").read_text())
+    p["LAT"] = manifest["latency"]
+    if p["LAT"] < 2 or p["LAT"] + 1 >= (1 << p["FW"]):
+        sys.exit(f"run_formal: {top.parent}/manifest.json: latency {p['LAT']} out of range")
     if (1 << p["SD"]) <= p["L"] + 2:
         sys.exit(f"run_formal: {top}: side_i has {p['SD']} bits; the tags need 2^SD > "
                  f"{p['L'] + 2} samples in flight (generate with a wider --axis-user)")
@@ -173,21 +194,26 @@ def prove(design, build, depth, bmc):
 
 
 def plant(design, build, name):
-    old, new, _ = PLANTS[name]
+    """A copy of `design` with the plant's edits: (old, new, assertion[, file]), or with a list
+    of (old, new) pairs in place of old and None for new."""
+    old, new, _ = PLANTS[name][:3]
+    file = PLANTS[name][3] if len(PLANTS[name]) > 3 else "rmap_top.v"
+    edits = old if isinstance(old, list) else [(old, new)]
     copy = build / f"design-{name}"
     if copy.exists():
         shutil.rmtree(copy)
     shutil.copytree(design, copy)
-    top = copy / "rmap_top.v"
+    top = copy / file
     text = top.read_text()
-    if isinstance(old, re.Pattern):
-        changed, n = old.subn(new, text)
-    else:
-        n = text.count(old)
-        changed = text.replace(old, new)
-    if n != 1:
-        sys.exit(f"run_formal: plant {name}: expected one match in {top}, found {n}")
-    top.write_text(changed)
+    for old, new in edits:
+        if isinstance(old, re.Pattern):
+            text, n = old.subn(new, text)
+        else:
+            n = text.count(old)
+            text = text.replace(old, new)
+        if n != 1:
+            sys.exit(f"run_formal: plant {name}: expected one match in {top}, found {n}")
+    top.write_text(text)
     return copy
 
 
