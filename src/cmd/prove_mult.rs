@@ -1,6 +1,7 @@
 //! `rmapgen prove-mult`: the formal proof that every adder tree of a generated design
 //! equals the plain product its plan says it builds (`a * b + c`), on every input, with
-//! Yosys's SAT solver on the generated modules ([`crate::rtl::mult_proof`]).
+//! Yosys's SAT solver or by evaluating the cut miter on every input, on the generated modules
+//! ([`crate::rtl::mult_proof`]).
 //!
 //! Exit 0 when every tree is proved, 1 when any is not (each failure names the stage, the
 //! tree and the first failing case), 2 for bad input.
@@ -11,9 +12,9 @@ use super::sim::{generate_row, selected_rows};
 use crate::design_dir::DesignDir;
 use crate::grid::GridRow;
 use crate::output::{absolute, Policy, StagedDir};
-use crate::rtl::mult_proof::{self, Job};
+use crate::rtl::mult_proof::{self, Engine, EngineChoice, Job};
 use crate::toolchain::{self, yosys};
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -41,6 +42,11 @@ pub struct ProveMultArgs {
     /// With --matrix: Yosys processes side by side (default: JOBS, else the cores).
     #[arg(long, value_name = "N", requires = "matrix", value_parser = parse::whole::<usize>(1, 64))]
     pub jobs: Option<usize>,
+    /// How each tree is proved: sat (Yosys sat -prove, one run per value of the split
+    /// factor), exhaustive (the cut miter evaluated on every input), or auto (exhaustive up to
+    /// 2^34 inputs, else sat).
+    #[arg(long, value_enum, default_value = "auto")]
+    pub engine: EngineChoice,
     #[command(flatten)]
     pub force: ForceArg,
 }
@@ -49,6 +55,9 @@ pub fn run(a: &ProveMultArgs) -> Result<ExitCode> {
     // Bad input first (the rows, the directory), then the tool, then the runs.
     let failed = if a.matrix {
         let rows = selected_rows(&a.row)?;
+        for r in &rows {
+            engines(&mult_proof::jobs(&r.config), a.engine)?;
+        }
         need_yosys()?;
         matrix(a, &rows)?
     } else {
@@ -57,8 +66,14 @@ pub fn run(a: &ProveMultArgs) -> Result<ExitCode> {
             .as_deref()
             .expect("clap requires DIR without --matrix");
         let design = DesignDir::open(dir)?;
+        engines(&mult_proof::jobs(&design.config), a.engine)?;
         need_yosys()?;
-        let proof = prove(&design, &a.logs, &a.force.policy(&[Some(design.path())]))?;
+        let proof = prove(
+            &design,
+            &a.logs,
+            &a.force.policy(&[Some(design.path())]),
+            a.engine,
+        )?;
         print!("{}", proof.stdout);
         eprint!("{}", proof.stderr);
         !proof.passed
@@ -70,6 +85,11 @@ pub fn run(a: &ProveMultArgs) -> Result<ExitCode> {
     })
 }
 
+/// Each job's engine; a tree `--engine exhaustive` cannot take is bad input.
+fn engines(jobs: &[Job], choice: EngineChoice) -> Result<Vec<Engine>> {
+    jobs.iter().map(|j| j.engine(choice)).collect()
+}
+
 fn need_yosys() -> Result<()> {
     if !toolchain::installed(&yosys::yosys()) {
         bail!("{} not found (make tools installs it)", yosys::yosys());
@@ -77,25 +97,28 @@ fn need_yosys() -> Result<()> {
     Ok(())
 }
 
-/// One design's proof: whether every tree was proved, what to print, the SAT cases and the
-/// seconds Yosys took.
+/// One design's proof: whether every tree was proved, what to print, the SAT cases, the
+/// inputs evaluated and the seconds Yosys and the evaluation took.
 struct Proof {
     passed: bool,
     stdout: String,
     stderr: String,
     cases: usize,
+    inputs: u128,
     seconds: f64,
 }
 
 /// Proves every tree of `design`, its script, miters and log staged into `logs`.
-fn prove(design: &DesignDir, logs: &Path, policy: &Policy) -> Result<Proof> {
+fn prove(design: &DesignDir, logs: &Path, policy: &Policy, choice: EngineChoice) -> Result<Proof> {
     let jobs = mult_proof::jobs(&design.config);
+    let engines = engines(&jobs, choice)?;
     let shown = design.path().display();
     let mut p = Proof {
         passed: true,
         stdout: String::new(),
         stderr: String::new(),
         cases: 0,
+        inputs: 0,
         seconds: 0.0,
     };
     if jobs.is_empty() {
@@ -119,7 +142,13 @@ fn prove(design: &DesignDir, logs: &Path, policy: &Policy) -> Result<Proof> {
         .iter()
         .map(|f| design.path().join(f).display().to_string())
         .collect();
-    let script = mult_proof::script(&files, &jobs, &wrappers, mult_proof::TRANSPARENT_FILE);
+    let script = mult_proof::script(
+        &files,
+        &jobs,
+        &engines,
+        &wrappers,
+        mult_proof::TRANSPARENT_FILE,
+    );
     staged.write_text("mult.ys", &script)?;
     let mut cmd = Command::new(yosys::yosys());
     cmd.args(["-q", "-l"])
@@ -130,11 +159,33 @@ fn prove(design: &DesignDir, logs: &Path, policy: &Policy) -> Result<Proof> {
     let log_text = std::fs::read_to_string(dir.join(yosys::LOG)).unwrap_or_default();
     let shown_logs = absolute(&staged.commit()?);
     let ran = ran?;
-    let results = mult_proof::results(&jobs, &log_text);
-    report(&jobs, &results, &mut p);
+    let mut results = mult_proof::results(&jobs, &log_text);
     let log = shown_logs.join(yosys::LOG);
-    p.seconds = ran.seconds;
-    p.cases = results.iter().map(|r| r.cases).sum();
+    let start = Instant::now();
+    if ran.success() {
+        for (i, j) in jobs.iter().enumerate() {
+            if engines[i] == Engine::Exhaustive {
+                let (aag, map) = j.aig_files();
+                let read = |f: &str| {
+                    let path = shown_logs.join(f);
+                    std::fs::read_to_string(&path)
+                        .with_context(|| format!("cannot read {}", path.display()))
+                };
+                results[i] =
+                    mult_proof::exhaustive(j, &read(&aag)?, &read(&map)?).with_context(|| {
+                        format!("{}: {}", j.name(), shown_logs.join(&aag).display())
+                    })?;
+                p.inputs += j.exhaustive_inputs();
+            }
+        }
+    }
+    report(&jobs, &results, &mut p);
+    p.seconds = ran.seconds + start.elapsed().as_secs_f64();
+    p.cases = results
+        .iter()
+        .filter(|r| r.engine == Engine::Sat)
+        .map(|r| r.cases)
+        .sum();
     if !ran.success() {
         p.passed = false;
         p.stderr += &format!(
@@ -152,10 +203,11 @@ fn prove(design: &DesignDir, logs: &Path, policy: &Policy) -> Result<Proof> {
         .collect();
     if failed.is_empty() {
         p.stdout += &format!(
-            "prove-mult: {shown}: all {} trees proved equal to their products ({} SAT cases, {:.1} s)\n",
+            "prove-mult: {shown}: all {} trees proved equal to their products ({} SAT cases, {} inputs evaluated, {:.1} s)\n",
             results.len(),
             p.cases,
-            ran.seconds
+            mult_proof::count(p.inputs),
+            p.seconds
         );
     } else {
         p.passed = false;
@@ -193,7 +245,7 @@ fn matrix(a: &ProveMultArgs, rows: &[GridRow]) -> Result<bool> {
             s.spawn(|| loop {
                 let i = next.fetch_add(1, Ordering::Relaxed);
                 let Some(r) = rows.get(i) else { break };
-                let proof = prove(&designs[i], &a.logs.join(r.name), &policy);
+                let proof = prove(&designs[i], &a.logs.join(r.name), &policy, a.engine);
                 if let Ok(p) = &proof {
                     // One row's lines together, under its name.
                     let mut all =
@@ -207,10 +259,11 @@ fn matrix(a: &ProveMultArgs, rows: &[GridRow]) -> Result<bool> {
         }
     });
     let mut failed = Vec::new();
-    let (mut cases, mut cpu) = (0usize, 0.0f64);
+    let (mut cases, mut inputs, mut cpu) = (0usize, 0u128, 0.0f64);
     for (r, p) in rows.iter().zip(out.into_inner().expect("no worker panics")) {
         let p = p.expect("every row ran")?;
         cases += p.cases;
+        inputs += p.inputs;
         cpu += p.seconds;
         if !p.passed {
             failed.push(r.name);
@@ -218,9 +271,10 @@ fn matrix(a: &ProveMultArgs, rows: &[GridRow]) -> Result<bool> {
     }
     if failed.is_empty() {
         println!(
-            "prove-mult: every row proved ({} row{}, {cases} SAT cases, {:.0} s of Yosys in {:.0} s on {workers} job{})",
+            "prove-mult: every row proved ({} row{}, {cases} SAT cases, {} inputs evaluated, {:.0} s of Yosys and evaluation in {:.0} s on {workers} job{})",
             rows.len(),
             if rows.len() == 1 { "" } else { "s" },
+            mult_proof::count(inputs),
             cpu,
             start.elapsed().as_secs_f64(),
             if workers == 1 { "" } else { "s" }
@@ -234,13 +288,17 @@ fn matrix(a: &ProveMultArgs, rows: &[GridRow]) -> Result<bool> {
 fn report(jobs: &[Job], results: &[mult_proof::TreeResult], p: &mut Proof) {
     for (j, r) in jobs.iter().zip(results) {
         if r.passed() {
-            p.stdout += &format!(
-                "prove-mult: {} = {}: proved ({} case{})\n",
-                r.name,
-                r.title,
-                r.cases,
-                if r.cases == 1 { "" } else { "s" }
-            );
+            let how = match r.engine {
+                Engine::Sat => format!(
+                    "{} SAT case{}",
+                    r.cases,
+                    if r.cases == 1 { "" } else { "s" }
+                ),
+                Engine::Exhaustive => {
+                    format!("every input: {}", mult_proof::count(j.exhaustive_inputs()))
+                }
+            };
+            p.stdout += &format!("prove-mult: {} = {}: proved ({how})\n", r.name, r.title);
         } else if let Some(case) = &r.failed {
             p.stderr += &format!(
                 "prove-mult: {} = {}: FAILED: the sum {} differs from the product{}\n",

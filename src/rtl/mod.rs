@@ -4,6 +4,7 @@
 //! in code, and everything here walks them.
 
 pub mod adder_tree;
+pub mod aig;
 pub mod fpga;
 pub mod infer;
 pub mod manifest;

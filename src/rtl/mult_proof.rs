@@ -8,13 +8,46 @@
 //! their drivers disconnected) and its sum exposed; a miter module (written here from the
 //! specification only) instantiates the stage and compares the sum with `a * b + c` in
 //! Verilog; registers are made transparent (a techmap of every flip-flop to `Q = D`, see
-//! docs/VERIFICATION.md for why that covers the pipelined tree), and `sat -prove ok 1` runs
-//! once per value of the split factor ([`crate::rtl::tree_spec::Split`]). Markers in the log
-//! (`rmapgen-mult: tree M T`) attribute every result to its tree.
+//! docs/VERIFICATION.md for why that covers the pipelined tree). Then one of two engines
+//! ([`Engine`]) shows that the miter's `ok` is 1 on every input:
+//! - SAT: `sat -prove ok 1` runs once per value of the split factor
+//!   ([`crate::rtl::tree_spec::Split`]); markers in the log (`rmapgen-mult: tree M T`)
+//!   attribute every result to its tree;
+//! - exhaustive: the miter is written as an and-inverter graph and evaluated on every input
+//!   ([`super::aig`]), case by case.
 
+use super::aig::{self, Aig};
 use super::tree_spec::{Factor, TreeSpec};
 use crate::config::Config;
 use crate::stages;
+use anyhow::{bail, Result};
+
+/// How the trees are proved (`prove-mult --engine`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum EngineChoice {
+    /// Exhaustive where a tree has at most AUTO_EXHAUSTIVE_INPUTS inputs, else SAT.
+    Auto,
+    /// Yosys `sat -prove` for every tree.
+    Sat,
+    /// Every input of every tree (a tree above MAX_EXHAUSTIVE_INPUTS is refused).
+    Exhaustive,
+}
+
+/// The engine one tree is proved with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Engine {
+    Sat,
+    Exhaustive,
+}
+
+/// Most inputs (cases x values of the other inputs) that `auto` proves exhaustively: 2^34.
+/// Measured here, evaluation costs about a nanosecond per input for the widest normalise
+/// tree (about 4,000 gates per case), so 2^34 is minutes on two cores; SAT costs per case,
+/// from 0.07 s for a 10-bit symbolic factor to 16 s for 20 bits.
+pub const AUTO_EXHAUSTIVE_INPUTS: u128 = 1 << 34;
+
+/// Most inputs `--engine exhaustive` takes for one tree: 2^36 (about an hour).
+pub const MAX_EXHAUSTIVE_INPUTS: u128 = 1 << 36;
 
 /// Maps every flip-flop kind `proc` and `opt` leave to a wire from D to Q: the registers of a
 /// pipelined tree become transparent, and the tree one combinational sum.
@@ -82,6 +115,44 @@ impl Job {
         format!("mult_proof_{}_{}", self.module, self.spec.tree)
     }
 
+    /// Input bits not fixed by a case: enumerated by the exhaustive engine, symbolic in SAT.
+    pub fn free_bits(&self) -> u32 {
+        let split: u32 = self.spec.split.as_ref().map_or(0, |s| {
+            s.sig.width + s.complement.as_ref().map_or(0, |(c, _)| c.width)
+        });
+        self.spec.inputs().iter().map(|s| s.width).sum::<u32>() - split
+    }
+
+    /// Inputs the exhaustive engine evaluates: cases x 2^free bits (saturating).
+    pub fn exhaustive_inputs(&self) -> u128 {
+        let per_case = 1u128.checked_shl(self.free_bits()).unwrap_or(u128::MAX);
+        per_case.saturating_mul(self.cases().len() as u128)
+    }
+
+    /// The engine `choice` gives this tree; an exhaustive choice over
+    /// [`MAX_EXHAUSTIVE_INPUTS`] is refused.
+    pub fn engine(&self, choice: EngineChoice) -> Result<Engine> {
+        let n = self.exhaustive_inputs();
+        Ok(match choice {
+            EngineChoice::Sat => Engine::Sat,
+            EngineChoice::Auto if n <= AUTO_EXHAUSTIVE_INPUTS => Engine::Exhaustive,
+            EngineChoice::Auto => Engine::Sat,
+            EngineChoice::Exhaustive if n <= MAX_EXHAUSTIVE_INPUTS => Engine::Exhaustive,
+            EngineChoice::Exhaustive => bail!(
+                "--engine exhaustive: {} has {} inputs, more than {} (use --engine auto or sat)",
+                self.name(),
+                count(n),
+                count(MAX_EXHAUSTIVE_INPUTS)
+            ),
+        })
+    }
+
+    /// The and-inverter graph files the exhaustive engine has Yosys write.
+    pub fn aig_files(&self) -> (String, String) {
+        let w = self.wrapper_name();
+        (format!("{w}.aag"), format!("{w}.map"))
+    }
+
     /// The cases: for each, the `-set` pairs (signal, value).
     pub fn cases(&self) -> Vec<Vec<(String, u128)>> {
         match &self.spec.split {
@@ -96,6 +167,15 @@ impl Job {
                 })
                 .collect(),
         }
+    }
+}
+
+/// An input count for messages: `2^32` when a power of two, else the number.
+pub fn count(n: u128) -> String {
+    if n.is_power_of_two() {
+        format!("2^{}", n.trailing_zeros())
+    } else {
+        n.to_string()
     }
 }
 
@@ -189,12 +269,20 @@ pub fn wrapper(job: &Job) -> String {
 }
 
 /// The Yosys script proving every job of one design: `files` are the design's Verilog files,
-/// `wrappers` the miter files (one per job, same order), `transparent` the techmap file.
-pub fn script(files: &[String], jobs: &[Job], wrappers: &[String], transparent: &str) -> String {
+/// `wrappers` the miter files and `engines` the engines (one per job, same order),
+/// `transparent` the techmap file. A SAT job runs its cases; an exhaustive job has its miter
+/// mapped to AND and NOT gates and written as ASCII AIGER ([`Job::aig_files`]).
+pub fn script(
+    files: &[String],
+    jobs: &[Job],
+    engines: &[Engine],
+    wrappers: &[String],
+    transparent: &str,
+) -> String {
     let mut s = String::new();
     s.push_str(&format!("read_verilog {}\n", files.join(" ")));
     s.push_str("proc\ndesign -save rmapgen_base\n");
-    for (job, file) in jobs.iter().zip(wrappers) {
+    for ((job, file), engine) in jobs.iter().zip(wrappers).zip(engines) {
         let m = &job.module;
         let cut: Vec<String> = job
             .spec
@@ -210,6 +298,13 @@ pub fn script(files: &[String], jobs: &[Job], wrappers: &[String], transparent: 
             "hierarchy -top {0}\nproc\nflatten\nopt_clean\nopt_dff\ntechmap -map {transparent}\nopt -fast\n",
             job.wrapper_name()
         ));
+        if *engine == Engine::Exhaustive {
+            let (aag, map) = job.aig_files();
+            s.push_str(&format!(
+                "techmap\nopt -fast\naigmap\nopt_clean\nwrite_aiger -ascii -map {map} {aag}\n"
+            ));
+            continue;
+        }
         s.push_str(&format!("log {MARK} {m} {}\n", job.spec.tree));
         for case in job.cases() {
             let sets: String = case.iter().map(|(x, v)| format!(" -set {x} {v}")).collect();
@@ -224,6 +319,7 @@ pub fn script(files: &[String], jobs: &[Job], wrappers: &[String], transparent: 
 pub struct TreeResult {
     pub name: String,
     pub title: String,
+    pub engine: Engine,
     pub cases: usize,
     pub proved: usize,
     /// The first failing case's assignments, as `sig = value` text (empty: no split).
@@ -236,13 +332,36 @@ impl TreeResult {
     }
 }
 
-/// Reads the results out of the Yosys log of [`script`].
+/// The exhaustive engine's result for `job`, from the AIGER file and map Yosys wrote: every
+/// case, every value of the other inputs; the first failing input named.
+pub fn exhaustive(job: &Job, aag: &str, map: &str) -> Result<TreeResult> {
+    let graph = Aig::parse(aag, map)?;
+    let cases = job.cases();
+    let failed = aig::exhaustive(&graph, &cases)?;
+    Ok(TreeResult {
+        name: job.name(),
+        title: job.spec.title.clone(),
+        engine: Engine::Exhaustive,
+        cases: cases.len(),
+        proved: if failed.is_some() { 0 } else { cases.len() },
+        failed: failed.map(|sigs| {
+            sigs.iter()
+                .map(|(x, v)| format!("{x} = {v}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        }),
+    })
+}
+
+/// Reads the results of the SAT jobs out of the Yosys log of [`script`] (an exhaustive job's
+/// entry is a placeholder, proved nothing, for [`exhaustive`] to replace).
 pub fn results(jobs: &[Job], log: &str) -> Vec<TreeResult> {
     let mut out: Vec<TreeResult> = jobs
         .iter()
         .map(|j| TreeResult {
             name: j.name(),
             title: j.spec.title.clone(),
+            engine: Engine::Sat,
             cases: j.cases().len(),
             proved: 0,
             failed: None,
@@ -283,6 +402,34 @@ pub fn results(jobs: &[Job], log: &str) -> Vec<TreeResult> {
 mod tests {
     use super::*;
     use crate::grid;
+
+    /// `auto` takes every tree of every row of the grid, exhaustive where it is cheap: the
+    /// widest normalise tree (2^32 inputs) is exhaustive, the widest interpolate sum is SAT;
+    /// `--engine exhaustive` refuses that one, naming it.
+    #[test]
+    fn engines_follow_the_input_counts() {
+        for r in grid::rows() {
+            for j in jobs(&r.config) {
+                let e = j.engine(EngineChoice::Auto).unwrap();
+                assert_eq!(
+                    e == Engine::Exhaustive,
+                    j.exhaustive_inputs() <= AUTO_EXHAUSTIVE_INPUTS,
+                    "{}: {}",
+                    r.name,
+                    j.name()
+                );
+                assert_eq!(j.engine(EngineChoice::Sat).unwrap(), Engine::Sat);
+            }
+        }
+        let widest = jobs(&grid::row("widest").unwrap().config);
+        let pa = widest.iter().find(|j| j.name() == "normalise.pa").unwrap();
+        assert_eq!(pa.exhaustive_inputs(), 1 << 32);
+        assert_eq!(pa.engine(EngineChoice::Auto).unwrap(), Engine::Exhaustive);
+        let r = widest.iter().find(|j| j.name() == "interpolate.r").unwrap();
+        assert_eq!(r.engine(EngineChoice::Auto).unwrap(), Engine::Sat);
+        let e = r.engine(EngineChoice::Exhaustive).unwrap_err().to_string();
+        assert!(e.contains("interpolate.r") && e.contains("2^36"), "{e}");
+    }
 
     /// Every row of the grid has its trees stated: two in normalise, two in linear_index (no
     /// compensation), three in interpolate, six in color_mul; each specification's sum is a

@@ -61,12 +61,13 @@ const PLANTS: &[(&str, &str, &str, &str, &str)] = &[
     ),
 ];
 
-fn prove(dir: &Path, logs: &Path) -> (bool, String, String) {
+fn prove(dir: &Path, logs: &Path, engine: &str) -> (bool, String, String) {
     let out = rmapgen()
         .arg("prove-mult")
         .arg(dir)
         .arg("--logs")
         .arg(logs)
+        .args(["--engine", engine])
         .output()
         .expect("rmapgen runs");
     (
@@ -84,8 +85,16 @@ fn every_tree_is_proved_and_every_planted_fault_is_caught() {
     let tmp = tempdir();
     let good = tmp.path().join("good");
     generate(&good, FLAGS, 0);
-    let (ok, out, err) = prove(&good, &tmp.path().join("logs"));
-    assert!(ok, "the generated design must prove: {out}{err}");
+    // Both engines on the same design and the same faults: each must prove the design and
+    // catch every fault on its own.
+    for (engine, how) in [("sat", "SAT case"), ("exhaustive", "every input: ")] {
+        proves_and_catches(tmp.path(), &good, engine, how);
+    }
+}
+
+fn proves_and_catches(tmp: &Path, good: &Path, engine: &str, how: &str) {
+    let (ok, out, err) = prove(good, &tmp.join(format!("logs-{engine}")), engine);
+    assert!(ok, "{engine}: the generated design must prove: {out}{err}");
     for tree in [
         "normalise.pa",
         "normalise.pb",
@@ -99,17 +108,18 @@ fn every_tree_is_proved_and_every_planted_fault_is_caught() {
         "color_mul.pg",
         "color_mul.pb",
     ] {
-        assert!(
-            out.contains(&format!("prove-mult: {tree} = ")),
-            "{tree}: {out}"
-        );
+        let line = out
+            .lines()
+            .find(|l| l.starts_with(&format!("prove-mult: {tree} = ")))
+            .unwrap_or_else(|| panic!("{engine}: {tree}: {out}"));
+        assert!(line.contains(how), "{engine}: {line}");
     }
     assert!(out.contains("all 11 trees proved"), "{out}");
 
     for (k, (what, file, old, new, tree)) in PLANTS.iter().enumerate() {
-        let bad = tmp.path().join(format!("bad{k}"));
+        let bad = tmp.join(format!("bad-{engine}-{k}"));
         std::fs::create_dir(&bad).unwrap();
-        for e in std::fs::read_dir(&good).unwrap() {
+        for e in std::fs::read_dir(good).unwrap() {
             let e = e.unwrap();
             if e.file_type().unwrap().is_file() {
                 std::fs::copy(e.path(), bad.join(e.file_name())).unwrap();
@@ -119,8 +129,8 @@ fn every_tree_is_proved_and_every_planted_fault_is_caught() {
         let text = std::fs::read_to_string(&path).unwrap();
         assert_eq!(text.matches(old).count(), 1, "{what}: {old} in {file}");
         std::fs::write(&path, text.replace(old, new)).unwrap();
-        let (ok, out, err) = prove(&bad, &tmp.path().join(format!("logs{k}")));
-        assert!(!ok, "{what} must make the proof fail: {out}{err}");
+        let (ok, out, err) = prove(&bad, &tmp.join(format!("logs-{engine}-{k}")), engine);
+        assert!(!ok, "{engine}: {what} must make the proof fail: {out}{err}");
         assert!(
             err.contains(&format!("prove-mult: {tree} = ")) && err.contains("FAILED"),
             "{what}: the failure must name {tree}: {err}"
@@ -215,7 +225,7 @@ fn inferred_products_are_plain_and_proved_and_a_planted_fault_is_caught() {
     if !require("yosys") {
         return;
     }
-    let (ok, out, err) = prove(&good, &tmp.path().join("logs"));
+    let (ok, out, err) = prove(&good, &tmp.path().join("logs"), "auto");
     assert!(ok, "the inferred design must prove: {out}{err}");
     assert!(out.contains("all 11 trees proved"), "{out}");
     let bad = tmp.path().join("bad");
@@ -234,7 +244,7 @@ fn inferred_products_are_plain_and_proved_and_a_planted_fault_is_caught() {
     );
     assert_eq!(text.matches(old).count(), 1, "{old}");
     std::fs::write(&path, text.replace(old, new)).unwrap();
-    let (ok, out, err) = prove(&bad, &tmp.path().join("logs_bad"));
+    let (ok, out, err) = prove(&bad, &tmp.path().join("logs_bad"), "auto");
     assert!(!ok, "a wrong constant must make the proof fail: {out}{err}");
     let failed: Vec<&str> = err
         .lines()

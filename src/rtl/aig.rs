@@ -1,0 +1,362 @@
+//! The exhaustive engine of `rmapgen prove-mult`: a tree's miter, cut and made combinational
+//! by the same Yosys steps as for the SAT engine, is written as an and-inverter graph (Yosys
+//! `aigmap; write_aiger -ascii -map`) and evaluated here on every input, 512 at a time
+//! (bit-parallel: one bit of a machine word per input).
+//!
+//! Why: for a product of a wide symbolic factor and a split constant (the widest grid row's
+//! normalise tree, 20 x 12 bits), each SAT case takes about 16 s of CPU (both sides are sums
+//! of shifted copies of the factor, associated differently, and CDCL reasons through every
+//! carry), 8,192 cases a row: over a day. Evaluating the graph on all 2^32 inputs takes
+//! minutes. For every input the miter's `ok` must be 1, which is the same statement the SAT
+//! engine proves, over the same netlist.
+//!
+//! Each case of the split fixes some inputs; the graph is first simplified for those
+//! constants (constant propagation only: an AND with a 0 input is 0, with a 1 input is its
+//! other input), then every value of the remaining inputs is applied.
+
+use anyhow::{bail, Context, Result};
+use rayon::prelude::*;
+
+/// Machine words per evaluation block: 8 x 64 = 512 inputs at once.
+const WORDS: usize = 8;
+/// Inputs per block.
+const BLOCK_BITS: u32 = 9;
+
+/// An and-inverter graph with named inputs and one output.
+#[derive(Clone, Debug)]
+pub struct Aig {
+    /// For each input (in AIGER order): its signal name and bit.
+    pub inputs: Vec<(String, u32)>,
+    /// Variable of each input (the AIGER literal / 2).
+    input_vars: Vec<u32>,
+    /// AND gates in topological order: (lhs variable, rhs literal, rhs literal).
+    ands: Vec<(u32, u32, u32)>,
+    /// The output literal.
+    output: u32,
+    max_var: u32,
+}
+
+fn num(s: Option<&str>, what: &str) -> Result<u32> {
+    s.with_context(|| format!("missing {what}"))?
+        .parse::<u32>()
+        .with_context(|| format!("bad {what}"))
+}
+
+impl Aig {
+    /// Parses Yosys's ASCII AIGER (`aag M I L O A`, no latches, one output) and its `-map`
+    /// file (`input INDEX BIT NAME`).
+    pub fn parse(aag: &str, map: &str) -> Result<Aig> {
+        let mut lines = aag.lines();
+        let head: Vec<&str> = lines
+            .next()
+            .context("empty AIGER file")?
+            .split_whitespace()
+            .collect();
+        if head.len() != 6 || head[0] != "aag" {
+            bail!("not an ASCII AIGER header: {}", head.join(" "));
+        }
+        let n: Vec<u32> = head[1..]
+            .iter()
+            .map(|s| s.parse().context("bad AIGER header"))
+            .collect::<Result<_>>()?;
+        let (max_var, ni, nl, no, na) = (n[0], n[1], n[2], n[3], n[4]);
+        if nl != 0 {
+            bail!("{nl} latches: the miter must be combinational");
+        }
+        if no != 1 {
+            bail!("{no} outputs: the miter has one (ok)");
+        }
+        let mut input_vars = Vec::with_capacity(ni as usize);
+        for _ in 0..ni {
+            let lit = num(lines.next(), "input literal")?;
+            if lit & 1 == 1 || lit == 0 {
+                bail!("bad input literal {lit}");
+            }
+            input_vars.push(lit / 2);
+        }
+        let output = num(lines.next(), "output literal")?;
+        let mut ands = Vec::with_capacity(na as usize);
+        for _ in 0..na {
+            let l = lines.next().context("missing AND gate")?;
+            let mut it = l.split_whitespace();
+            let (lhs, a, b) = (
+                num(it.next(), "AND lhs")?,
+                num(it.next(), "AND rhs")?,
+                num(it.next(), "AND rhs")?,
+            );
+            // AIGER's ASCII form lists gates after their inputs (lhs > rhs), which the
+            // evaluation below relies on.
+            if lhs & 1 == 1 || lhs / 2 > max_var || a >= lhs || b >= lhs {
+                bail!("AND gate {l} out of order");
+            }
+            ands.push((lhs / 2, a, b));
+        }
+        let mut inputs = vec![(String::new(), 0); ni as usize];
+        let mut named = 0;
+        for l in map.lines() {
+            let f: Vec<&str> = l.split_whitespace().collect();
+            if f.len() == 4 && f[0] == "input" {
+                let i: usize = f[1].parse().context("bad map index")?;
+                let bit: u32 = f[2].parse().context("bad map bit")?;
+                let slot = inputs
+                    .get_mut(i)
+                    .with_context(|| format!("map names input {i} of {ni}"))?;
+                *slot = (f[3].to_string(), bit);
+                named += 1;
+            }
+        }
+        if named != ni as usize {
+            bail!("the map names {named} of {ni} inputs");
+        }
+        Ok(Aig {
+            inputs,
+            input_vars,
+            ands,
+            output,
+            max_var,
+        })
+    }
+
+    /// AND gates.
+    pub fn gates(&self) -> usize {
+        self.ands.len()
+    }
+
+    /// Whether input `i` drives any gate or the output (an unused port, such as the miter's
+    /// clock once the registers are wires, cannot change `ok`).
+    fn used(&self) -> Vec<bool> {
+        let mut used = vec![false; self.max_var as usize + 1];
+        used[(self.output / 2) as usize] = true;
+        for &(_, a, b) in &self.ands {
+            used[(a / 2) as usize] = true;
+            used[(b / 2) as usize] = true;
+        }
+        self.input_vars.iter().map(|&v| used[v as usize]).collect()
+    }
+}
+
+/// Literal of the compiled program: variable * 2 + negation; 0 is false, 1 is true.
+type Lit = u32;
+
+/// The graph simplified for one case: free inputs are variables 1..=free, then the gates.
+struct Program {
+    /// (lhs variable, a, b) with a, b literals of earlier variables.
+    gates: Vec<(u32, Lit, Lit)>,
+    output: Lit,
+    vars: usize,
+}
+
+fn compile(aig: &Aig, fixed: &[Option<bool>], free: &[usize]) -> Program {
+    const NONE: Lit = u32::MAX;
+    let mut map = vec![NONE; aig.max_var as usize + 1];
+    map[0] = 0;
+    for (i, &v) in aig.input_vars.iter().enumerate() {
+        map[v as usize] = match fixed[i] {
+            Some(b) => b as Lit,
+            None => 0, // an unused input: it drives nothing
+        };
+    }
+    for (k, &i) in free.iter().enumerate() {
+        map[aig.input_vars[i] as usize] = 2 * (k as u32 + 1);
+    }
+    let lit = |map: &[Lit], l: u32| map[(l / 2) as usize] ^ (l & 1);
+    let mut gates = Vec::new();
+    let mut next = free.len() as u32 + 1;
+    for &(lhs, a, b) in &aig.ands {
+        let (x, y) = (lit(&map, a), lit(&map, b));
+        map[lhs as usize] = if x == 0 || y == 0 || x == (y ^ 1) {
+            0
+        } else if x == 1 {
+            y
+        } else if y == 1 || x == y {
+            x
+        } else {
+            gates.push((next, x, y));
+            next += 1;
+            2 * (next - 1)
+        };
+    }
+    Program {
+        output: lit(&map, aig.output),
+        gates,
+        vars: next as usize,
+    }
+}
+
+/// The word pattern of free input `j` in word `w` of block `block`: inputs are numbered
+/// block * 512 + w * 64 + lane, and free input j is bit j of that number.
+fn pattern(j: usize, w: usize, block: u64) -> u64 {
+    const LANE: [u64; 6] = [
+        0xAAAA_AAAA_AAAA_AAAA,
+        0xCCCC_CCCC_CCCC_CCCC,
+        0xF0F0_F0F0_F0F0_F0F0,
+        0xFF00_FF00_FF00_FF00,
+        0xFFFF_0000_FFFF_0000,
+        0xFFFF_FFFF_0000_0000,
+    ];
+    let bit = if j < 6 {
+        return LANE[j];
+    } else if j < BLOCK_BITS as usize {
+        (w >> (j - 6)) & 1
+    } else {
+        ((block >> (j - BLOCK_BITS as usize)) & 1) as usize
+    };
+    0u64.wrapping_sub(bit as u64)
+}
+
+/// Runs `p` on every value of its free inputs; the first input number (block * 512 + lane)
+/// where the output is 0, if any.
+fn sweep(p: &Program, free: usize) -> Option<u64> {
+    let mut vals = vec![[0u64; WORDS]; p.vars];
+    let blocks = 1u64 << free.saturating_sub(BLOCK_BITS as usize);
+    // Fewer than 512 inputs: only the first 2^free lanes of the one block are inputs.
+    let valid = if free >= BLOCK_BITS as usize {
+        [!0u64; WORDS]
+    } else {
+        let n = 1usize << free;
+        std::array::from_fn(|w| {
+            let lanes = n.saturating_sub(w * 64).min(64);
+            if lanes == 64 {
+                !0
+            } else {
+                (1u64 << lanes) - 1
+            }
+        })
+    };
+    let get = |vals: &[[u64; WORDS]], l: Lit| -> [u64; WORDS] {
+        let m = if l & 1 == 1 { !0 } else { 0 };
+        let v = &vals[(l / 2) as usize];
+        std::array::from_fn(|k| v[k] ^ m)
+    };
+    for block in 0..blocks {
+        for j in 0..free {
+            vals[j + 1] = std::array::from_fn(|w| pattern(j, w, block));
+        }
+        for &(v, a, b) in &p.gates {
+            let (x, y) = (get(&vals, a), get(&vals, b));
+            vals[v as usize] = std::array::from_fn(|k| x[k] & y[k]);
+        }
+        let out = get(&vals, p.output);
+        for w in 0..WORDS {
+            let bad = !out[w] & valid[w];
+            if bad != 0 {
+                return Some((block << BLOCK_BITS) + (w as u64) * 64 + bad.trailing_zeros() as u64);
+            }
+        }
+    }
+    None
+}
+
+/// A failing input: each signal's value.
+pub type Assignment = Vec<(String, u128)>;
+
+/// Evaluates `aig` on every input: for each case (values of some signals, the rest
+/// enumerated). Returns the first failing input (cases in order, then input order), or None
+/// when `ok` is 1 everywhere. Signals named in a case must be inputs of the graph.
+pub fn exhaustive(aig: &Aig, cases: &[Vec<(String, u128)>]) -> Result<Option<Assignment>> {
+    let used = aig.used();
+    for case in cases {
+        for (s, _) in case {
+            if !aig.inputs.iter().any(|(n, _)| n == s) {
+                bail!("the case signal {s} is not an input of the miter");
+            }
+        }
+    }
+    let failure = cases
+        .par_iter()
+        .map(|case| {
+            let fixed: Vec<Option<bool>> = aig
+                .inputs
+                .iter()
+                .map(|(n, bit)| {
+                    case.iter()
+                        .find(|(s, _)| s == n)
+                        .map(|&(_, v)| (v >> bit) & 1 == 1)
+                })
+                .collect();
+            let free: Vec<usize> = (0..aig.inputs.len())
+                .filter(|&i| fixed[i].is_none() && used[i])
+                .collect();
+            let p = compile(aig, &fixed, &free);
+            sweep(&p, free.len()).map(|n| {
+                // The failing input's value of every signal.
+                let mut sigs: Assignment = Vec::new();
+                for (i, (name, bit)) in aig.inputs.iter().enumerate() {
+                    let b = match fixed[i] {
+                        Some(b) => b,
+                        None => free
+                            .iter()
+                            .position(|&f| f == i)
+                            .is_some_and(|k| (n >> k) & 1 == 1),
+                    };
+                    match sigs.iter_mut().find(|(s, _)| s == name) {
+                        Some((_, v)) => *v |= (b as u128) << bit,
+                        None => sigs.push((name.clone(), (b as u128) << bit)),
+                    }
+                }
+                sigs
+            })
+        })
+        .find_map_first(|f| f);
+    Ok(failure)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `ok = x XOR y`, built by hand: false at x = y.
+    fn xor_aig() -> (String, String) {
+        // ok = x XOR y over two inputs: 1 = x (var 1), 2 = y (var 2);
+        // 3 = x & !y, 4 = !x & y, 5 = !3 & !4 (XNOR), output !5.
+        let aag = "aag 5 2 0 1 3\n2\n4\n11\n6 2 5\n8 3 4\n10 7 9\n";
+        let map = "input 0 0 x\ninput 1 0 y\noutput 0 0 ok\n";
+        (aag.into(), map.into())
+    }
+
+    #[test]
+    fn finds_the_one_failing_input_and_names_it() {
+        let (aag, map) = xor_aig();
+        let g = Aig::parse(&aag, &map).unwrap();
+        assert_eq!(g.gates(), 3);
+        // XOR fails only at x = y: the first input in order is x = 0, y = 0.
+        let f = exhaustive(&g, &[Vec::new()]).unwrap().unwrap();
+        assert_eq!(f, vec![("x".into(), 0), ("y".into(), 0)]);
+        // With x = 1 fixed, y = 1 fails.
+        let f = exhaustive(&g, &[vec![("x".into(), 1)]]).unwrap().unwrap();
+        assert_eq!(f, vec![("x".into(), 1), ("y".into(), 1)]);
+    }
+
+    #[test]
+    fn a_tautology_over_many_inputs_passes_and_one_wrong_minterm_fails() {
+        // ok = !(AND of the twelve bits of x): false only at x = 4095, in the last block of
+        // eight (so the sweep must reach blocks past the first).
+        let n = 12u32;
+        let mut aag = format!("aag {} {n} 0 1 {}\n", 2 * n - 1, n - 1);
+        for i in 1..=n {
+            aag += &format!("{}\n", 2 * i);
+        }
+        aag += &format!("{}\n", 2 * (2 * n - 1) + 1);
+        let mut prev = 2;
+        for k in 0..n - 1 {
+            let lhs = 2 * (n + 1 + k);
+            aag += &format!("{lhs} {} {prev}\n", 2 * (k + 2));
+            prev = lhs;
+        }
+        let map: String = (0..n).map(|i| format!("input {i} {i} x\n")).collect();
+        let g = Aig::parse(&aag, &map).unwrap();
+        let f = exhaustive(&g, &[Vec::new()]).unwrap().unwrap();
+        assert_eq!(f, vec![("x".into(), 4095)]);
+        // A case fixing x = 0 leaves nothing to enumerate, and ok is 1 there.
+        let none = exhaustive(&g, &[vec![("x".into(), 0)]]).unwrap();
+        assert_eq!(none, None);
+    }
+
+    #[test]
+    fn refuses_latches_and_unknown_case_signals() {
+        assert!(Aig::parse("aag 1 0 1 1 0\n2 3\n2\n", "").is_err());
+        let (aag, map) = xor_aig();
+        let g = Aig::parse(&aag, &map).unwrap();
+        assert!(exhaustive(&g, &[vec![("z".into(), 1)]]).is_err());
+    }
+}
