@@ -47,6 +47,10 @@ pub struct ProveMultArgs {
     /// 2^34 inputs, else sat).
     #[arg(long, value_enum, default_value = "auto")]
     pub engine: EngineChoice,
+    /// Only these trees, by stage and tree name (normalise.pa; repeat the flag or separate
+    /// with commas) [default: every tree].
+    #[arg(long, value_name = "STAGE.TREE", value_delimiter = ',')]
+    pub tree: Vec<String>,
     #[command(flatten)]
     pub force: ForceArg,
 }
@@ -55,9 +59,13 @@ pub fn run(a: &ProveMultArgs) -> Result<ExitCode> {
     // Bad input first (the rows, the directory), then the tool, then the runs.
     let failed = if a.matrix {
         let rows = selected_rows(&a.row)?;
+        let mut all = Vec::new();
         for r in &rows {
-            engines(&mult_proof::jobs(&r.config), a.engine)?;
+            let jobs = chosen(&r.config, &a.tree);
+            engines(&jobs, a.engine)?;
+            all.extend(jobs);
         }
+        known_trees(&all, &a.tree)?;
         need_yosys()?;
         matrix(a, &rows)?
     } else {
@@ -66,13 +74,16 @@ pub fn run(a: &ProveMultArgs) -> Result<ExitCode> {
             .as_deref()
             .expect("clap requires DIR without --matrix");
         let design = DesignDir::open(dir)?;
-        engines(&mult_proof::jobs(&design.config), a.engine)?;
+        let jobs = chosen(&design.config, &a.tree);
+        known_trees(&jobs, &a.tree)?;
+        engines(&jobs, a.engine)?;
         need_yosys()?;
         let proof = prove(
             &design,
             &a.logs,
             &a.force.policy(&[Some(design.path())]),
             a.engine,
+            &a.tree,
         )?;
         print!("{}", proof.stdout);
         eprint!("{}", proof.stderr);
@@ -83,6 +94,24 @@ pub fn run(a: &ProveMultArgs) -> Result<ExitCode> {
     } else {
         ExitCode::SUCCESS
     })
+}
+
+/// The trees of `cfg` that `--tree` names (all without it).
+fn chosen(cfg: &crate::config::Config, trees: &[String]) -> Vec<Job> {
+    mult_proof::jobs(cfg)
+        .into_iter()
+        .filter(|j| trees.is_empty() || trees.contains(&j.name()))
+        .collect()
+}
+
+/// A `--tree` that names no tree of the designs is bad input.
+fn known_trees(jobs: &[Job], trees: &[String]) -> Result<()> {
+    for t in trees {
+        if !jobs.iter().any(|j| &j.name() == t) {
+            bail!("--tree {t}: no such tree in the design (names are stage.tree, as prove-mult prints them)");
+        }
+    }
+    Ok(())
 }
 
 /// Each job's engine; a tree `--engine exhaustive` cannot take is bad input.
@@ -109,8 +138,14 @@ struct Proof {
 }
 
 /// Proves every tree of `design`, its script, miters and log staged into `logs`.
-fn prove(design: &DesignDir, logs: &Path, policy: &Policy, choice: EngineChoice) -> Result<Proof> {
-    let jobs = mult_proof::jobs(&design.config);
+fn prove(
+    design: &DesignDir,
+    logs: &Path,
+    policy: &Policy,
+    choice: EngineChoice,
+    trees: &[String],
+) -> Result<Proof> {
+    let jobs = chosen(&design.config, trees);
     let engines = engines(&jobs, choice)?;
     let shown = design.path().display();
     let mut p = Proof {
@@ -122,7 +157,11 @@ fn prove(design: &DesignDir, logs: &Path, policy: &Policy, choice: EngineChoice)
         seconds: 0.0,
     };
     if jobs.is_empty() {
-        p.stdout = format!("prove-mult: {shown} has no adder tree\n");
+        p.stdout = if trees.is_empty() {
+            format!("prove-mult: {shown} has no adder tree\n")
+        } else {
+            format!("prove-mult: {shown} has none of the trees named\n")
+        };
         return Ok(p);
     }
     let staged = StagedDir::new(logs, policy)?;
@@ -245,7 +284,13 @@ fn matrix(a: &ProveMultArgs, rows: &[GridRow]) -> Result<bool> {
             s.spawn(|| loop {
                 let i = next.fetch_add(1, Ordering::Relaxed);
                 let Some(r) = rows.get(i) else { break };
-                let proof = prove(&designs[i], &a.logs.join(r.name), &policy, a.engine);
+                let proof = prove(
+                    &designs[i],
+                    &a.logs.join(r.name),
+                    &policy,
+                    a.engine,
+                    &a.tree,
+                );
                 if let Ok(p) = &proof {
                     // One row's lines together, under its name.
                     let mut all =

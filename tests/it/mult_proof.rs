@@ -182,6 +182,32 @@ fn the_matrix_proves_the_rows_named_and_refuses_an_unknown_row() {
     assert_eq!(err.trim().lines().count(), 1, "{err}");
     assert!(err.contains("no_such_row"), "{err}");
     assert!(!bad.exists());
+
+    // A tree no selected row has, and a tree too wide for --engine exhaustive: bad input,
+    // refused before anything is generated.
+    for (args, named) in [
+        (
+            &["--row", "narrowest", "--tree", "normalise.pq"][..],
+            "normalise.pq",
+        ),
+        (
+            &["--row", "widest", "--engine", "exhaustive"][..],
+            "interpolate.r",
+        ),
+    ] {
+        let out = rmapgen()
+            .arg("prove-mult")
+            .arg(&bad)
+            .arg("--matrix")
+            .args(args)
+            .output()
+            .expect("rmapgen runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(err.contains(named), "{err}");
+        assert!(!bad.exists());
+    }
 }
 
 /// `--mult infer`: the Verilog holds plain `*` products and no partial product (no gated
