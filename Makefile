@@ -264,15 +264,18 @@ fpga-check-ecp5: build venv
 	$(ECP5_ENV) $(RMAPGEN) fpga $(ECP5_ARGS) --require-timing
 
 # ---- Throughput sweep (rmapgen bench --throughput, src/bench/throughput.rs; a benchmark, not
-# in make test): lanes $(TP_LANES) x family $(TP_FAMILIES) (x multiplier style), each design
-# synthesised once and placed and routed on seeds 1..$(TP_SEEDS): median post-route Fmax,
-# samples/s = lanes x Fmax, logic cells, block RAMs, DSPs, the best row's critical path. ECP5
-# rows out of context (fpga --ooc), on the LFE5U-85F; iCE40 rows on the HX8K ("does not fit"
-# is a row). Writes throughput.md/.csv/.json and every seed's logs to $(TP_DIR). The full sweep
-# takes about an hour on 2 shared cores (eight ECP5 lanes: ~1 min synthesis, ~4.5 min a seed);
-# sections with e.g. make fpga-throughput TP_LANES=8 TP_FAMILIES=ecp5.
+# in make test): lanes $(TP_LANES) x family $(TP_FAMILIES) x multiplier style $(TP_MULTS),
+# each design synthesised once and placed and routed on seeds 1..$(TP_SEEDS): median
+# post-route Fmax, samples/s = lanes x Fmax, logic cells, block RAMs, DSPs, the best row's
+# critical path. Every row in context where its ports fit the pins; an ECP5 row with more port
+# bits than CABGA381 has pins (eight lanes) out of context (fpga --ooc), and the row says so;
+# iCE40 rows on the HX8K ("does not fit" is a row). Writes throughput.md/.csv/.json (rewritten
+# after every row) and every seed's logs to $(TP_DIR). The full sweep at 3 seeds took
+# 67 minutes on 2 shared cores (eight ECP5 lanes: ~1 min synthesis, ~4.5 min a seed);
+# sections with e.g. make fpga-throughput TP_LANES=8 TP_FAMILIES=ecp5 TP_MULTS=tree.
 TP_LANES    ?= 1,2,4,8
 TP_FAMILIES ?= ice40,ecp5
+TP_MULTS    ?= tree,infer
 TP_SEEDS    ?= 5
 TP_DIR      ?= out/throughput
 
@@ -280,7 +283,7 @@ TP_DIR      ?= out/throughput
 
 fpga-throughput: build venv
 	@WITH_FPGA=1 scripts/install-tools.sh
-	YOSYS=$(YOSYS) $(ECP5_ENV) $(RMAPGEN) bench --throughput --lanes $(TP_LANES) --family $(TP_FAMILIES) --seeds $(TP_SEEDS) --out $(TP_DIR) --force
+	YOSYS=$(YOSYS) $(ECP5_ENV) $(RMAPGEN) bench --throughput --lanes $(TP_LANES) --family $(TP_FAMILIES) --mult $(TP_MULTS) --seeds $(TP_SEEDS) --out $(TP_DIR) --force
 
 # ---- Gate-level sign-off (rmapgen sim --gate): the default design for the iCE40 (--target
 # ice40, what fpga places) generated into $(GATE_OUT), its top synthesised with Yosys

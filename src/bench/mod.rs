@@ -5,12 +5,13 @@
 //! via `render`); the fast bit-exact path's throughput on one thread and on all cores over 2^20
 //! uniform random gradients, and the float reference's on the same gradients (all cores, the
 //! ratio); the host's map build per frame (median); the ROM and map bits and, with Yosys and
-//! nextpnr-ice40 installed, the generated design placed and routed on an iCE40 HX8K
-//! (`rtl::fpga::ice40_report`: logic cells, block RAMs, post-route Fmax). A row is
+//! nextpnr installed, the generated design placed and routed on an iCE40 HX8K, or with
+//! `--family ecp5` an ECP5-85F, built with `--lanes` lanes ([`fpga::figures`]: logic cells,
+//! block RAMs, DSP blocks on the ECP5, post-route Fmax, samples/s = lanes x Fmax). A row is
 //! on a scene's Pareto front when no other row of that scene is at least as good in both error
 //! (RMSE) and cost (bits), or in both error and one-thread speed.
 
-pub mod ice40;
+pub mod fpga;
 pub mod octahedral;
 pub mod pareto;
 pub mod plot;
@@ -26,9 +27,10 @@ use crate::model::Model;
 use crate::output::StagedDir;
 use crate::reference::Reference;
 use crate::render::{self, metrics, sphere_gradients};
+use crate::rtl::fpga::Family;
 use crate::scene::Scene;
 use anyhow::Result;
-use ice40::{ice40_figures, Ice40};
+use fpga::{figures, Flow};
 use octahedral::Octahedral;
 use pareto::mark_pareto;
 use rayon::prelude::*;
@@ -43,8 +45,12 @@ pub struct Options {
     pub size: u32,
     /// Seconds spent timing each throughput figure.
     pub seconds: f64,
-    /// Place and route each configuration (Yosys, nextpnr-ice40) when they are installed.
+    /// Place and route each configuration (Yosys, nextpnr) when they are installed.
     pub yosys: bool,
+    /// The family placed, on its default part.
+    pub family: Family,
+    /// Lanes of each placed design (the model's figures are per lane).
+    pub lanes: u32,
     /// Only the paper's configuration (and the octahedral map).
     pub quick: bool,
     /// The scenes measured, (name, scene): [`scenes`] unless the command names one.
@@ -62,6 +68,8 @@ impl Default for Options {
             size: 512,
             seconds: 0.3,
             yosys: true,
+            family: Family::Ice40,
+            lanes: 1,
             quick: false,
             scenes: scenes(),
             fits: FITS.to_vec(),
@@ -183,13 +191,13 @@ pub fn run(opts: &Options, progress: &dyn Fn(&str)) -> Result<Vec<Row>> {
     let configs = configurations(opts.quick);
     let figures = if opts.yosys {
         let cs: Vec<Config> = configs.iter().map(|c| c.1.clone()).collect();
-        ice40_figures(&cs)?
+        figures(&cs, opts.family, opts.lanes)?
     } else {
-        vec![Ice40::NotRun; configs.len()]
+        vec![Flow::NotRun; configs.len()]
     };
     for ((design, cfg), fig) in configs.into_iter().zip(figures) {
         let placed = match &fig {
-            Ice40::Placed(r) => Some(r.as_ref()),
+            Flow::Placed(r) => Some(r.as_ref()),
             _ => None,
         };
         let model = Model::new(&cfg);
@@ -239,7 +247,12 @@ pub fn run(opts: &Options, progress: &dyn Fn(&str)) -> Result<Vec<Row>> {
                     ice40_cells: placed.map(|f| f.logic_cells),
                     ice40_brams: placed.map(|f| f.block_rams),
                     fmax_mhz: placed.map(|f| f.fmax_mhz),
-                    ice40_too_big: matches!(fig, Ice40::DoesNotFit(_)),
+                    ice40_too_big: matches!(fig, Flow::DoesNotFit(_)),
+                    family: opts.family,
+                    lanes: opts.lanes,
+                    dsps: placed
+                        .filter(|_| opts.family == Family::Ecp5)
+                        .map(|f| f.dsps),
                     pareto_cost: false,
                     pareto_speed: false,
                 });
@@ -292,6 +305,9 @@ pub fn run(opts: &Options, progress: &dyn Fn(&str)) -> Result<Vec<Row>> {
             ice40_brams: None,
             fmax_mhz: None,
             ice40_too_big: false,
+            family: opts.family,
+            lanes: opts.lanes,
+            dsps: None,
             pareto_cost: false,
             pareto_speed: false,
         });

@@ -6,16 +6,23 @@
 //! flip-flops, block RAMs and DSP blocks, and the critical path of the median seed. A design
 //! that needs more of the part than it has is a row saying so ("does not fit"), not an error.
 //!
-//! The ECP5 rows are placed out of context ([`fpga::Options::out_of_context`]): eight lanes
-//! have more port bits than any ECP5 package has pins, and an IP core is timed without its
-//! pins; every ECP5 row is placed the same way so the rows compare. The iCE40 rows are placed
-//! in context (nextpnr-ice40 has no out-of-context mode), on the HX8K in ct256.
+//! Every row is placed in context (its ports on the package's pins) where it can be. An ECP5
+//! design with more port bits than the package has pins (eight lanes on CABGA381) is placed
+//! out of context ([`fpga::Options::out_of_context`]: an IP core timed without its pins), and
+//! its row says so; nextpnr itself decides, from its complaint on the first seed
+//! ([`fpga::DoesNotFit::pins`]), so no pin count is kept here beside the one in nextpnr's
+//! database. The iCE40 rows are on the HX8K in ct256 (nextpnr-ice40 has no out-of-context
+//! mode, and a design that does not fit its pins does not fit).
 //!
-//! The multiplier style is a column so that the products a DSP block can absorb (`--mult
-//! infer`, not in this tree yet) become more rows of the same table; today every product is an
-//! adder tree (`tree`).
+//! The multiplier style (`--mult`, [`Mult`]) is a column: adder trees of partial products
+//! (`tree`) and plain products a DSP block can absorb (`infer`) of the same lane count and
+//! family are rows of the same table.
+//!
+//! The tables are rewritten after every row, in the sweep's staging directory, and each row is
+//! reported as a Markdown line as soon as it is measured: a sweep stopped part-way (it takes
+//! hours) still leaves the rows it finished (see [`run`]).
 
-use crate::config::{Config, Target};
+use crate::config::{Config, Mult, Target};
 use crate::output::StagedDir;
 use crate::rtl::fpga::{self, Family, FpgaReport};
 use anyhow::{Context, Result};
@@ -27,6 +34,8 @@ use std::path::Path;
 pub struct Sweep {
     pub lanes: Vec<u32>,
     pub families: Vec<Family>,
+    /// Multiplier styles.
+    pub mults: Vec<Mult>,
     /// Placer seeds; the row's Fmax is their median.
     pub seeds: Vec<u64>,
     /// The clock the placer aims at, MHz.
@@ -42,14 +51,15 @@ pub const SEEDS: u64 = 5;
 /// The placer's target in the sweep, MHz: above what either part reaches with this design,
 /// so that the placer keeps pushing for timing on every seed.
 pub const FREQ_MHZ: f64 = 200.0;
-/// The multiplier style of every product today (adder trees of partial products, rtl/sum.rs).
-pub const MULT: &str = "tree";
+/// The multiplier styles of the full sweep.
+pub const MULTS: [Mult; 2] = [Mult::Tree, Mult::Infer];
 
 impl Default for Sweep {
     fn default() -> Self {
         Sweep {
             lanes: LANES.to_vec(),
             families: FAMILIES.to_vec(),
+            mults: MULTS.to_vec(),
             seeds: (1..=SEEDS).collect(),
             freq_mhz: FREQ_MHZ,
         }
@@ -71,7 +81,7 @@ pub struct Row {
     pub package: String,
     pub out_of_context: bool,
     pub lanes: u32,
-    pub mult: String,
+    pub mult: Mult,
     /// nextpnr's complaint when the design needs more of the part than it has.
     pub does_not_fit: Option<String>,
     pub seeds: Vec<Seed>,
@@ -98,35 +108,41 @@ fn median(v: &[f64]) -> f64 {
     }
 }
 
-/// The part each family is swept on, and whether out of context.
+/// The part each family is swept on, in context.
 fn options(family: Family, freq_mhz: f64) -> fpga::Options {
     fpga::Options {
         freq_mhz,
-        out_of_context: family == Family::Ecp5,
         ..fpga::Options::for_family(family)
     }
 }
 
-/// Runs the sweep; logs of each configuration under `out/<family>-l<lanes>-<mult>/` (the
-/// netlist, yosys.log, nextpnr_seed<N>.log and its report). `progress` hears each step.
+/// Runs the sweep, family by family, lane count by lane count, multiplier style by style;
+/// logs of each configuration under `out/<family>-l<lanes>-<mult>/` (the netlist, yosys.log,
+/// nextpnr_seed<N>.log and its report). After every row the tables ([`write`]) are rewritten
+/// in `out` with the rows so far, and `progress` hears the row as a Markdown line (it hears
+/// each step too): a sweep stopped part-way keeps what it measured.
 pub fn run(sweep: &Sweep, out: &StagedDir, progress: &dyn Fn(&str)) -> Result<Vec<Row>> {
     anyhow::ensure!(!sweep.seeds.is_empty(), "the sweep has no seeds");
     let mut rows = Vec::new();
     for &family in &sweep.families {
         for &lanes in &sweep.lanes {
-            let cfg = Config {
-                lanes,
-                ..Config::default()
+            for &mult in &sweep.mults {
+                let cfg = Config {
+                    lanes,
+                    mult,
+                    ..Config::default()
+                }
+                .for_target(Target::Ice40);
+                cfg.validate()?;
+                let name = format!("{}-l{lanes}-{}", family.name(), mult.name());
+                let logs = out.path().join(&name);
+                progress(&format!("{name}: synthesis"));
+                let row = configuration(&cfg, family, sweep, &logs, &name, progress)
+                    .with_context(|| format!("throughput sweep, {name}"))?;
+                progress(&format!("{name}: {}", line(&row).trim_end()));
+                rows.push(row);
+                write(&rows, out)?;
             }
-            .for_target(Target::Ice40);
-            cfg.validate()?;
-            let name = format!("{}-l{lanes}-{MULT}", family.name());
-            let logs = out.path().join(&name);
-            progress(&format!("{name}: synthesis"));
-            rows.push(
-                configuration(&cfg, family, sweep, &logs, &name, progress)
-                    .with_context(|| format!("throughput sweep, {name}"))?,
-            );
         }
     }
     Ok(rows)
@@ -156,7 +172,7 @@ fn configuration(
         package: opts.package.clone(),
         out_of_context: opts.out_of_context,
         lanes: cfg.lanes,
-        mult: MULT.into(),
+        mult: cfg.mult,
         does_not_fit: None,
         seeds: Vec::new(),
         fmax_mhz: None,
@@ -170,7 +186,29 @@ fn configuration(
     for &seed in &sweep.seeds {
         progress(&format!("{name}: seed {seed}"));
         opts.seed = seed;
-        match fpga::place(&syn, &opts) {
+        let mut placed = fpga::place(&syn, &opts);
+        // Too few pins for the ports (ECP5 only: the first seed in context tells): the row is
+        // placed out of context from here on, every seed alike. The in-context attempt's log
+        // is kept beside the others.
+        let pins = placed
+            .as_ref()
+            .err()
+            .and_then(|e| e.downcast_ref::<fpga::DoesNotFit>())
+            .is_some_and(|d| d.pins);
+        if pins && family == Family::Ecp5 && !opts.out_of_context {
+            progress(&format!(
+                "{name}: more port bits than pins; placing out of context"
+            ));
+            let (stem, ext) = split(crate::toolchain::nextpnr::LOG);
+            std::fs::rename(
+                logs.join(crate::toolchain::nextpnr::LOG),
+                logs.join(format!("{stem}_in_context.{ext}")),
+            )?;
+            opts.out_of_context = true;
+            row.out_of_context = true;
+            placed = fpga::place(&syn, &opts);
+        }
+        match placed {
             Ok(r) => reports.push(r),
             Err(e) => match e.downcast_ref::<fpga::DoesNotFit>() {
                 // Another seed does not change what the part has.
@@ -189,7 +227,7 @@ fn configuration(
             crate::toolchain::nextpnr::LOG,
             crate::toolchain::nextpnr::REPORT,
         ] {
-            let (stem, ext) = f.rsplit_once('.').unwrap_or((f, ""));
+            let (stem, ext) = split(f);
             std::fs::rename(logs.join(f), logs.join(format!("{stem}_seed{seed}.{ext}")))?;
         }
     }
@@ -211,6 +249,11 @@ fn configuration(
     Ok(row)
 }
 
+/// A log file's name as stem and extension.
+fn split(f: &str) -> (&str, &str) {
+    f.rsplit_once('.').unwrap_or((f, ""))
+}
+
 /// The row with the most samples/s.
 pub fn best(rows: &[Row]) -> Option<&Row> {
     rows.iter()
@@ -222,59 +265,70 @@ pub fn best(rows: &[Row]) -> Option<&Row> {
         })
 }
 
+/// The header of the Markdown table.
+const HEADER: &str = "| family | part | placed | lanes | mult | Fmax median (MHz) | Fmax per seed (MHz) | samples/s | logic cells | LUT4 | flip-flops | block RAMs | DSP | memory bits per lane |\n\
+     |---|---|---|---:|---|---:|---|---:|---:|---:|---:|---:|---:|---:|\n";
+
+/// How a row was placed, as its column says it.
+fn placed(r: &Row) -> &'static str {
+    if r.out_of_context {
+        "out of context (more port bits than pins)"
+    } else {
+        "in context"
+    }
+}
+
+/// One row of the Markdown table, with its line end.
+pub fn line(r: &Row) -> String {
+    let head = format!(
+        "| {} | {} {} | {} | {} | {} |",
+        r.family.title(),
+        r.device,
+        r.package,
+        placed(r),
+        r.lanes,
+        r.mult.name()
+    );
+    match (&r.report, r.fmax_mhz, r.samples_per_s) {
+        (Some(p), Some(f), Some(sps)) => {
+            let seeds: Vec<String> = r
+                .seeds
+                .iter()
+                .map(|x| format!("{:.1}", x.fmax_mhz))
+                .collect();
+            format!(
+                "{head} {f:.1} | {} | {:.3e} | {} | {} | {} | {} | {} | {} |\n",
+                seeds.join(", "),
+                sps,
+                p.logic_cells,
+                p.luts,
+                p.flip_flops,
+                p.block_rams,
+                p.dsps,
+                r.memory_bits_per_lane
+            )
+        }
+        _ => format!(
+            "{head} does not fit | | | | | | | | {} |\n",
+            r.memory_bits_per_lane
+        ),
+    }
+}
+
 /// The rows as a Markdown table, then the critical path of the best row.
 pub fn markdown(rows: &[Row]) -> String {
-    let mut s = String::from(
-        "| family | part | lanes | mult | Fmax median (MHz) | Fmax per seed (MHz) | samples/s | logic cells | LUT4 | flip-flops | block RAMs | DSP | memory bits per lane |\n\
-         |---|---|---:|---|---:|---|---:|---:|---:|---:|---:|---:|---:|\n",
-    );
+    let mut s = String::from(HEADER);
     for r in rows {
-        let part = format!(
-            "{} {}{}",
-            r.device,
-            r.package,
-            if r.out_of_context { ", OOC" } else { "" }
-        );
-        let head = format!(
-            "| {} | {part} | {} | {} |",
-            r.family.title(),
-            r.lanes,
-            r.mult
-        );
-        match (&r.report, r.fmax_mhz, r.samples_per_s) {
-            (Some(p), Some(f), Some(sps)) => {
-                let seeds: Vec<String> = r
-                    .seeds
-                    .iter()
-                    .map(|x| format!("{:.1}", x.fmax_mhz))
-                    .collect();
-                s += &format!(
-                    "{head} {f:.1} | {} | {:.3e} | {} | {} | {} | {} | {} | {} |\n",
-                    seeds.join(", "),
-                    sps,
-                    p.logic_cells,
-                    p.luts,
-                    p.flip_flops,
-                    p.block_rams,
-                    p.dsps,
-                    r.memory_bits_per_lane
-                );
-            }
-            _ => {
-                s += &format!(
-                    "{head} does not fit | | | | | | | | {} |\n",
-                    r.memory_bits_per_lane
-                );
-            }
-        }
+        s += &line(r);
     }
     if let Some(b) = best(rows) {
         if let Some(c) = b.report.as_ref().and_then(|p| p.critical_path.as_ref()) {
             s += &format!(
-                "\nBest: {} {} lanes ({}), {:.3e} samples/s; critical path of seed {} ({:.1} ns logic, {:.1} ns routing): {}\n",
+                "\nBest: {} {} lanes ({}, {}), {:.3e} samples/s; critical path of seed {} ({:.1} ns logic, {:.1} ns routing): {}\n",
                 b.family.title(),
                 b.lanes,
-                b.mult,
+                b.mult.name(),
+                placed(b),
                 b.samples_per_s.unwrap_or(0.0),
                 b.report.as_ref().map_or(0, |p| p.seed),
                 c.logic_ns,
@@ -285,9 +339,10 @@ pub fn markdown(rows: &[Row]) -> String {
     }
     for r in rows.iter().filter(|r| r.does_not_fit.is_some()) {
         s += &format!(
-            "\n{} {} lanes does not fit: {}\n",
+            "\n{} {} lanes ({}) does not fit: {}\n",
             r.family.title(),
             r.lanes,
+            r.mult.name(),
             r.does_not_fit.as_deref().unwrap_or("")
         );
     }
@@ -312,7 +367,7 @@ pub fn csv(rows: &[Row]) -> String {
             r.package,
             r.out_of_context,
             r.lanes,
-            r.mult,
+            r.mult.name(),
             r.does_not_fit.is_none(),
             r.fmax_mhz.map_or(String::new(), |f| format!("{f:.2}")),
             seeds.join(" "),
@@ -340,6 +395,53 @@ pub fn write(rows: &[Row], out: &StagedDir) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn row(family: Family, lanes: u32, mult: Mult, out_of_context: bool) -> Row {
+        Row {
+            family,
+            device: "85k".into(),
+            package: "CABGA381".into(),
+            out_of_context,
+            lanes,
+            mult,
+            does_not_fit: None,
+            seeds: Vec::new(),
+            fmax_mhz: None,
+            samples_per_s: None,
+            report: None,
+            memory_bits: 8,
+            memory_bits_per_lane: 1,
+        }
+    }
+
+    #[test]
+    fn a_row_says_how_it_was_placed_and_its_multiplier() {
+        let mut r = row(Family::Ecp5, 8, Mult::Infer, true);
+        r.does_not_fit = Some("no BELs".into());
+        let l = line(&r);
+        assert!(
+            l.starts_with("| ECP5 | 85k CABGA381 | out of context (more port bits than pins) | 8 | infer | does not fit |"),
+            "{l}"
+        );
+        let l = line(&row(Family::Ecp5, 1, Mult::Tree, false));
+        assert!(l.contains("| in context | 1 | tree |"), "{l}");
+        // Every line has the header's columns.
+        let md = markdown(&[r.clone(), row(Family::Ice40, 2, Mult::Tree, false)]);
+        let bars: Vec<usize> = md.lines().take(4).map(|x| x.matches('|').count()).collect();
+        assert!(bars.iter().all(|&n| n == bars[0]), "{md}");
+        assert!(
+            md.contains("ECP5 8 lanes (infer) does not fit: no BELs"),
+            "{md}"
+        );
+        let c = csv(&[r]);
+        assert!(
+            c.lines()
+                .nth(1)
+                .unwrap()
+                .starts_with("ecp5,85k,CABGA381,true,8,infer,false,"),
+            "{c}"
+        );
+    }
 
     #[test]
     fn median_of_odd_and_even_counts() {

@@ -32,7 +32,7 @@ pub struct BenchArgs {
     /// Seconds spent timing each throughput figure (0, 60].
     #[arg(long, value_name = "S", default_value_t = 0.3, value_parser = super::parse::positive())]
     pub seconds: f64,
-    /// Skip the iCE40 place and route (Yosys, nextpnr-ice40) even when they are installed.
+    /// Skip the FPGA place and route (Yosys, nextpnr) even when they are installed.
     #[arg(long)]
     pub no_yosys: bool,
     /// Only the paper's configuration (and the octahedral map).
@@ -43,18 +43,27 @@ pub struct BenchArgs {
     #[command(flatten)]
     pub map: super::map_args::MapArgs,
     /// Instead of the error/cost table: the FPGA throughput sweep (make fpga-throughput).
-    /// Each lane count x family is synthesised once and placed and routed per seed; the table
-    /// (throughput.md, .csv, .json in --out) gives the median post-route Fmax, samples/s =
-    /// lanes x Fmax, logic cells, block RAMs and DSP blocks, and the best row's critical path.
-    /// ECP5 rows are placed out of context (fpga --ooc). Slow: hours for the full sweep.
+    /// Each lane count x family x multiplier style is synthesised once and placed and routed
+    /// per seed; the table (throughput.md, .csv, .json in --out, rewritten after every row)
+    /// gives the median post-route Fmax, samples/s = lanes x Fmax, logic cells, block RAMs and
+    /// DSP blocks, and the best row's critical path. Rows are placed in context; an ECP5 row
+    /// with more port bits than pins out of context (fpga --ooc), and says so. Slow: hours for
+    /// the full sweep.
     #[arg(long)]
     pub throughput: bool,
-    /// Lane counts of the throughput sweep [default: 1,2,4,8].
-    #[arg(long, value_delimiter = ',', requires = "throughput", value_parser = super::parse::field("lanes"))]
+    /// Lane counts of the throughput sweep [default: 1,2,4,8]; without --throughput, the one
+    /// lane count each configuration is placed with (its FPGA columns then add samples/s =
+    /// lanes x Fmax) [1..=8, default 1].
+    #[arg(long, value_delimiter = ',', value_parser = super::parse::field("lanes"))]
     pub lanes: Vec<u32>,
-    /// Families of the throughput sweep [default: ice40,ecp5].
-    #[arg(long, value_enum, value_delimiter = ',', requires = "throughput")]
+    /// Families of the throughput sweep [default: ice40,ecp5]; without --throughput, the one
+    /// family each configuration is placed on (its default part: iCE40 HX8K, ECP5-85F)
+    /// [default: ice40].
+    #[arg(long, value_enum, value_delimiter = ',')]
     pub family: Vec<crate::rtl::fpga::Family>,
+    /// Multiplier styles of the throughput sweep [default: tree,infer].
+    #[arg(long, value_enum, value_delimiter = ',', requires = "throughput")]
+    pub mult: Vec<crate::config::Mult>,
     /// Placer seeds of the throughput sweep, 1..=N [default: 5].
     #[arg(long, value_name = "N", requires = "throughput", value_parser = super::parse::whole::<u64>(1, MAX_SEEDS))]
     pub seeds: Option<u64>,
@@ -82,11 +91,23 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         }
         None => bench::scenes(),
     };
+    // One FPGA for the bench's columns; the lists are the throughput sweep's.
+    anyhow::ensure!(
+        a.lanes.len() <= 1,
+        "--lanes takes one lane count without --throughput (a list is the throughput sweep's)"
+    );
+    anyhow::ensure!(
+        a.family.len() <= 1,
+        "--family takes one family without --throughput (a list is the throughput sweep's)"
+    );
+    let d = Options::default();
     let out = StagedDir::new(&a.out, &a.force.policy(&[a.map.input()]))?;
     let opts = Options {
         size: a.size,
         seconds: a.seconds,
         yosys: !a.no_yosys,
+        family: a.family.first().copied().unwrap_or(d.family),
+        lanes: a.lanes.first().copied().unwrap_or(d.lanes),
         quick: a.quick,
         scenes,
         fits: a.map.map_fit.map_or(bench::FITS.to_vec(), |f| vec![f]),
@@ -128,9 +149,28 @@ fn throughput(a: &BenchArgs) -> Result<()> {
         } else {
             a.family.clone()
         },
+        mults: if a.mult.is_empty() {
+            d.mults
+        } else {
+            a.mult.clone()
+        },
         seeds: a.seeds.map_or(d.seeds, |n| (1..=n).collect()),
         freq_mhz: d.freq_mhz,
     };
+    // A value named twice would be a row measured twice into the same log directory.
+    fn once<T: PartialEq + std::fmt::Debug>(flag: &str, v: &[T]) -> Result<()> {
+        for (i, x) in v.iter().enumerate() {
+            anyhow::ensure!(
+                !v[..i].contains(x),
+                "{flag} names {} twice",
+                format!("{x:?}").to_lowercase()
+            );
+        }
+        Ok(())
+    }
+    once("--lanes", &sweep.lanes)?;
+    once("--family", &sweep.families)?;
+    once("--mult", &sweep.mults)?;
     let out = StagedDir::new(&a.out, &a.force.policy(&[]))?;
     let result = throughput::run(&sweep, &out, &|m| eprintln!("rmapgen: throughput: {m}"));
     // The logs are kept also when a configuration fails, so that they can be read.

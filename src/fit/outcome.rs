@@ -25,6 +25,10 @@ pub struct Candidate {
 pub struct Decision {
     pub target: Target,
     pub cost: CostKind,
+    /// The family whose synthesis counted the cells; left out of fit.json for the iCE40 (the
+    /// default), so a default fit writes what it wrote before the flag.
+    #[serde(skip_serializing_if = "is_ice40")]
+    pub family: crate::rtl::fpga::Family,
     pub image_size: u32,
     pub pixels: usize,
     pub map_fit: MapFit,
@@ -44,6 +48,10 @@ pub struct Decision {
     /// Candidates synthesised (cost in cells; 0 otherwise), besides the paper's.
     pub synthesised: usize,
     pub seconds: f64,
+}
+
+fn is_ice40(f: &crate::rtl::fpga::Family) -> bool {
+    *f == crate::rtl::fpga::Family::Ice40
 }
 
 /// The lowest error reachable, when nothing meets the target.

@@ -30,7 +30,7 @@ fn range(field: &str) -> (u32, u32) {
 }
 
 /// Every valid configuration with `base`'s interface fields (grad_bits, map_bits, color,
-/// pipeline_depth, handshake), in no particular order.
+/// pipeline_depth, handshake, lanes), in no particular order.
 pub fn candidates(base: &Config) -> Vec<Config> {
     let (r0, r1) = range("red_bits");
     let (f0, f1) = range("frac_bits");
@@ -123,6 +123,7 @@ pub fn paper(base: &Config) -> Config {
         color: base.color,
         pipeline_depth: base.pipeline_depth,
         handshake: base.handshake,
+        lanes: base.lanes,
         ..Config::default()
     }
 }

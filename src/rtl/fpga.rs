@@ -16,8 +16,8 @@
 //! error; a device or package nextpnr does not know, or a design that does not fit, is an
 //! error whose one line quotes nextpnr's complaint.
 //!
-//! `rmapgen fpga` and `make fpga` (`make fpga-ecp5`) print the report; `rmapgen bench` and
-//! `fit --cost cells` call [`ice40_report`].
+//! `rmapgen fpga` and `make fpga` (`make fpga-ecp5`) print the report; `rmapgen bench` calls
+//! [`report`] for its FPGA columns, and `bench --throughput` [`synthesise`] and [`place`].
 
 use super::manifest;
 use super::ports::CLOCK;
@@ -204,11 +204,6 @@ pub fn tools_available(opts: &Options) -> bool {
     yosys && nextpnr::available(opts.family)
 }
 
-/// [`report`], the name the iCE40 callers (bench, `fit --cost cells`) know it by.
-pub fn ice40_report(cfg: &Config, opts: &Options) -> Result<FpgaReport> {
-    report(cfg, opts)
-}
-
 /// Generates `cfg`'s design with `--target ice40` (block-RAM attributes, whatever
 /// `cfg.target` says; the standard scene's maps) into a temporary directory and runs the flow
 /// of `opts.family` on it.
@@ -251,6 +246,17 @@ fn signal(cell: &str) -> String {
 #[error("{message}")]
 pub struct DoesNotFit {
     pub message: String,
+    /// What is short is pins: the top has more port bits than the package has I/O cells
+    /// (nextpnr's complaint names TRELLIS_IO, the ECP5 I/O cell), which placing out of context
+    /// ([`Options::out_of_context`]) lifts.
+    pub pins: bool,
+}
+
+/// Whether nextpnr's complaint `said` is about pins: it names the ECP5 I/O cell (TRELLIS_IO),
+/// which only a design placed in context has. Read from the complaint line, not the whole
+/// log: every ECP5 log lists TRELLIS_IO in its utilisation.
+fn short_of_pins(said: &str, out_of_context: bool) -> bool {
+    !out_of_context && said.contains("TRELLIS_IO")
 }
 
 /// What nextpnr says when the design needs more of a resource than the device has.
@@ -471,13 +477,14 @@ pub fn place(syn: &Synthesis, opts: &Options) -> Result<FpgaReport> {
     let run = toolchain::capture(&mut nextpnr::place_and_route(&target(opts), logs, top))?;
     let out = run.output;
     if !run.status.success() {
-        let mut message = format!("{part}: {}", complaint(&out));
-        // The ECP5 IO cell: more port bits than the package has pins.
-        if !opts.out_of_context && out.contains("TRELLIS_IO") {
+        let said = complaint(&out);
+        let mut message = format!("{part}: {said}");
+        let pins = short_of_pins(&said, opts.out_of_context);
+        if pins {
             message += "; the top has more port bits than the package has pins: place it out of context (--ooc)";
         }
         if DOES_NOT_FIT.iter().any(|m| out.contains(m)) {
-            return Err(DoesNotFit { message }.into());
+            return Err(DoesNotFit { message, pins }.into());
         }
         bail!(message);
     }
@@ -576,6 +583,16 @@ mod tests {
         assert!(is_design_clock("clk_i") && is_design_clock("clk_i$SB_IO_IN_$glb_clk"));
         // Another net that nextpnr took for a clock is not the design's.
         assert!(!is_design_clock("u_lane0.clk_div") && !is_design_clock("clk_io"));
+    }
+
+    #[test]
+    fn too_few_pins_is_told_from_the_complaint() {
+        // nextpnr-ecp5's words for eight lanes in context on CABGA381 (399 of 365 I/O).
+        let io = "ERROR: Unable to place cell 'valid_o[6]$tr_io', no BELs remaining to implement cell type 'TRELLIS_IO'";
+        assert!(short_of_pins(io, false));
+        assert!(!short_of_pins(io, true));
+        let ram = "ERROR: Unable to place cell 'u_lane0.u_map_lookup.mem', no BELs remaining to implement cell type 'DP16KD'";
+        assert!(!short_of_pins(ram, false));
     }
 
     #[test]

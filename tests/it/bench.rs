@@ -4,6 +4,7 @@
 use super::helpers;
 use rmapgen::bench::row::Row;
 use rmapgen::bench::{pareto, table};
+use rmapgen::rtl::fpga::Family;
 
 fn row(scene: &str, bits: u64, speed: f64, rmse: f64) -> Row {
     Row {
@@ -24,6 +25,9 @@ fn row(scene: &str, bits: u64, speed: f64, rmse: f64) -> Row {
         ice40_cells: None,
         ice40_brams: None,
         ice40_too_big: false,
+        family: Family::Ice40,
+        lanes: 1,
+        dsps: None,
         fmax_mhz: None,
         pareto_cost: false,
         pareto_speed: false,
@@ -81,6 +85,110 @@ fn a_design_too_big_for_the_device_is_a_figure() {
         ["", "", "", "true"],
         "{csv}"
     );
+}
+
+#[test]
+fn another_family_or_lanes_name_the_family_and_add_dsps_and_samples_per_second() {
+    let mut r = row("s", 100, 1.0, 1.0);
+    r.family = Family::Ecp5;
+    r.lanes = 4;
+    r.ice40_cells = Some(5000);
+    r.ice40_brams = Some(28);
+    r.dsps = Some(32);
+    r.fmax_mhz = Some(125.0);
+    let md = table::markdown(std::slice::from_ref(&r));
+    let lines: Vec<&str> = md.lines().collect();
+    assert!(
+        lines[0].contains(
+            "| ECP5 cells | block RAMs | Fmax (MHz) | DSP | samples/s (4 lanes) | Pareto |"
+        ),
+        "{md}"
+    );
+    assert_eq!(lines[0].matches('|').count(), lines[1].matches('|').count());
+    assert!(
+        lines[2].contains("| 5000 | 28 | 125.0 | 32 | 5.000e8 |"),
+        "{md}"
+    );
+    let csv = table::csv(std::slice::from_ref(&r));
+    let head = csv.lines().next().unwrap();
+    assert!(
+        head.contains(",ecp5_cells,ecp5_brams,fmax_mhz,ecp5_too_big,"),
+        "{csv}"
+    );
+    assert!(head.ends_with(",lanes,dsps,samples_per_s"), "{csv}");
+    assert!(
+        csv.lines().nth(1).unwrap().ends_with(",4,32,500000000"),
+        "{csv}"
+    );
+    // The default (iCE40, one lane) has the columns it had before the flags.
+    let d = table::csv(&[row("s", 100, 1.0, 1.0)]);
+    assert!(
+        d.lines()
+            .next()
+            .unwrap()
+            .ends_with(",ice40_cells,ice40_brams,fmax_mhz,ice40_too_big,pareto_cost,pareto_speed"),
+        "{d}"
+    );
+    let json = serde_json::to_value(row("s", 100, 1.0, 1.0)).unwrap();
+    assert!(
+        json.get("family").is_none() && json.get("lanes").is_none(),
+        "{json}"
+    );
+    let json = serde_json::to_value(&r).unwrap();
+    assert_eq!(
+        (json["family"].as_str(), json["lanes"].as_u64()),
+        (Some("ecp5"), Some(4))
+    );
+}
+
+/// The FPGA flags of bench and of its throughput sweep: bad input is one line, exit 2, and
+/// nothing written (no synthesis runs: every case fails before it).
+#[test]
+fn bad_fpga_flags_are_one_line_and_write_nothing() {
+    let tmp = helpers::tempdir();
+    let out = tmp.path().join("b");
+    let o = out.to_str().unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        // Lists are the sweep's; the bench places one family with one lane count.
+        (
+            &["--lanes", "1,2"],
+            "--lanes takes one lane count without --throughput",
+        ),
+        (
+            &["--family", "ice40,ecp5"],
+            "--family takes one family without --throughput",
+        ),
+        (&["--lanes", "9"], "--lanes must be in 1..=8, not 9"),
+        (
+            &["--family", "virtex"],
+            "invalid value 'virtex' for '--family",
+        ),
+        // --mult is the sweep's only.
+        (&["--mult", "infer"], "--throughput"),
+        (
+            &["--throughput", "--mult", "tree,fast"],
+            "invalid value 'fast' for '--mult",
+        ),
+        // A value named twice would be a row measured twice into one log directory.
+        (
+            &["--throughput", "--mult", "tree,tree"],
+            "--mult names tree twice",
+        ),
+        (
+            &["--throughput", "--lanes", "2,1,2"],
+            "--lanes names 2 twice",
+        ),
+        (
+            &["--throughput", "--family", "ecp5,ecp5"],
+            "--family names ecp5 twice",
+        ),
+    ];
+    for (args, needle) in cases {
+        let mut a = vec!["bench", "--quick", "--out", o];
+        a.extend_from_slice(args);
+        helpers::assert_error(&helpers::run(&a), needle);
+        assert!(!out.exists(), "{args:?} wrote {o}");
+    }
 }
 
 #[test]

@@ -319,7 +319,7 @@ fn bad_input_is_one_line_exit_2_and_leaves_the_output_alone() {
         "[material]\nambient=0.1\ndiffuse=0.6\nspecular=0.3\nshininess=20\n[[light]]\ndirection=[0,0,0]\n",
     )
     .unwrap();
-    let cases: [(Vec<&str>, &str); 6] = [
+    let cases: [(Vec<&str>, &str); 9] = [
         (
             vec!["--scene", &s, "--max-error", "4", "--grad-bits", "20"],
             "--grad-bits must be in 8..=16, not 20",
@@ -343,6 +343,28 @@ fn bad_input_is_one_line_exit_2_and_leaves_the_output_alone() {
         (
             vec!["--scene", &s, "--rmse", "0.0001", "--size", "64"],
             "the lowest RMSE reachable",
+        ),
+        // The family only says whose synthesis counts cells.
+        (
+            vec!["--scene", &s, "--max-error", "4", "--family", "ecp5"],
+            "--family chooses the synthesis that counts --cost cells",
+        ),
+        (
+            vec![
+                "--scene",
+                &s,
+                "--max-error",
+                "4",
+                "--cost",
+                "cells",
+                "--family",
+                "virtex",
+            ],
+            "invalid value 'virtex' for '--family",
+        ),
+        (
+            vec!["--scene", &s, "--max-error", "4", "--lanes", "9"],
+            "--lanes must be in 1..=8, not 9",
         ),
     ];
     for (args, needle) in cases {

@@ -278,7 +278,7 @@ fn ice40_report_gives_a_missed_target_as_a_figure() {
         freq_mhz: 500.0,
         ..fpga::Options::default()
     };
-    let r = fpga::ice40_report(&cfg, &opts).expect("the flow runs");
+    let r = fpga::report(&cfg, &opts).expect("the flow runs");
     assert!(
         !r.timing_met && r.fmax_mhz > 50.0 && r.fmax_mhz < 500.0,
         "{r:?}"
