@@ -32,7 +32,9 @@ pub mod histogram;
 pub mod load;
 pub mod picture;
 pub mod prepared;
+pub mod renderer;
 pub mod report;
+pub mod shear;
 pub mod synthetic;
 
 use anyhow::{bail, Result};
