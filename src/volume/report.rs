@@ -473,6 +473,27 @@ mod tests {
     }
 
     #[test]
+    fn shear_warp_batch_hook() {
+        // `--rtl` with shear-warp: the batch shader shades the collected samples; one that
+        // agrees with the model gives its image, one that does not is reported.
+        let vol = synthetic::engine_block([48, 48, 24], [1.0; 3]).unwrap();
+        let cfg = Config::default();
+        let p = Prepared::new(&vol, cfg.grad_bits, 8);
+        let o = CastOptions {
+            size: 48,
+            caster: crate::volume::cast::options::CasterKind::ShearWarp,
+            ..CastOptions::default()
+        };
+        let s = scene();
+        let same = AsModel(ModelShader::new(&cfg, &s));
+        let r = render(&p, &cfg, &s, o, Some(&same), false).unwrap();
+        assert_eq!(r.rtl_mismatches(), Some(0));
+        assert!(r.metrics.as_ref().unwrap().pixels > 48 * 48 / 4);
+        let other = render(&p, &cfg, &s, o, Some(&Fixed(3)), false).unwrap();
+        assert!(other.rtl_mismatches().unwrap() > 0);
+    }
+
+    #[test]
     fn a_scene_without_transfer_is_refused() {
         let vol = synthetic::engine_block([16, 16, 8], [1.0; 3]).unwrap();
         let p = Prepared::new(&vol, 12, 8);

@@ -74,7 +74,7 @@ pub struct ShearWarp<'a> {
     opts: CastOptions,
     /// Principal axis and the slice axes (a along scanlines).
     axes: [usize; 3],
-    /// Voxel index stride along c, a and b.
+    /// Index strides along c, a and b in the runs' slice-ordered voxels.
     stride: [usize; 3],
     /// Whether the rays run towards increasing slice index.
     forward: bool,
@@ -163,12 +163,12 @@ impl<'a> ShearWarp<'a> {
         let tf = cl.transfer.compile(step as f32, cl.prepared.grads.scale);
         Ok(ShearWarp {
             cl,
-            runs: cl.runs(c),
+            runs: cl.runs(c)?,
             tf,
             camera,
             opts,
             axes: [c, a, b],
-            stride: [c, a, b].map(|x| [1, d[0], d[0] * d[1]][x]),
+            stride: [d[a] * d[b], 1, d[a]],
             forward: dv[c] > 0.0,
             slices,
             width,
@@ -216,15 +216,17 @@ impl<'a> ShearWarp<'a> {
     ) {
         let skip = self.opts.skip;
         let ert = self.opts.ert as f32;
-        let vol = self.cl.prepared.vol;
-        let data = &vol.data[..];
-        let grads = &self.cl.prepared.grads.data[..];
+        let vox = &self.runs.voxels[..];
         let [sc, sa, sb] = self.stride;
         let (cells, lines) = (self.runs.cells, self.runs.lines);
         let full = [[0u32, cells as u32]];
         let nc = self.slices.len();
         let tf = &self.tf;
         let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
+        // Early ray termination without visiting opaque pixels (VolPack's pixel skip links):
+        // `link[p]` is 0 for a pixel still open, else a distance to jump towards the next
+        // open pixel of its row (shortened as chains are followed).
+        let mut link = vec![0u32; acc.len()];
         for step in 0..nc {
             let k = if self.forward { step } else { nc - 1 - step };
             let sl = self.slices[k];
@@ -236,30 +238,45 @@ impl<'a> ShearWarp<'a> {
                 st.samples += cells as u64;
                 let spans = if skip { self.runs.line(k, cb) } else { &full };
                 let row = (j - rows.start) * self.width + sl.i0;
+                let row_end = (j - rows.start + 1) * self.width;
                 let base = k * sc + cb * sb;
                 let mut visited = 0u64;
                 for &[first, end] in spans {
                     visited += (end - first) as u64;
-                    for ca in first as usize..end as usize {
+                    let mut ca = first as usize;
+                    while ca < end as usize {
                         let px = row + ca;
-                        let before = acc[px];
-                        if skip && before >= 1.0 {
-                            st.terminated += 1;
+                        if skip && link[px] != 0 {
+                            // Follow the chain to the next open pixel (or the row's end).
+                            let mut q = px;
+                            while q < row_end && link[q] != 0 {
+                                q += link[q] as usize;
+                            }
+                            // Path compression: every pixel on the chain now points at q,
+                            // so a later run starting inside the stretch jumps at once.
+                            let mut r = px;
+                            while r < q {
+                                let next = r + link[r] as usize;
+                                link[r] = (q - r) as u32;
+                                r = next;
+                            }
+                            let next = (ca + q - px).min(end as usize);
+                            st.terminated += (next - ca) as u64;
+                            ca = next;
                             continue;
                         }
+                        ca += 1;
+                        let before = acc[px];
                         st.evaluated += 1;
-                        let i = base + ca * sa;
-                        let v = lerp(
-                            lerp(data[i], data[i + sa], fa),
-                            lerp(data[i + sb], data[i + sa + sb], fa),
-                            fb,
-                        );
+                        let i = base + (ca - 1) * sa;
+                        let (q00, q10, q01, q11) =
+                            (vox[i], vox[i + sa], vox[i + sb], vox[i + sa + sb]);
+                        let v = lerp(lerp(q00.v, q10.v, fa), lerp(q01.v, q11.v, fa), fb);
                         let o = tf.value_opacity(v);
                         if skip && o == 0.0 {
                             continue;
                         }
-                        let (g00, g10, g01, g11) =
-                            (grads[i], grads[i + sa], grads[i + sb], grads[i + sa + sb]);
+                        let (g00, g10, g01, g11) = (q00.g, q10.g, q01.g, q11.g);
                         let g = [0, 1, 2].map(|x| {
                             super::cast::march::round_half_away(lerp(
                                 lerp(g00[x] as f32, g10[x] as f32, fa),
@@ -279,7 +296,12 @@ impl<'a> ShearWarp<'a> {
                             sink(px, w, g);
                         }
                         let after = before + w;
-                        acc[px] = if after >= ert { 1.0 } else { after };
+                        if after >= ert {
+                            acc[px] = 1.0;
+                            link[px] = 1;
+                        } else {
+                            acc[px] = after;
+                        }
                     }
                 }
                 st.empty_skipped += cells as u64 - visited;
@@ -390,40 +412,59 @@ impl<'a> ShearWarp<'a> {
     /// (composited values and opacities) where its ray meets it.
     fn warp(&self, value: &[f32], acc: &[f32], stats: Stats) -> Frame {
         let n = self.opts.size as usize;
-        let (w, h) = (self.width as isize, self.height as isize);
+        let (w, h) = (self.width, self.height);
         let m = self.warp;
+        // The intermediate image with a border of one zero pixel, value and opacity side by
+        // side: every position in (-1, w) x (-1, h) reads its four pixels without checks.
+        let pw = w + 2;
+        let mut pad = vec![[0.0f32; 2]; pw * (h + 2)];
+        for j in 0..h {
+            for i in 0..w {
+                pad[(j + 1) * pw + i + 1] = [value[j * w + i], acc[j * w + i]];
+            }
+        }
         let mut out_v = vec![0.0f32; n * n];
         let mut out_a = vec![0.0f32; n * n];
+        // Pixels whose position is outside (-1, w) x (-1, h) stay 0; each row's range of
+        // the others is found from the affine map, and floor is a truncation there
+        // (positions > -1), not a libm call.
+        let (wf, hf) = (w as f64, h as f64);
         out_v
             .par_chunks_mut(n)
             .zip(out_a.par_chunks_mut(n))
             .enumerate()
             .for_each(|(y, (vr, ar))| {
                 let yf = y as f64;
-                for x in 0..n {
+                let (i0, j0) = (m[0] + m[2] * yf, m[3] + m[5] * yf);
+                // x range where -1 < i0 + m1 x < w and -1 < j0 + m4 x < h.
+                let (mut lo, mut hi) = (0.0f64, n as f64);
+                for (p0, d, top) in [(i0, m[1], wf), (j0, m[4], hf)] {
+                    if d == 0.0 {
+                        if p0 <= -1.0 || p0 >= top {
+                            return;
+                        }
+                    } else {
+                        let (a, b) = ((-1.0 - p0) / d, (top - p0) / d);
+                        lo = lo.max(a.min(b));
+                        hi = hi.min(a.max(b));
+                    }
+                }
+                let x0 = lo.max(0.0).floor() as usize;
+                let x1 = (hi.ceil().max(0.0) as usize).min(n);
+                let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
+                for x in x0..x1 {
                     let xf = x as f64;
-                    let (pi, pj) = (m[0] + m[1] * xf + m[2] * yf, m[3] + m[4] * xf + m[5] * yf);
-                    let (fi, fj) = (pi.floor(), pj.floor());
-                    let (i, j) = (fi as isize, fj as isize);
-                    if i < -1 || j < -1 || i >= w || j >= h {
+                    let (pi, pj) = (i0 + m[1] * xf + 1.0, j0 + m[4] * xf + 1.0);
+                    // Padded positions in (0, w + 1) x (0, h + 1).
+                    if pi <= 0.0 || pj <= 0.0 || pi >= wf + 1.0 || pj >= hf + 1.0 {
                         continue;
                     }
-                    let (ti, tj) = ((pi - fi) as f32, (pj - fj) as f32);
-                    let at = |ii: isize, jj: isize| {
-                        if ii < 0 || jj < 0 || ii >= w || jj >= h {
-                            (0.0, 0.0)
-                        } else {
-                            let q = (jj * w + ii) as usize;
-                            (value[q], acc[q])
-                        }
-                    };
-                    let (v00, a00) = at(i, j);
-                    let (v10, a10) = at(i + 1, j);
-                    let (v01, a01) = at(i, j + 1);
-                    let (v11, a11) = at(i + 1, j + 1);
-                    let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
-                    vr[x] = lerp(lerp(v00, v10, ti), lerp(v01, v11, ti), tj);
-                    ar[x] = lerp(lerp(a00, a10, ti), lerp(a01, a11, ti), tj);
+                    let (i, j) = (pi as usize, pj as usize);
+                    let (ti, tj) = ((pi - i as f64) as f32, (pj - j as f64) as f32);
+                    let q = j * pw + i;
+                    let (p00, p10, p01, p11) = (pad[q], pad[q + 1], pad[q + pw], pad[q + pw + 1]);
+                    vr[x] = lerp(lerp(p00[0], p10[0], ti), lerp(p01[0], p11[0], ti), tj);
+                    ar[x] = lerp(lerp(p00[1], p10[1], ti), lerp(p01[1], p11[1], ti), tj);
                 }
             });
         Frame {
@@ -431,6 +472,280 @@ impl<'a> ShearWarp<'a> {
             value: out_v,
             alpha: out_a,
             stats,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::Config;
+    use crate::scene::transfer::Transfer;
+    use crate::scene::Scene;
+    use crate::volume::cast::options::CasterKind;
+    use crate::volume::cast::shader::ModelShader;
+    use crate::volume::cast::Caster;
+    use crate::volume::prepared::Prepared;
+    use crate::volume::{camera, synthetic, Volume, VolumeInfo};
+
+    fn opts(size: u32, skip: bool) -> CastOptions {
+        CastOptions {
+            size,
+            skip,
+            caster: CasterKind::ShearWarp,
+            ..CastOptions::default()
+        }
+    }
+
+    fn classified_tf() -> Transfer {
+        Transfer {
+            points: vec![[900.0, 0.0], [1900.0, 1.0]],
+            gradient: Some(vec![[0.0, 0.0], [150.0, 0.0], [700.0, 1.0]]),
+            min_opacity: Some(0.2),
+        }
+    }
+
+    /// On and off give the same bytes; returns the skipping-on frame.
+    fn same_on_and_off(cl: &Classified, view: [f64; 3], o: CastOptions, what: &str) -> Frame {
+        let model = ModelShader::new(&Config::default(), &Scene::standard());
+        let on = ShearWarp::new(cl, view, CastOptions { skip: true, ..o })
+            .unwrap()
+            .render(&model);
+        let off = ShearWarp::new(cl, view, CastOptions { skip: false, ..o })
+            .unwrap()
+            .render(&model);
+        assert_eq!(on.value, off.value, "{what}");
+        assert_eq!(on.alpha, off.alpha, "{what}");
+        assert_eq!(on.stats.samples, off.stats.samples, "{what}");
+        assert_eq!(off.stats.evaluated, off.stats.samples, "{what}");
+        on
+    }
+
+    #[test]
+    fn skipping_does_not_change_the_image() {
+        // Views along each principal axis, both ways, and oblique; spacing that is not
+        // uniform; the value ramp alone and with a gradient ramp and a minimum opacity,
+        // zoomed, with an up direction and voxel axes that are not the world's.
+        let views = [
+            [-0.5, -0.7, 0.5],
+            [0.0, 0.0, 1.0],
+            [1.0, 0.0, 0.0],
+            [0.3, 0.8, -0.6],
+            [-0.9, 0.2, -0.3],
+        ];
+        let axes = [[0.0, 1.0, 0.0], [0.0, 0.0, -1.0], [-1.0, 0.0, 0.0]];
+        for (spacing, tf, zoom, up, ax, ert) in [
+            (
+                [1.0; 3],
+                Transfer::new(vec![[1100.0, 0.0], [1900.0, 1.0]]),
+                1.0,
+                None,
+                camera::IDENTITY,
+                0.99,
+            ),
+            (
+                [1.0, 1.0, 1.5],
+                classified_tf(),
+                1.6,
+                Some([0.3, 1.0, 0.2]),
+                axes,
+                0.95,
+            ),
+            (
+                [0.8, 1.0, 1.0],
+                classified_tf(),
+                1.0,
+                None,
+                camera::IDENTITY,
+                1.0,
+            ),
+        ] {
+            let mut vol = synthetic::engine_block([48, 40, 24], spacing).unwrap();
+            vol.axes = ax;
+            let p = Prepared::new(&vol, 12, 8);
+            let cl = Classified::new(&p, &tf).unwrap();
+            for view in views {
+                let o = CastOptions {
+                    zoom,
+                    up,
+                    ert,
+                    ..opts(40, true)
+                };
+                let what = format!("view {view:?} spacing {spacing:?} tf {tf:?}");
+                let on = same_on_and_off(&cl, view, o, &what);
+                assert!(on.stats.skipped_fraction() > 0.3, "{what} {:?}", on.stats);
+                assert!(on.stats.shaded > 100, "{what} {:?}", on.stats);
+                if ert < 1.0 {
+                    assert!(on.stats.terminated > 0, "{what} {:?}", on.stats);
+                }
+            }
+        }
+    }
+
+    /// Smoothed noise with a flat lower half, and a gradient-magnitude ramp around its
+    /// typical gradients: much of it is transparent by the ramp alone and rays see through
+    /// (no termination), so a cell wrongly skipped changes the image.
+    fn noise() -> Volume {
+        let n = 24;
+        let mut seed = 12345u64;
+        let mut d: Vec<f32> = (0..n * n * n)
+            .map(|_| {
+                seed = seed
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (seed >> 40) as f32 / (1u64 << 24) as f32 * 100.0
+            })
+            .collect();
+        for _ in 0..2 {
+            let c = d.clone();
+            for i in 1..d.len() - 1 {
+                d[i] = (c[i - 1] + c[i] + c[i + 1]) / 3.0;
+            }
+        }
+        for v in &mut d[..n * n * n / 2] {
+            *v = 60.0;
+        }
+        let info = VolumeInfo {
+            source: "noise".into(),
+            voxel_type: "float".into(),
+        };
+        Volume::new([n, n, n], [1.0; 3], d, info).unwrap()
+    }
+
+    #[test]
+    fn skipping_on_noise_and_a_planted_wrong_skip_is_caught() {
+        let vol = noise();
+        let p = Prepared::new(&vol, 12, 2);
+        let tf = Transfer {
+            points: vec![[30.0, 0.0], [70.0, 1.0]],
+            gradient: Some(vec![[8.0, 0.0], [20.0, 1.0]]),
+            min_opacity: Some(0.3),
+        };
+        let o = CastOptions {
+            ert: 1.0,
+            ..opts(40, true)
+        };
+        let views = [[0.2, 0.3, 1.0], [-1.0, 0.5, 0.1], [0.1, -1.0, 0.4]];
+        let cl = Classified::new(&p, &tf).unwrap();
+        for view in views {
+            let on = same_on_and_off(&cl, view, o, &format!("{view:?}"));
+            assert!(
+                on.stats.shaded > 1000 && on.stats.empty_skipped > 0,
+                "{:?}",
+                on.stats
+            );
+            // The ramp makes cells transparent that the values alone would not.
+            let no_ramp = Transfer {
+                gradient: None,
+                ..tf.clone()
+            };
+            let plain = Classified::new(&p, &no_ramp).unwrap();
+            let sw = ShearWarp::new(&cl, view, o).unwrap();
+            let sw_plain = ShearWarp::new(&plain, view, o).unwrap();
+            assert!(
+                sw.empty_cell_fraction() > sw_plain.empty_cell_fraction() + 0.05,
+                "{} {}",
+                sw.empty_cell_fraction(),
+                sw_plain.empty_cell_fraction()
+            );
+        }
+        // A wrong skip (one scanline of every slice taken as transparent) changes the
+        // image, so the comparison above would catch it.
+        let model = ModelShader::new(&Config::default(), &Scene::standard());
+        for view in views {
+            let mut wrong = Classified::new(&p, &tf).unwrap();
+            wrong.plant_wrong_skip = Some(11);
+            let bad = ShearWarp::new(&wrong, view, o).unwrap().render(&model);
+            let off = ShearWarp::new(&cl, view, CastOptions { skip: false, ..o })
+                .unwrap()
+                .render(&model);
+            assert_ne!(bad.value, off.value, "{view:?}");
+        }
+    }
+
+    #[test]
+    fn batch_path_equals_fused_path() {
+        let vol = synthetic::engine_block([48, 40, 24], [1.0, 1.0, 1.5]).unwrap();
+        let small = Config {
+            grad_bits: 10,
+            red_bits: 7,
+            compensation: false,
+            interpolation: false,
+            interp_bits: 0,
+            ..Config::default()
+        };
+        for cfg in [Config::default(), small] {
+            let p = Prepared::new(&vol, cfg.grad_bits, 8);
+            let cl = Classified::new(&p, &classified_tf()).unwrap();
+            let sw = ShearWarp::new(&cl, [-0.4, -0.8, 0.45], opts(40, true)).unwrap();
+            let model = ModelShader::new(&cfg, &Scene::standard());
+            let fused = sw.render(&model);
+            let s = sw.collect().unwrap();
+            assert_eq!(s.stats, fused.stats);
+            assert!(s.gradients.len() > 1000);
+            let shaded: Vec<u32> = s
+                .gradients
+                .iter()
+                .map(|&g| model.model.intensity(&model.maps, g))
+                .collect();
+            assert_eq!(
+                sw.composite(&s, &shaded).unwrap(),
+                fused,
+                "{}",
+                cfg.summary()
+            );
+            assert!(sw.composite(&s, &shaded[1..]).is_err());
+            let e = sw.collect_at_most(s.gradients.len() - 1).unwrap_err();
+            assert!(e.to_string().contains("more than"), "{e}");
+            // A batch that differs in one sample changes the image.
+            let mut off = shaded.clone();
+            let i = s.weights.iter().position(|&w| w > 0.2).unwrap();
+            off[i] = off[i].wrapping_add(9) % 256;
+            assert_ne!(sw.composite(&s, &off).unwrap().value, fused.value);
+        }
+    }
+
+    #[test]
+    fn the_image_matches_the_ray_casters() {
+        // Same camera, same shading: the two renderers sample differently (slices against
+        // half-voxel steps, bilinear against trilinear, a warp), so the images differ a
+        // little, but a wrong shear, order or warp (mirrored, shifted, transposed) differs
+        // by far more.
+        let vol = synthetic::engine_block([64, 64, 32], [1.0, 1.0, 1.2]).unwrap();
+        let cfg = Config::default();
+        let p = Prepared::new(&vol, cfg.grad_bits, 8);
+        let tf = Transfer::new(vec![[1100.0, 0.0], [1900.0, 1.0]]);
+        let cl = Classified::new(&p, &tf).unwrap();
+        let model = ModelShader::new(&cfg, &Scene::standard());
+        for (view, up) in [
+            ([-0.5, -0.7, 0.5], None),
+            ([0.6, 0.2, -0.75], Some([0.0, 1.0, 0.0])),
+            ([0.0, -1.0, 0.1], None),
+        ] {
+            let o = CastOptions {
+                up,
+                ..opts(96, true)
+            };
+            let sw = ShearWarp::new(&cl, view, o).unwrap().render(&model);
+            let ray = Caster::new(&p, &tf, view, o).unwrap().render(&model);
+            let (a, b) = (sw.pixels(255), ray.pixels(255));
+            let covered = ray.alpha.iter().filter(|&&x| x > 0.5).count();
+            let mean = a
+                .iter()
+                .zip(&b)
+                .map(|(&x, &y)| x.abs_diff(y) as f64)
+                .sum::<f64>()
+                / covered as f64;
+            // Opacity masks agree on nearly every pixel.
+            let disagree = sw
+                .alpha
+                .iter()
+                .zip(&ray.alpha)
+                .filter(|(&x, &y)| (x > 0.5) != (y > 0.5))
+                .count();
+            assert!(covered > 96 * 96 / 5, "{view:?} {covered}");
+            assert!(disagree * 50 < covered, "{view:?} {disagree} of {covered}");
+            assert!(mean < 12.0, "{view:?}: mean |difference| {mean}");
         }
     }
 }

@@ -9,6 +9,11 @@
 //! rounded gradient is no longer than the longest of the four plus [`GRAD_MARGIN`]. A cell on
 //! which [`Tf::transparent_on`] holds for that range and magnitude holds no visible sample;
 //! a run is a maximal stretch of cells along a scanline that are not transparent.
+//!
+//! With the runs, each axis keeps the volume's voxels (value and quantised gradient) in its
+//! slice order ([`Runs::voxels`]): a run's samples then read memory in sequence, as
+//! VolPack's per-axis copies do, instead of one cache line per sample when the scanline
+//! runs across the file's x order.
 
 use super::super::bricks::{GRAD_MARGIN, WIDEN};
 use super::super::prepared::Prepared;
@@ -27,10 +32,19 @@ pub fn slice_axes(c: usize) -> (usize, usize) {
     }
 }
 
+/// One voxel in a slice-ordered copy: its value and its quantised gradient.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Voxel {
+    pub v: f32,
+    pub g: [i16; 3],
+}
+
 /// The runs of non-transparent cells of every scanline of every slice, for one principal
-/// axis.
+/// axis, and the voxels in slice order.
 #[derive(Clone, Debug)]
 pub struct Runs {
+    /// Voxel (along a, along b, slice k) at `a + na (b + nb k)`.
+    pub voxels: Vec<Voxel>,
     /// The principal axis (slices are perpendicular to it).
     pub axis: usize,
     /// Cells per scanline (voxels along the scanline axis minus one).
@@ -68,39 +82,59 @@ impl Runs {
         c: usize,
         transparent: impl Fn(f32, f32, f32) -> bool + Sync,
         wrong_line: Option<usize>,
-    ) -> Runs {
+    ) -> Result<Runs> {
         let vol = p.vol;
         let (a, b) = slice_axes(c);
         let d = vol.dims;
         let stride = [1, d[0], d[0] * d[1]];
-        let (cells, lines) = (d[a] - 1, d[b] - 1);
-        // Each voxel's quantised gradient length (LSBs), computed once.
-        let glen: Vec<f32> = p
-            .grads
-            .data
-            .par_iter()
-            .map(|g| {
-                let [x, y, z] = g.map(|c| c as f32);
-                (x * x + y * y + z * z).sqrt()
-            })
-            .collect();
-        let per_slice: Vec<(Vec<u32>, Vec<[u32; 2]>)> = (0..d[c])
-            .into_par_iter()
-            .map(|k| {
+        let (na, nb) = (d[a], d[b]);
+        let (cells, lines) = (na - 1, nb - 1);
+        let mut voxels: Vec<Voxel> = Vec::new();
+        voxels.try_reserve_exact(vol.data.len()).map_err(|_| {
+            anyhow::anyhow!(
+                "{}: cannot allocate {} for the shear-warp copy of {} voxels; use --caster ray",
+                vol.info.source,
+                super::super::human_bytes((std::mem::size_of::<Voxel>() * vol.data.len()) as u64),
+                vol.data.len()
+            )
+        })?;
+        voxels.resize(vol.data.len(), Voxel::default());
+        voxels
+            .par_chunks_mut(na * nb)
+            .enumerate()
+            .for_each(|(k, slice)| {
+                for (jb, row) in slice.chunks_mut(na).enumerate() {
+                    let base = k * stride[c] + jb * stride[b];
+                    for (ia, o) in row.iter_mut().enumerate() {
+                        let i = base + ia * stride[a];
+                        *o = Voxel {
+                            v: vol.data[i],
+                            g: p.grads.data[i],
+                        };
+                    }
+                }
+            });
+        let glen = |x: &Voxel| {
+            let [gx, gy, gz] = x.g.map(|c| c as f32);
+            (gx * gx + gy * gy + gz * gz).sqrt()
+        };
+        let per_slice: Vec<(Vec<u32>, Vec<[u32; 2]>)> = voxels
+            .par_chunks(na * nb)
+            .map(|slice| {
                 let mut counts = Vec::with_capacity(lines);
                 let mut spans = Vec::new();
                 for cb in 0..lines {
                     let before = spans.len();
-                    let base = k * stride[c] + cb * stride[b];
+                    let base = cb * na;
                     let mut open: Option<u32> = None;
                     for ca in 0..cells {
-                        let i = base + ca * stride[a];
-                        let q = [i, i + stride[a], i + stride[b], i + stride[a] + stride[b]];
+                        let i = base + ca;
+                        let q = [i, i + 1, i + na, i + na + 1];
                         let (mut lo, mut hi, mut g) = (f32::INFINITY, f32::NEG_INFINITY, 0f32);
                         for j in q {
-                            lo = lo.min(vol.data[j]);
-                            hi = hi.max(vol.data[j]);
-                            g = g.max(glen[j]);
+                            lo = lo.min(slice[j].v);
+                            hi = hi.max(slice[j].v);
+                            g = g.max(glen(&slice[j]));
                         }
                         let e = lo.abs().max(hi.abs()) * WIDEN + f32::MIN_POSITIVE;
                         let empty =
@@ -132,14 +166,15 @@ impl Runs {
             spans.extend(s);
         }
         let visible_cells = spans.iter().map(|s| (s[1] - s[0]) as u64).sum();
-        Runs {
+        Ok(Runs {
+            voxels,
             axis: c,
             cells,
             lines,
             start,
             spans,
             visible_cells,
-        }
+        })
     }
 }
 
@@ -150,7 +185,8 @@ pub struct Classified<'a> {
     pub transfer: Transfer,
     /// The transfer function for [`Tf::transparent_on`] (which does not depend on the step).
     tf: Tf,
-    runs: [OnceLock<Runs>; 3],
+    /// Per axis, the runs or why they could not be built (no memory).
+    runs: [OnceLock<std::result::Result<Runs, String>>; 3],
     /// A deliberately wrong classification for the tests: this scanline of every slice is
     /// marked transparent, to show the skipping tests catch a wrong skip.
     #[cfg(test)]
@@ -171,26 +207,23 @@ impl<'a> Classified<'a> {
     }
 
     /// The runs for principal axis `c`, built on first use.
-    pub fn runs(&self, c: usize) -> &Runs {
+    pub fn runs(&self, c: usize) -> Result<&Runs> {
         #[cfg(test)]
         let wrong = self.plant_wrong_skip;
         #[cfg(not(test))]
         let wrong = None;
-        self.runs[c].get_or_init(|| {
-            Runs::build(
-                self.prepared,
-                c,
-                |lo, hi, g| self.tf.transparent_on(lo, hi, g),
-                wrong,
-            )
-        })
-    }
-
-    /// Builds the runs of all three axes now (for timing frames without the first build).
-    pub fn build_all(&self) {
-        for c in 0..3 {
-            self.runs(c);
-        }
+        self.runs[c]
+            .get_or_init(|| {
+                Runs::build(
+                    self.prepared,
+                    c,
+                    |lo, hi, g| self.tf.transparent_on(lo, hi, g),
+                    wrong,
+                )
+                .map_err(|e| e.to_string())
+            })
+            .as_ref()
+            .map_err(|e| anyhow::anyhow!("{e}"))
     }
 }
 
@@ -220,7 +253,7 @@ mod tests {
         let p = Prepared::new(&vol, 12, 2);
         let c = Classified::new(&p, &Transfer::new(vec![[25.0, 0.0], [50.0, 1.0]])).unwrap();
         // Principal axis z: scanlines along x, 5 cells, 4 lines, 4 slices.
-        let r = c.runs(2);
+        let r = c.runs(2).unwrap();
         assert_eq!((r.cells, r.lines), (5, 4));
         for k in 0..4 {
             for cb in 0..4 {
@@ -228,14 +261,17 @@ mod tests {
             }
         }
         // Principal axis x: scanlines along y; slice x = 0, 1 and 2 hold values <= 20.
-        let r = c.runs(0);
+        let r = c.runs(0).unwrap();
         assert_eq!((r.cells, r.lines), (4, 3));
         assert!(r.line(1, 0).is_empty() && r.line(2, 0).is_empty());
         assert_eq!(r.line(3, 2), &[[0, 4]]);
         assert_eq!(r.visible_cells, 3 * 4 * 3);
+        // The slice-ordered copy: voxel (y, z) = (2, 3) of slice x = 4.
+        let v = r.voxels[2 + 5 * (3 + 4 * 4)];
+        assert_eq!((v.v, v.g), (40.0, p.grads.data[vol.index(4, 2, 3)]));
         // Everything transparent: no runs.
         let none = Classified::new(&p, &Transfer::new(vec![[60.0, 0.0], [70.0, 1.0]])).unwrap();
-        assert_eq!(none.runs(1).visible_cells, 0);
-        assert_eq!(none.runs(1).empty_fraction(), 1.0);
+        assert_eq!(none.runs(1).unwrap().visible_cells, 0);
+        assert_eq!(none.runs(1).unwrap().empty_fraction(), 1.0);
     }
 }
