@@ -11,6 +11,9 @@ struct Cli {
     command: Command,
 }
 
+// Parsed once per process: the variants' sizes (the volume command's many options) cost
+// nothing worth boxing for.
+#[allow(clippy::large_enum_variant)]
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Generate the Verilog, ROM/map files, manifest, test vectors and testbenches of one

@@ -11,13 +11,14 @@ use crate::reference::Reference;
 use crate::scene::transfer::Transfer;
 use crate::scene::Scene;
 use crate::volume::cast::frame::Stats;
-use crate::volume::cast::options::{self, CastOptions};
+use crate::volume::cast::options::{self, CastOptions, CasterKind};
 use crate::volume::cast::shader::ModelShader;
-use crate::volume::cast::Caster;
 use crate::volume::load::{self, RawFormat};
 use crate::volume::picture::PixelFormat;
 use crate::volume::prepared::Prepared;
+use crate::volume::renderer::Renderer;
 use crate::volume::report::{self, VolumeRender};
+use crate::volume::shear::Classified;
 use crate::volume::{histogram, synthetic, Volume, ENGINE_SCENE_TOML};
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -94,13 +95,19 @@ pub struct VolumeArgs {
     /// Image width and height in pixels [1..=4096].
     #[arg(long, value_name = "N", default_value_t = 512, value_parser = super::parse::count::<u32>())]
     pub size: u32,
-    /// Sample step along a ray, in smallest voxel spacings [0.05..=4].
+    /// Renderer: ray (a ray per pixel, samples --step apart; cost grows with the image) or
+    /// shear-warp (the fast preview: slices composited at voxel resolution, then warped;
+    /// cost grows with the volume's visible voxels, images coarser).
+    #[arg(long, value_enum, default_value_t = CasterKind::default())]
+    pub caster: CasterKind,
+    /// Sample step along a ray, in smallest voxel spacings [0.05..=4] (ray caster; shear-warp
+    /// samples once per slice).
     #[arg(long, value_name = "S", default_value_t = options::DEFAULT_STEP, value_parser = super::parse::positive())]
     pub step: f64,
     /// Early ray termination: accumulated opacity at which a pixel counts as opaque (0, 1].
     #[arg(long, value_name = "A", default_value_t = options::DEFAULT_ERT, value_parser = super::parse::positive())]
     pub ert: f64,
-    /// Brick side in cells for empty-space skipping [a power of two, 2..=64].
+    /// Brick side in cells for the ray caster's empty-space skipping [a power of two, 2..=64].
     #[arg(long, value_name = "N", default_value_t = options::DEFAULT_BRICK, value_parser = super::parse::count::<usize>())]
     pub brick: usize,
     /// Turn skipping off (empty space, early termination, unshaded samples): same image,
@@ -331,12 +338,21 @@ fn time(n: u32, mut f: impl FnMut()) -> Timed {
 #[derive(Serialize)]
 struct Timing {
     threads: usize,
+    caster: CasterKind,
     load_ms: f64,
     /// Gradients and brick ranges: once per volume and gradient width.
     prepare_ms: f64,
-    /// One frame: the shader (maps and model tables), the caster (empty bricks for the
-    /// transfer function) and the image, model shader.
+    /// Shear-warp's runs of visible cells for the view's principal axis: once per volume,
+    /// transfer function and axis (0 for the ray caster).
+    classify_ms: f64,
+    /// One frame: the shader's scene part (maps and the model's intensity table; its
+    /// position table depends on the configuration only and is built once), the renderer
+    /// (for the ray caster the empty bricks of the transfer function) and the image.
     model_skipping_on: Timed,
+    /// Parts of a model frame: the shader alone (maps and intensity table), and the
+    /// renderer and image alone with the shader built.
+    model_shader: Timed,
+    model_image: Timed,
     float_skipping_on: Timed,
     model_skipping_off: Timed,
     speedup: f64,
@@ -365,32 +381,67 @@ fn timing(
         skip: false,
         ..opts
     };
-    let frame_on = Caster::new(p, tf, view, on)?.render(&model);
-    let frame_off = Caster::new(p, tf, view, off)?.render(&model);
+    // Classified once, untimed like the gradients (VolPack's vpClassifyVolume likewise):
+    // it depends on the volume and the transfer function, not on the frame.
+    let t = Instant::now();
+    let classified = Classified::new(p, tf)?;
+    let first = Renderer::new(&classified, view, on)?;
+    let classify_ms = if opts.caster == CasterKind::ShearWarp {
+        t.elapsed().as_secs_f64() * 1e3
+    } else {
+        0.0
+    };
+    let frame_on = first.render(&model);
+    let frame_off = Renderer::new(&classified, view, off)?.render(&model);
     if frame_on.value != frame_off.value || frame_on.alpha != frame_off.alpha {
         bail!("internal error: the image with skipping differs from the image without");
     }
     // Each timed run builds the frame's shader (the maps and the model's tables, or the
-    // reference) and the caster (empty bricks for the transfer function), then renders.
+    // reference) and the renderer (for the ray caster the empty bricks of the transfer
+    // function), then renders.
+    // The model's configuration tables (its position table) are built once, as the
+    // gradients are; a frame rebuilds what depends on the scene (the maps, and the fused
+    // intensity table when it is no larger than the previous frame's shaded samples, as an
+    // interactive preview would know them).
+    let mut m = ModelShader::new(cfg, scene);
+    let shaded = frame_on.stats.shaded as usize;
     let model_on = time(repeat, || {
-        let m = ModelShader::new(cfg, scene);
-        Caster::new(p, tf, view, on).expect("checked").render(&m);
+        m.set_scene_for(scene, shaded);
+        Renderer::new(&classified, view, on)
+            .expect("checked")
+            .render(&m);
+    });
+    let model_shader = time(repeat, || {
+        m.set_scene_for(scene, shaded);
+    });
+    let model_image = time(repeat, || {
+        Renderer::new(&classified, view, on)
+            .expect("checked")
+            .render(&model);
     });
     let float_on = time(repeat, || {
         let r = Reference::new(cfg, scene);
-        Caster::new(p, tf, view, on).expect("checked").render(&r);
+        Renderer::new(&classified, view, on)
+            .expect("checked")
+            .render(&r);
     });
     let model_off = time(repeat.min(2), || {
-        let m = ModelShader::new(cfg, scene);
-        Caster::new(p, tf, view, off).expect("checked").render(&m);
+        m.set_scene_for(scene, shaded);
+        Renderer::new(&classified, view, off)
+            .expect("checked")
+            .render(&m);
     });
     let st = frame_on.stats;
     let t = Timing {
         threads: rayon::current_num_threads(),
+        caster: opts.caster,
         load_ms: 0.0,
         prepare_ms: 0.0,
+        classify_ms,
         speedup: model_off.median_ms / model_on.median_ms,
         model_skipping_on: model_on,
+        model_shader,
+        model_image,
         float_skipping_on: float_on,
         model_skipping_off: model_off,
         skipping_on: st,
@@ -400,10 +451,12 @@ fn timing(
     };
     let pct = |n: u64| 100.0 * n as f64 / st.samples.max(1) as f64;
     let text = format!(
-        "  model, skipping on   {:8.1} ms (median of {}, fastest {:.1})\n  float, skipping on   {:8.1} ms (median of {}, fastest {:.1})\n  model, skipping off  {:8.1} ms (median of {}), speed-up {:.1}x, identical image\n  samples on rays {}: {:.1}% skipped ({:.1}% empty space, {:.1}% after termination), {:.2}% shaded, {:.1}% of bricks empty",
+        "  model, skipping on   {:8.1} ms (median of {}, fastest {:.1}): shader {:.1} ms, image {:.1} ms\n  float, skipping on   {:8.1} ms (median of {}, fastest {:.1})\n  model, skipping off  {:8.1} ms (median of {}), speed-up {:.1}x, identical image\n  samples on rays {}: {:.1}% skipped ({:.1}% empty space, {:.1}% after termination), {:.2}% shaded, {:.1}% of {} empty",
         t.model_skipping_on.median_ms,
         t.model_skipping_on.runs,
         t.model_skipping_on.min_ms,
+        t.model_shader.median_ms,
+        t.model_image.median_ms,
         t.float_skipping_on.median_ms,
         t.float_skipping_on.runs,
         t.float_skipping_on.min_ms,
@@ -415,7 +468,11 @@ fn timing(
         pct(st.empty_skipped),
         pct(st.terminated),
         pct(st.shaded),
-        100.0 * Caster::new(p, tf, view, on)?.empty_brick_fraction()
+        100.0 * first.empty_fraction(),
+        match opts.caster {
+            CasterKind::Ray => "bricks",
+            CasterKind::ShearWarp => "slice cells",
+        }
     );
     Ok((t, text))
 }
@@ -435,6 +492,7 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
             .as_deref()
             .map(|u| triple::<f64>("--up", u))
             .transpose()?,
+        caster: a.caster,
     };
     opts.validate()?;
     if a.timing && a.repeat == 0 {

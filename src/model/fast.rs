@@ -203,7 +203,15 @@ impl FastShader {
 
     /// Replaces the maps (a new frame), keeping the configuration's position table.
     pub fn set_maps(&mut self, maps: &Maps) {
-        self.intensities = Intensities::new(&self.cfg, maps, usize::MAX);
+        self.set_maps_for(maps, usize::MAX);
+    }
+
+    /// [`FastShader::set_maps`] for a frame of about `samples` gradients: the intensity
+    /// table is fused only when it has at most `samples` entries (as
+    /// [`FastShader::for_samples`]), so a frame that shades few samples does not pay for a
+    /// table much larger than its work.
+    pub fn set_maps_for(&mut self, maps: &Maps, samples: usize) {
+        self.intensities = Intensities::new(&self.cfg, maps, samples);
     }
 
     pub fn config(&self) -> &Config {

@@ -16,7 +16,14 @@
 //!   compositing, empty-space skipping and early ray termination; each sample is shaded by a
 //!   [`cast::shader::Shader`] (the float reference or the bit-accurate model), or its
 //!   gradients are collected for a batch shader (an RTL simulation, through
-//!   [`crate::model::IntensitySource`]).
+//!   [`crate::model::IntensitySource`]). The default renderer: its cost grows with the image.
+//! - [`shear`]: shear-warp (`--caster shear-warp`), the fast preview: slices composited at
+//!   voxel resolution (bilinear value and gradient at the sheared positions, the same
+//!   compositing and shaders), skipping runs of transparent cells ([`shear::runs`], once
+//!   per volume, transfer function and principal axis) and opaque pixels, then one warp to
+//!   the image; its cost grows with the visible voxels.
+//! - [`renderer`]: the caster `--caster` picks, behind one interface (fused render, batch
+//!   render).
 //! - [`report`]: one render with every shader (or the model alone), the images, the error
 //!   statistics and `metrics.json`; [`picture`]: the images' pixel formats.
 //!
@@ -32,7 +39,9 @@ pub mod histogram;
 pub mod load;
 pub mod picture;
 pub mod prepared;
+pub mod renderer;
 pub mod report;
+pub mod shear;
 pub mod synthetic;
 
 use anyhow::{bail, Result};

@@ -5,12 +5,13 @@
 //! [`crate::render::metrics`] and [`crate::render::images`]; the statistics are taken over
 //! the pixels the volume covers (accumulated opacity > 0), as the sphere's over its disc.
 
-use super::cast::frame::{Frame, Stats};
+use super::cast::frame::Stats;
 use super::cast::options::CastOptions;
 use super::cast::shader::ModelShader;
-use super::cast::Caster;
 use super::picture::{self, PixelFormat};
 use super::prepared::Prepared;
+use super::renderer::Renderer;
+use super::shear::Classified;
 use super::VolumeInfo;
 use crate::config::Config;
 use crate::model::IntensitySource;
@@ -66,7 +67,9 @@ pub struct Context {
     pub image_right: [f64; 3],
     pub image_up: [f64; 3],
     pub pixel: f64,
-    pub empty_brick_fraction: f64,
+    /// Fraction of the skipping units empty for the transfer function: bricks (ray
+    /// caster) or slice cells (shear-warp).
+    pub empty_fraction: f64,
 }
 
 /// The pixel with the largest model error.
@@ -172,21 +175,24 @@ pub fn render(
     let transfer = scene_transfer(scene)?;
     let shading = p.vol.shading_scene(scene);
     let t = Instant::now();
+    // The classification (shear-warp's runs of visible cells) is built by the first frame
+    // and reused by the reference's.
+    let classified = Classified::new(p, transfer)?;
     let model_shader = ModelShader::new(cfg, &shading);
-    let caster = Caster::new(p, transfer, scene.view.direction, opts)?;
+    let caster = Renderer::new(&classified, scene.view.direction, opts)?;
     let model_frame = caster.render(&model_shader);
     let model_ms = ms(t);
     let (reference_frame, reference_ms) = if model_only {
         (None, None)
     } else {
         let t = Instant::now();
-        let f = Caster::new(p, transfer, scene.view.direction, opts)?
+        let f = Renderer::new(&classified, scene.view.direction, opts)?
             .render(&Reference::new(cfg, &shading));
         (Some(f), Some(ms(t)))
     };
     let rtl = match rtl {
         None => None,
-        Some(src) => Some(batch(&caster, src, cfg)?),
+        Some(src) => Some(caster.batch(src, cfg)?.pixels(cfg.map_max())),
     };
 
     let covered: Vec<bool> = model_frame.alpha.iter().map(|&a| a > 0.0).collect();
@@ -215,7 +221,7 @@ pub fn render(
         image_right: cam.right.to_array(),
         image_up: cam.up.to_array(),
         pixel: cam.pixel,
-        empty_brick_fraction: caster.empty_brick_fraction(),
+        empty_fraction: caster.empty_fraction(),
     };
     Ok(VolumeRender {
         cfg: cfg.clone(),
@@ -233,28 +239,6 @@ pub fn render(
         reference_ms,
         format: PixelFormat::default(),
     })
-}
-
-/// A batch shader's image: the contributing samples' gradients shaded in one batch, then
-/// composited.
-pub fn batch(caster: &Caster, src: &dyn IntensitySource, cfg: &Config) -> Result<Vec<u32>> {
-    let samples = caster.collect()?;
-    let v = src.intensities(&samples.gradients)?;
-    if v.len() != samples.gradients.len() {
-        bail!(
-            "the batch shader gave {} intensities for {} samples",
-            v.len(),
-            samples.gradients.len()
-        );
-    }
-    if let Some(bad) = v.iter().find(|&&i| i > cfg.map_max()) {
-        bail!(
-            "the batch shader gave intensity {bad}, wider than map_bits = {}",
-            cfg.map_bits
-        );
-    }
-    let frame: Frame = samples.composite(&v)?;
-    Ok(frame.pixels(cfg.map_max()))
 }
 
 impl VolumeRender {
@@ -486,6 +470,27 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("wider than"));
+    }
+
+    #[test]
+    fn shear_warp_batch_hook() {
+        // `--rtl` with shear-warp: the batch shader shades the collected samples; one that
+        // agrees with the model gives its image, one that does not is reported.
+        let vol = synthetic::engine_block([48, 48, 24], [1.0; 3]).unwrap();
+        let cfg = Config::default();
+        let p = Prepared::new(&vol, cfg.grad_bits, 8);
+        let o = CastOptions {
+            size: 48,
+            caster: crate::volume::cast::options::CasterKind::ShearWarp,
+            ..CastOptions::default()
+        };
+        let s = scene();
+        let same = AsModel(ModelShader::new(&cfg, &s));
+        let r = render(&p, &cfg, &s, o, Some(&same), false).unwrap();
+        assert_eq!(r.rtl_mismatches(), Some(0));
+        assert!(r.metrics.as_ref().unwrap().pixels > 48 * 48 / 4);
+        let other = render(&p, &cfg, &s, o, Some(&Fixed(3)), false).unwrap();
+        assert!(other.rtl_mismatches().unwrap() > 0);
     }
 
     #[test]

@@ -519,3 +519,66 @@ fn bad_framing_and_classification() {
     );
     fails(&with(&s, &["--crop", "0:3,0:15"]), "three ranges");
 }
+
+#[test]
+fn shear_warp_caster_skips_without_changing_the_files() {
+    // The shear-warp renderer from the command line: the images, the same files with
+    // skipping off, the caster named in metrics.json, and --timing with its classification.
+    let tmp = tempdir();
+    let (on, off) = (tmp.path().join("on"), tmp.path().join("off"));
+    let args = [
+        "--synthetic",
+        "--dims",
+        SMALL,
+        "--view",
+        "0.3,-0.8,0.5",
+        "--caster",
+        "shear-warp",
+    ];
+    let stdout = render(&args, &on);
+    assert!(stdout.contains("max abs error"), "{stdout}");
+    render(&[&args[..], &["--no-skip"]].concat(), &off);
+    for img in ["reference.png", "model.png", "error50.png"] {
+        assert_eq!(
+            std::fs::read(on.join(img)).unwrap(),
+            std::fs::read(off.join(img)).unwrap(),
+            "{img}"
+        );
+    }
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(on.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(j["cast"]["caster"], "shear-warp");
+    assert!(j["skipping"]["skipped_fraction"].as_f64().unwrap() > 0.5);
+    let model = model_png(&on).to_luma8();
+    assert!(
+        model.pixels().filter(|p| p.0[0] > 50).count() > 64 * 64 / 4,
+        "the part is visible"
+    );
+    let timed = tmp.path().join("timed");
+    let stdout = render(
+        &[&args[..], &["--timing", "--repeat", "1", "--model-only"]].concat(),
+        &timed,
+    );
+    assert!(
+        stdout.contains("identical image") && stdout.contains("slice cells"),
+        "{stdout}"
+    );
+    let t: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(timed.join("timing.json")).unwrap()).unwrap();
+    assert_eq!(t["caster"], "shear-warp");
+    assert!(t["classify_ms"].as_f64().unwrap() > 0.0);
+    // The default is the ray caster.
+    let ray = tmp.path().join("ray");
+    render(&args[..5], &ray);
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(ray.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(j["cast"]["caster"], "ray");
+}
+
+#[test]
+fn unknown_caster_is_refused() {
+    fails(
+        &["--synthetic", "--dims", "16,16,8", "--caster", "fan"],
+        "invalid value 'fan' for '--caster",
+    );
+}

@@ -24,7 +24,7 @@ pub struct Stats {
 }
 
 impl Stats {
-    pub(super) fn add(self, o: Stats) -> Stats {
+    pub(crate) fn add(self, o: Stats) -> Stats {
         Stats {
             rays: self.rays + o.rays,
             samples: self.samples + o.samples,

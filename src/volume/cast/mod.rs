@@ -284,6 +284,7 @@ mod tests {
                     skip: true,
                     zoom,
                     up,
+                    caster: options::CasterKind::Ray,
                 };
                 let on = Caster::new(&p, &tf, view, o).unwrap().render(&model);
                 let off = Caster::new(&p, &tf, view, CastOptions { skip: false, ..o })

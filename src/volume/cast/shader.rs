@@ -35,6 +35,21 @@ impl ModelShader {
         let fast = FastShader::new(&model, &maps);
         ModelShader { model, maps, fast }
     }
+
+    /// The shader for another scene (a new frame): its maps and the fused intensity table,
+    /// keeping the configuration's model and position table (they do not depend on the
+    /// scene). Equal to `ModelShader::new(cfg, scene)`.
+    pub fn set_scene(&mut self, scene: &Scene) {
+        self.set_scene_for(scene, usize::MAX);
+    }
+
+    /// [`ModelShader::set_scene`] for a frame of about `samples` shaded samples (e.g. the
+    /// previous frame's): the fused intensity table is built only when it is no larger than
+    /// that ([`FastShader::set_maps_for`]); the intensities are the same either way.
+    pub fn set_scene_for(&mut self, scene: &Scene, samples: usize) {
+        self.maps = scene.maps(&self.model.cfg);
+        self.fast.set_maps_for(&self.maps, samples);
+    }
 }
 
 impl Shader for ModelShader {

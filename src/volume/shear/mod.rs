@@ -1,0 +1,751 @@
+//! Shear-warp rendering (Lacroute and Levoy's factorisation, as VolPack): the cost of a frame
+//! scales with the volume's visible voxels, not with the image, because compositing happens
+//! at voxel resolution and only a final 2D warp touches the image's pixels.
+//!
+//! **Samples.** The principal axis c is the voxel axis most nearly along the rays (largest
+//! |component| of the ray direction in voxel units); the slices are the voxel planes
+//! perpendicular to it, the other two axes (a, b; [`runs::slice_axes`]) span the
+//! *intermediate image*, one pixel per voxel. Every ray of the intermediate image crosses
+//! slice k at the sheared position (i + shift_a(k), j + shift_b(k)); the shift's fraction is
+//! the same for the whole slice, so every sample of a slice has the same bilinear weights.
+//! A sample's value is the bilinear interpolation of its slice cell's four voxels, its
+//! gradient the bilinear interpolation of their quantised gradients rounded half away from
+//! zero: a G-bit integer vector, the shader's input, as in the ray caster. Samples lie in
+//! the half-open cells `0 <= p < n - 1` along a and b (each cell gives one sample per slice).
+//! Consecutive samples of a ray are one slice apart: the transfer function is corrected for
+//! that length (in smallest spacings), which depends on the view.
+//!
+//! **Compositing.** Front to back, slice by slice, per intermediate pixel exactly as the ray
+//! caster per ray ([`crate::volume::cast`]): weight (1 - A) a, termination at `ert`, where A
+//! becomes 1 and later weights are exactly 0.
+//!
+//! **Warp.** Each final pixel's ray meets the intermediate image at an affine function of
+//! the pixel's position; its value and opacity are the bilinear interpolation of the four
+//! intermediate pixels around it (zero outside). The camera and framing are the ray
+//! caster's ([`crate::volume::camera`]), so both casters show the same view.
+//!
+//! **Skipping** (on by default) changes the work, never the image:
+//! - empty space: only the runs of non-transparent cells of each scanline are visited
+//!   ([`runs`], computed once per volume, transfer function and principal axis);
+//! - early ray termination: a sample whose intermediate pixel is opaque (A = 1) is skipped;
+//! - a sample with zero opacity, or a zero gradient, is not shaded (it adds nothing).
+//!
+//! **Threads**: slabs of intermediate scanlines in parallel (rayon); a slab composites all
+//! slices front to back.
+//!
+//! **Shaders**: [`ShearWarp::render`] shades each contributing sample as it is composited
+//! (any [`Shader`]); [`ShearWarp::collect`] lists the contributing samples for a batch
+//! shader (the Verilated RTL), and [`ShearWarp::composite`] composites their intensities in
+//! the same order, so the two paths give the same image when the intensities agree.
+
+pub mod runs;
+
+use super::camera::{Camera, Framing};
+use super::cast::frame::{Frame, Stats};
+use super::cast::options::CastOptions;
+use super::cast::shader::Shader;
+use super::cast::MAX_BATCH_SAMPLES;
+use crate::scene::transfer::Tf;
+use anyhow::{bail, ensure, Result};
+use rayon::prelude::*;
+pub use runs::{Classified, Runs};
+
+/// Intermediate scanlines per parallel task: small enough that two threads share the work
+/// evenly, large enough that each task composites many samples.
+const SLAB_ROWS: usize = 4;
+
+/// Where one slice's samples lie in the intermediate image.
+#[derive(Clone, Copy, Debug)]
+struct Slice {
+    /// Intermediate pixel of cell 0 along a and b.
+    i0: usize,
+    j0: usize,
+    /// Bilinear weights of the slice's samples (the fraction of the shear).
+    fa: f32,
+    fb: f32,
+}
+
+/// A shear-warp renderer for one classified volume, view and options.
+pub struct ShearWarp<'a> {
+    cl: &'a Classified<'a>,
+    runs: &'a Runs,
+    tf: Tf,
+    camera: Camera,
+    opts: CastOptions,
+    /// Principal axis and the slice axes (a along scanlines).
+    axes: [usize; 3],
+    /// Index strides along c, a and b in the runs' slice-ordered voxels.
+    stride: [usize; 3],
+    /// Whether the rays run towards increasing slice index.
+    forward: bool,
+    slices: Vec<Slice>,
+    /// Intermediate image size (a, b).
+    width: usize,
+    height: usize,
+    /// Intermediate position of final pixel (x, y)'s ray: `i = w[0] + w[1] x + w[2] y`,
+    /// `j = w[3] + w[4] x + w[5] y`.
+    warp: [f64; 6],
+}
+
+/// Every contributing sample of an intermediate image, for a batch shader: the pixel each
+/// adds to, its weight and gradient, in compositing order.
+#[derive(Clone, Debug)]
+pub struct ShearSamples {
+    /// Accumulated opacity per intermediate pixel.
+    pub alpha: Vec<f32>,
+    pub pixels: Vec<u32>,
+    pub weights: Vec<f32>,
+    pub gradients: Vec<[i32; 3]>,
+    pub stats: Stats,
+}
+
+impl<'a> ShearWarp<'a> {
+    /// `view` points from the volume towards the viewer (a world direction), as for the ray
+    /// caster.
+    pub fn new(cl: &'a Classified<'a>, view: [f64; 3], opts: CastOptions) -> Result<Self> {
+        opts.validate()?;
+        let vol = cl.prepared.vol;
+        let s = vol.spacing;
+        let hi = [0, 1, 2].map(|a| (vol.dims[a] - 1) as f64 * s[a]);
+        let framing = Framing {
+            up: opts.up,
+            zoom: opts.zoom,
+            axes: vol.axes,
+        };
+        let camera = Camera::new([0.0; 3], hi, view, opts.size, &framing)?;
+        // Ray direction in voxel units.
+        let dv = [0, 1, 2].map(|a| -camera.view.to_array()[a] / s[a]);
+        let c = (0..3)
+            .max_by(|&x, &y| dv[x].abs().total_cmp(&dv[y].abs()))
+            .expect("three axes");
+        ensure!(dv[c] != 0.0, "the view direction has no component");
+        let (a, b) = runs::slice_axes(c);
+        let d = vol.dims;
+        let nc = d[c];
+        let (sa, sb) = (dv[a] / dv[c], dv[b] / dv[c]);
+        // shift(k) = k s - off lies in [-(nc - 1)|s|, 0], so every intermediate index is >= 0.
+        let (oa, ob) = (
+            (sa * (nc - 1) as f64).max(0.0),
+            (sb * (nc - 1) as f64).max(0.0),
+        );
+        let slices: Vec<Slice> = (0..nc)
+            .map(|k| {
+                let (ha, hb) = (k as f64 * sa - oa, k as f64 * sb - ob);
+                let (fa, fb) = (ha.floor(), hb.floor());
+                Slice {
+                    i0: (-fa) as usize,
+                    j0: (-fb) as usize,
+                    fa: (ha - fa) as f32,
+                    fb: (hb - fb) as f32,
+                }
+            })
+            .collect();
+        let width = slices.iter().map(|s| s.i0).max().unwrap_or(0) + d[a] - 1;
+        let height = slices.iter().map(|s| s.j0).max().unwrap_or(0) + d[b] - 1;
+        // The ray of a final pixel with voxel-unit origin o meets slice k at p_a = o_a + (k -
+        // o_c) sa, the intermediate pixel p_a - shift_a(k) = o_a - o_c sa + oa for every k.
+        let meet = |x: u32, y: u32| {
+            let (o, _) = camera.ray(x, y);
+            let o = [o.x / s[0], o.y / s[1], o.z / s[2]];
+            (o[a] - o[c] * sa + oa, o[b] - o[c] * sb + ob)
+        };
+        let (p00, p10, p01) = (meet(0, 0), meet(1, 0), meet(0, 1));
+        let warp = [
+            p00.0,
+            p10.0 - p00.0,
+            p01.0 - p00.0,
+            p00.1,
+            p10.1 - p00.1,
+            p01.1 - p00.1,
+        ];
+        // Samples are one slice apart: |dv_c|^-1 world units along the (unit) ray.
+        let step = 1.0 / (dv[c].abs() * vol.unit());
+        let tf = cl.transfer.compile(step as f32, cl.prepared.grads.scale);
+        Ok(ShearWarp {
+            cl,
+            runs: cl.runs(c)?,
+            tf,
+            camera,
+            opts,
+            axes: [c, a, b],
+            stride: [d[a] * d[b], 1, d[a]],
+            forward: dv[c] > 0.0,
+            slices,
+            width,
+            height,
+            warp,
+        })
+    }
+
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    /// The principal axis (0, 1 or 2 for voxel x, y, z).
+    pub fn principal_axis(&self) -> usize {
+        self.axes[0]
+    }
+
+    /// Intermediate image width and height.
+    pub fn intermediate(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+
+    /// Distance between consecutive samples of a ray, in smallest voxel spacings.
+    pub fn sample_step(&self) -> f64 {
+        let s = self.cl.prepared.vol.spacing[self.axes[0]];
+        let dv = -self.camera.view.to_array()[self.axes[0]] / s;
+        1.0 / (dv.abs() * self.cl.prepared.vol.unit())
+    }
+
+    /// Fraction of the slice cells that are transparent for the transfer function.
+    pub fn empty_cell_fraction(&self) -> f64 {
+        self.runs.empty_fraction()
+    }
+
+    /// Composites the slab of intermediate rows `rows` (opacities `acc`, row-major, width
+    /// [`Self::width`]), handing each sample to be shaded to `sink` with its pixel (within
+    /// the slab) and weight.
+    #[inline]
+    fn slab<F: FnMut(usize, f32, [i32; 3])>(
+        &self,
+        rows: std::ops::Range<usize>,
+        acc: &mut [f32],
+        st: &mut Stats,
+        mut sink: F,
+    ) {
+        let skip = self.opts.skip;
+        let ert = self.opts.ert as f32;
+        let vox = &self.runs.voxels[..];
+        let [sc, sa, sb] = self.stride;
+        let (cells, lines) = (self.runs.cells, self.runs.lines);
+        let full = [[0u32, cells as u32]];
+        let nc = self.slices.len();
+        let tf = &self.tf;
+        let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
+        // Early ray termination without visiting opaque pixels (VolPack's pixel skip links):
+        // `link[p]` is 0 for a pixel still open, else a distance to jump towards the next
+        // open pixel of its row (shortened as chains are followed).
+        let mut link = vec![0u32; acc.len()];
+        for step in 0..nc {
+            let k = if self.forward { step } else { nc - 1 - step };
+            let sl = self.slices[k];
+            let (fa, fb) = (sl.fa, sl.fb);
+            for j in rows.clone() {
+                let Some(cb) = j.checked_sub(sl.j0).filter(|&cb| cb < lines) else {
+                    continue;
+                };
+                st.samples += cells as u64;
+                let spans = if skip { self.runs.line(k, cb) } else { &full };
+                let row = (j - rows.start) * self.width + sl.i0;
+                let row_end = (j - rows.start + 1) * self.width;
+                let base = k * sc + cb * sb;
+                let mut visited = 0u64;
+                for &[first, end] in spans {
+                    visited += (end - first) as u64;
+                    let mut ca = first as usize;
+                    while ca < end as usize {
+                        let px = row + ca;
+                        if skip && link[px] != 0 {
+                            // Follow the chain to the next open pixel (or the row's end).
+                            let mut q = px;
+                            while q < row_end && link[q] != 0 {
+                                q += link[q] as usize;
+                            }
+                            // Path compression: every pixel on the chain now points at q,
+                            // so a later run starting inside the stretch jumps at once.
+                            let mut r = px;
+                            while r < q {
+                                let next = r + link[r] as usize;
+                                link[r] = (q - r) as u32;
+                                r = next;
+                            }
+                            let next = (ca + q - px).min(end as usize);
+                            st.terminated += (next - ca) as u64;
+                            ca = next;
+                            continue;
+                        }
+                        ca += 1;
+                        let before = acc[px];
+                        st.evaluated += 1;
+                        let i = base + (ca - 1) * sa;
+                        let (q00, q10, q01, q11) =
+                            (vox[i], vox[i + sa], vox[i + sb], vox[i + sa + sb]);
+                        let v = lerp(lerp(q00.v, q10.v, fa), lerp(q01.v, q11.v, fa), fb);
+                        let o = tf.value_opacity(v);
+                        if skip && o == 0.0 {
+                            continue;
+                        }
+                        let (g00, g10, g01, g11) = (q00.g, q10.g, q01.g, q11.g);
+                        let g = [0, 1, 2].map(|x| {
+                            super::cast::march::round_half_away(lerp(
+                                lerp(g00[x] as f32, g10[x] as f32, fa),
+                                lerp(g01[x] as f32, g11[x] as f32, fa),
+                                fb,
+                            ))
+                        });
+                        // The ramp only lowers the opacity: the value test above skips
+                        // nothing visible.
+                        let alpha = tf.correct(tf.with_gradient(o, g));
+                        if skip && alpha == 0.0 {
+                            continue;
+                        }
+                        let w = (1.0 - before) * alpha;
+                        if !skip || g != [0; 3] {
+                            st.shaded += 1;
+                            sink(px, w, g);
+                        }
+                        let after = before + w;
+                        if after >= ert {
+                            acc[px] = 1.0;
+                            link[px] = 1;
+                        } else {
+                            acc[px] = after;
+                        }
+                    }
+                }
+                st.empty_skipped += cells as u64 - visited;
+            }
+        }
+    }
+
+    /// The image shaded by `shader`: slabs of intermediate scanlines in parallel, then the
+    /// warp.
+    pub fn render<S: Shader>(&self, shader: &S) -> Frame {
+        let w = self.width;
+        let mut value = vec![0.0f32; w * self.height];
+        let mut acc = vec![0.0f32; w * self.height];
+        let stats = value
+            .par_chunks_mut(w * SLAB_ROWS)
+            .zip(acc.par_chunks_mut(w * SLAB_ROWS))
+            .enumerate()
+            .map(|(s, (vslab, aslab))| {
+                let mut st = Stats::default();
+                let j0 = s * SLAB_ROWS;
+                let rows = j0..j0 + aslab.len() / w;
+                self.slab(rows, aslab, &mut st, |px, wt, g| {
+                    vslab[px] += wt * shader.intensity(g) as f32
+                });
+                st
+            })
+            .reduce(Stats::default, Stats::add);
+        self.warp(&value, &acc, self.with_rays(stats))
+    }
+
+    /// Every sample the fused path would shade, for a batch shader; refused once more than
+    /// [`MAX_BATCH_SAMPLES`] samples contribute.
+    pub fn collect(&self) -> Result<ShearSamples> {
+        self.collect_at_most(MAX_BATCH_SAMPLES)
+    }
+
+    fn collect_at_most(&self, limit: usize) -> Result<ShearSamples> {
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        let w = self.width;
+        let mut acc = vec![0.0f32; w * self.height];
+        let gathered = AtomicUsize::new(0);
+        type Slab = (Vec<u32>, Vec<f32>, Vec<[i32; 3]>, Stats);
+        let slabs: Result<Vec<Slab>> = acc
+            .par_chunks_mut(w * SLAB_ROWS)
+            .enumerate()
+            .map(|(s, aslab)| {
+                let mut st = Stats::default();
+                let j0 = s * SLAB_ROWS;
+                let rows = j0..j0 + aslab.len() / w;
+                let (mut p, mut wt, mut g) = (Vec::new(), Vec::new(), Vec::new());
+                self.slab(rows, aslab, &mut st, |px, wi, gi| {
+                    p.push((j0 * w + px) as u32);
+                    wt.push(wi);
+                    g.push(gi);
+                });
+                if gathered.fetch_add(p.len(), Ordering::Relaxed) + p.len() > limit {
+                    bail!(
+                        "the batch (--rtl) render gathers more than {limit} contributing samples, \
+                         the limit for {} of memory; use a smaller volume (--crop)",
+                        super::human_bytes(super::MEMORY_BUDGET)
+                    );
+                }
+                Ok((p, wt, g, st))
+            })
+            .collect();
+        let mut out = ShearSamples {
+            alpha: Vec::new(),
+            pixels: Vec::new(),
+            weights: Vec::new(),
+            gradients: Vec::new(),
+            stats: Stats::default(),
+        };
+        for (p, wt, g, st) in slabs? {
+            out.pixels.extend(p);
+            out.weights.extend(wt);
+            out.gradients.extend(g);
+            out.stats = out.stats.add(st);
+        }
+        out.stats = self.with_rays(out.stats);
+        out.alpha = acc;
+        Ok(out)
+    }
+
+    /// Composites intensities given for [`ShearSamples::gradients`] in order and warps: the
+    /// frame the fused path gives with a shader that returns them.
+    pub fn composite(&self, s: &ShearSamples, intensities: &[u32]) -> Result<Frame> {
+        if intensities.len() != s.gradients.len() {
+            bail!(
+                "{} intensities for {} samples",
+                intensities.len(),
+                s.gradients.len()
+            );
+        }
+        let mut value = vec![0.0f32; s.alpha.len()];
+        for ((&p, &w), &i) in s.pixels.iter().zip(&s.weights).zip(intensities) {
+            value[p as usize] += w * i as f32;
+        }
+        Ok(self.warp(&value, &s.alpha, s.stats))
+    }
+
+    /// The work counts with `rays` set: the intermediate image's pixels.
+    fn with_rays(&self, mut st: Stats) -> Stats {
+        st.rays = (self.width * self.height) as u64;
+        st
+    }
+
+    /// The final image: each pixel the bilinear interpolation of the intermediate image
+    /// (composited values and opacities) where its ray meets it.
+    fn warp(&self, value: &[f32], acc: &[f32], stats: Stats) -> Frame {
+        let n = self.opts.size as usize;
+        let (w, h) = (self.width, self.height);
+        let m = self.warp;
+        // The intermediate image with a border of one zero pixel, value and opacity side by
+        // side: every position in (-1, w) x (-1, h) reads its four pixels without checks.
+        let pw = w + 2;
+        let mut pad = vec![[0.0f32; 2]; pw * (h + 2)];
+        for j in 0..h {
+            for i in 0..w {
+                pad[(j + 1) * pw + i + 1] = [value[j * w + i], acc[j * w + i]];
+            }
+        }
+        let mut out_v = vec![0.0f32; n * n];
+        let mut out_a = vec![0.0f32; n * n];
+        // Pixels whose position is outside (-1, w) x (-1, h) stay 0; each row's range of
+        // the others is found from the affine map, and floor is a truncation there
+        // (positions > -1), not a libm call.
+        let (wf, hf) = (w as f64, h as f64);
+        out_v
+            .par_chunks_mut(n)
+            .zip(out_a.par_chunks_mut(n))
+            .enumerate()
+            .for_each(|(y, (vr, ar))| {
+                let yf = y as f64;
+                let (i0, j0) = (m[0] + m[2] * yf, m[3] + m[5] * yf);
+                // x range where -1 < i0 + m1 x < w and -1 < j0 + m4 x < h.
+                let (mut lo, mut hi) = (0.0f64, n as f64);
+                for (p0, d, top) in [(i0, m[1], wf), (j0, m[4], hf)] {
+                    if d == 0.0 {
+                        if p0 <= -1.0 || p0 >= top {
+                            return;
+                        }
+                    } else {
+                        let (a, b) = ((-1.0 - p0) / d, (top - p0) / d);
+                        lo = lo.max(a.min(b));
+                        hi = hi.min(a.max(b));
+                    }
+                }
+                let x0 = lo.max(0.0).floor() as usize;
+                let x1 = (hi.ceil().max(0.0) as usize).min(n);
+                let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
+                for x in x0..x1 {
+                    let xf = x as f64;
+                    let (pi, pj) = (i0 + m[1] * xf + 1.0, j0 + m[4] * xf + 1.0);
+                    // Padded positions in (0, w + 1) x (0, h + 1).
+                    if pi <= 0.0 || pj <= 0.0 || pi >= wf + 1.0 || pj >= hf + 1.0 {
+                        continue;
+                    }
+                    let (i, j) = (pi as usize, pj as usize);
+                    let (ti, tj) = ((pi - i as f64) as f32, (pj - j as f64) as f32);
+                    let q = j * pw + i;
+                    let (p00, p10, p01, p11) = (pad[q], pad[q + 1], pad[q + pw], pad[q + pw + 1]);
+                    vr[x] = lerp(lerp(p00[0], p10[0], ti), lerp(p01[0], p11[0], ti), tj);
+                    ar[x] = lerp(lerp(p00[1], p10[1], ti), lerp(p01[1], p11[1], ti), tj);
+                }
+            });
+        Frame {
+            size: self.opts.size,
+            value: out_v,
+            alpha: out_a,
+            stats,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::Config;
+    use crate::scene::transfer::Transfer;
+    use crate::scene::Scene;
+    use crate::volume::cast::options::CasterKind;
+    use crate::volume::cast::shader::ModelShader;
+    use crate::volume::cast::Caster;
+    use crate::volume::prepared::Prepared;
+    use crate::volume::{camera, synthetic, Volume, VolumeInfo};
+
+    fn opts(size: u32, skip: bool) -> CastOptions {
+        CastOptions {
+            size,
+            skip,
+            caster: CasterKind::ShearWarp,
+            ..CastOptions::default()
+        }
+    }
+
+    fn classified_tf() -> Transfer {
+        Transfer {
+            points: vec![[900.0, 0.0], [1900.0, 1.0]],
+            gradient: Some(vec![[0.0, 0.0], [150.0, 0.0], [700.0, 1.0]]),
+            min_opacity: Some(0.2),
+        }
+    }
+
+    /// On and off give the same bytes; returns the skipping-on frame.
+    fn same_on_and_off(cl: &Classified, view: [f64; 3], o: CastOptions, what: &str) -> Frame {
+        let model = ModelShader::new(&Config::default(), &Scene::standard());
+        let on = ShearWarp::new(cl, view, CastOptions { skip: true, ..o })
+            .unwrap()
+            .render(&model);
+        let off = ShearWarp::new(cl, view, CastOptions { skip: false, ..o })
+            .unwrap()
+            .render(&model);
+        assert_eq!(on.value, off.value, "{what}");
+        assert_eq!(on.alpha, off.alpha, "{what}");
+        assert_eq!(on.stats.samples, off.stats.samples, "{what}");
+        assert_eq!(off.stats.evaluated, off.stats.samples, "{what}");
+        on
+    }
+
+    #[test]
+    fn skipping_does_not_change_the_image() {
+        // Views along each principal axis, both ways, and oblique; spacing that is not
+        // uniform; the value ramp alone and with a gradient ramp and a minimum opacity,
+        // zoomed, with an up direction and voxel axes that are not the world's.
+        let views = [
+            [-0.5, -0.7, 0.5],
+            [0.0, 0.0, 1.0],
+            [1.0, 0.0, 0.0],
+            [0.3, 0.8, -0.6],
+            [-0.9, 0.2, -0.3],
+        ];
+        let axes = [[0.0, 1.0, 0.0], [0.0, 0.0, -1.0], [-1.0, 0.0, 0.0]];
+        for (spacing, tf, zoom, up, ax, ert) in [
+            (
+                [1.0; 3],
+                Transfer::new(vec![[1100.0, 0.0], [1900.0, 1.0]]),
+                1.0,
+                None,
+                camera::IDENTITY,
+                0.99,
+            ),
+            (
+                [1.0, 1.0, 1.5],
+                classified_tf(),
+                1.6,
+                Some([0.3, 1.0, 0.2]),
+                axes,
+                0.95,
+            ),
+            (
+                [0.8, 1.0, 1.0],
+                classified_tf(),
+                1.0,
+                None,
+                camera::IDENTITY,
+                1.0,
+            ),
+        ] {
+            let mut vol = synthetic::engine_block([48, 40, 24], spacing).unwrap();
+            vol.axes = ax;
+            let p = Prepared::new(&vol, 12, 8);
+            let cl = Classified::new(&p, &tf).unwrap();
+            for view in views {
+                let o = CastOptions {
+                    zoom,
+                    up,
+                    ert,
+                    ..opts(40, true)
+                };
+                let what = format!("view {view:?} spacing {spacing:?} tf {tf:?}");
+                let on = same_on_and_off(&cl, view, o, &what);
+                assert!(on.stats.skipped_fraction() > 0.3, "{what} {:?}", on.stats);
+                assert!(on.stats.shaded > 100, "{what} {:?}", on.stats);
+                if ert < 1.0 {
+                    assert!(on.stats.terminated > 0, "{what} {:?}", on.stats);
+                }
+            }
+        }
+    }
+
+    /// Smoothed noise with a flat lower half, and a gradient-magnitude ramp around its
+    /// typical gradients: much of it is transparent by the ramp alone and rays see through
+    /// (no termination), so a cell wrongly skipped changes the image.
+    fn noise() -> Volume {
+        let n = 24;
+        let mut seed = 12345u64;
+        let mut d: Vec<f32> = (0..n * n * n)
+            .map(|_| {
+                seed = seed
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (seed >> 40) as f32 / (1u64 << 24) as f32 * 100.0
+            })
+            .collect();
+        for _ in 0..2 {
+            let c = d.clone();
+            for i in 1..d.len() - 1 {
+                d[i] = (c[i - 1] + c[i] + c[i + 1]) / 3.0;
+            }
+        }
+        for v in &mut d[..n * n * n / 2] {
+            *v = 60.0;
+        }
+        let info = VolumeInfo {
+            source: "noise".into(),
+            voxel_type: "float".into(),
+        };
+        Volume::new([n, n, n], [1.0; 3], d, info).unwrap()
+    }
+
+    #[test]
+    fn skipping_on_noise_and_a_planted_wrong_skip_is_caught() {
+        let vol = noise();
+        let p = Prepared::new(&vol, 12, 2);
+        let tf = Transfer {
+            points: vec![[30.0, 0.0], [70.0, 1.0]],
+            gradient: Some(vec![[8.0, 0.0], [20.0, 1.0]]),
+            min_opacity: Some(0.3),
+        };
+        let o = CastOptions {
+            ert: 1.0,
+            ..opts(40, true)
+        };
+        let views = [[0.2, 0.3, 1.0], [-1.0, 0.5, 0.1], [0.1, -1.0, 0.4]];
+        let cl = Classified::new(&p, &tf).unwrap();
+        for view in views {
+            let on = same_on_and_off(&cl, view, o, &format!("{view:?}"));
+            assert!(
+                on.stats.shaded > 1000 && on.stats.empty_skipped > 0,
+                "{:?}",
+                on.stats
+            );
+            // The ramp makes cells transparent that the values alone would not.
+            let no_ramp = Transfer {
+                gradient: None,
+                ..tf.clone()
+            };
+            let plain = Classified::new(&p, &no_ramp).unwrap();
+            let sw = ShearWarp::new(&cl, view, o).unwrap();
+            let sw_plain = ShearWarp::new(&plain, view, o).unwrap();
+            assert!(
+                sw.empty_cell_fraction() > sw_plain.empty_cell_fraction() + 0.05,
+                "{} {}",
+                sw.empty_cell_fraction(),
+                sw_plain.empty_cell_fraction()
+            );
+        }
+        // A wrong skip (one scanline of every slice taken as transparent) changes the
+        // image, so the comparison above would catch it.
+        let model = ModelShader::new(&Config::default(), &Scene::standard());
+        for view in views {
+            let mut wrong = Classified::new(&p, &tf).unwrap();
+            wrong.plant_wrong_skip = Some(11);
+            let bad = ShearWarp::new(&wrong, view, o).unwrap().render(&model);
+            let off = ShearWarp::new(&cl, view, CastOptions { skip: false, ..o })
+                .unwrap()
+                .render(&model);
+            assert_ne!(bad.value, off.value, "{view:?}");
+        }
+    }
+
+    #[test]
+    fn batch_path_equals_fused_path() {
+        let vol = synthetic::engine_block([48, 40, 24], [1.0, 1.0, 1.5]).unwrap();
+        let small = Config {
+            grad_bits: 10,
+            red_bits: 7,
+            compensation: false,
+            interpolation: false,
+            interp_bits: 0,
+            ..Config::default()
+        };
+        for cfg in [Config::default(), small] {
+            let p = Prepared::new(&vol, cfg.grad_bits, 8);
+            let cl = Classified::new(&p, &classified_tf()).unwrap();
+            let sw = ShearWarp::new(&cl, [-0.4, -0.8, 0.45], opts(40, true)).unwrap();
+            let model = ModelShader::new(&cfg, &Scene::standard());
+            let fused = sw.render(&model);
+            let s = sw.collect().unwrap();
+            assert_eq!(s.stats, fused.stats);
+            assert!(s.gradients.len() > 1000);
+            let shaded: Vec<u32> = s
+                .gradients
+                .iter()
+                .map(|&g| model.model.intensity(&model.maps, g))
+                .collect();
+            assert_eq!(
+                sw.composite(&s, &shaded).unwrap(),
+                fused,
+                "{}",
+                cfg.summary()
+            );
+            assert!(sw.composite(&s, &shaded[1..]).is_err());
+            let e = sw.collect_at_most(s.gradients.len() - 1).unwrap_err();
+            assert!(e.to_string().contains("more than"), "{e}");
+            // A batch that differs in one sample changes the image.
+            let mut off = shaded.clone();
+            let i = s.weights.iter().position(|&w| w > 0.2).unwrap();
+            off[i] = off[i].wrapping_add(9) % 256;
+            assert_ne!(sw.composite(&s, &off).unwrap().value, fused.value);
+        }
+    }
+
+    #[test]
+    fn the_image_matches_the_ray_casters() {
+        // Same camera, same shading: the two renderers sample differently (slices against
+        // half-voxel steps, bilinear against trilinear, a warp), so the images differ a
+        // little, but a wrong shear, order or warp (mirrored, shifted, transposed) differs
+        // by far more.
+        let vol = synthetic::engine_block([64, 64, 32], [1.0, 1.0, 1.2]).unwrap();
+        let cfg = Config::default();
+        let p = Prepared::new(&vol, cfg.grad_bits, 8);
+        let tf = Transfer::new(vec![[1100.0, 0.0], [1900.0, 1.0]]);
+        let cl = Classified::new(&p, &tf).unwrap();
+        let model = ModelShader::new(&cfg, &Scene::standard());
+        for (view, up) in [
+            ([-0.5, -0.7, 0.5], None),
+            ([0.6, 0.2, -0.75], Some([0.0, 1.0, 0.0])),
+            ([0.0, -1.0, 0.1], None),
+        ] {
+            let o = CastOptions {
+                up,
+                ..opts(96, true)
+            };
+            let sw = ShearWarp::new(&cl, view, o).unwrap().render(&model);
+            let ray = Caster::new(&p, &tf, view, o).unwrap().render(&model);
+            let (a, b) = (sw.pixels(255), ray.pixels(255));
+            let covered = ray.alpha.iter().filter(|&&x| x > 0.5).count();
+            let mean = a
+                .iter()
+                .zip(&b)
+                .map(|(&x, &y)| x.abs_diff(y) as f64)
+                .sum::<f64>()
+                / covered as f64;
+            // Opacity masks agree on nearly every pixel.
+            let disagree = sw
+                .alpha
+                .iter()
+                .zip(&ray.alpha)
+                .filter(|(&x, &y)| (x > 0.5) != (y > 0.5))
+                .count();
+            assert!(covered > 96 * 96 / 5, "{view:?} {covered}");
+            assert!(disagree * 50 < covered, "{view:?} {disagree} of {covered}");
+            assert!(mean < 12.0, "{view:?}: mean |difference| {mean}");
+        }
+    }
+}
