@@ -103,6 +103,11 @@ pub fn harness(
 /// The module `top` linked with the C++ `harness` (no `main`: it exports C functions) into
 /// the shared object `MDIR/LIB`, for a program to load: [`harness`]'s flags with `--prefix
 /// PREFIX`, every object compiled `-fPIC -O3` and linked `-shared`.
+///
+/// `-O3` goes in through the Makefile's OPT_FAST, OPT_SLOW and OPT_GLOBAL, not CFLAGS: Verilator's
+/// Makefile puts those (`-Os` by default) after CFLAGS on every compile line, so an `-O3` in
+/// CFLAGS is overridden and the model and the harness are built `-Os` (the prove front ran
+/// about 15% slower so, docs/VERIFICATION.md "Figures").
 #[allow(clippy::too_many_arguments)]
 pub fn shared(
     top: &str,
@@ -132,7 +137,12 @@ pub fn shared(
         .args(files)
         .arg(harness)
         .arg("-CFLAGS")
-        .arg(format!("-fPIC -O3 -I{}", include.display()))
+        .arg(format!("-fPIC -I{}", include.display()))
+        .args(
+            ["OPT_FAST", "OPT_SLOW", "OPT_GLOBAL"]
+                .iter()
+                .flat_map(|v| ["-MAKEFLAGS".to_string(), format!("{v}=-O3")]),
+        )
         .args(["-LDFLAGS", "-shared"]);
     c
 }
