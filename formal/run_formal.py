@@ -4,7 +4,7 @@
 with --plant, on a copy of the design with a planted fault, and then it passes only if the
 proof FAILS, naming the assertion the fault breaks (every check must be able to fail).
 
-    run_formal.py DESIGN_DIR [--build DIR] [--depth K] [--plant NAME ...]
+    run_formal.py DESIGN_DIR [--build DIR] [--depth K] [--plant NAME ... | --all-plants]
 
 The harness is formal/rmap_formal.sv (its header lists the properties). This script reads the
 generated rmap_top.v for the harness's parameters (widths, SIDE_DELAY, BUF_DELAY, side_i width)
@@ -27,6 +27,9 @@ an edit that finds nothing to change is an error):
                 seen only with a reset in the middle of the stream
   latency-doc   the manifest documents one clock more latency than the RTL has: only the
                 bounded response (a_live) sees it
+  and more (PLANTS below: each property of the harness must be broken by at least three;
+  --all-plants runs them all and checks that, from the assertions that failed at each plant's
+  first failing step)
 Exit 0 when every run did what it should, 1 otherwise; the last line is `N passed, M failed`.
 """
 
@@ -61,6 +64,32 @@ PLANTS = {
     "wr-front": (".wr_buf_i  (~front_d),", ".wr_buf_i  (~front_q),", "a_wr_buf"),
     "buf-delay": (re.compile(r"(localparam BUF_DELAY  = )(\d+);"),
                   lambda m: f"{m.group(1)}{int(m.group(2)) + 1};", "a_rd_buf"),
+    "wr-same": (".wr_buf_i  (~front_d),", ".wr_buf_i  (front_d),", "a_wr_buf"),
+    "front-stuck": ("      front_q <= front_d;", "      front_q <= front_q;",
+                    ("a_wr_buf", "a_rd_buf")),
+    "phantom": ("assign push    = en && out_valid;", "assign push    = en;", "a_fly"),
+    "latency-short": (re.compile(r'^(  "latency": )(\d+),$', re.M),
+                      lambda m: f"{m.group(1)}{int(m.group(2)) - 1},", "a_live", "manifest.json"),
+    "en-swap": ("assign en      = en_q;", "assign en      = en_q && !swap_i;", "a_live"),
+    "swap-phantom": ("valid_q <= skid_valid_q || push;", "valid_q <= skid_valid_q || push || swap_i;",
+                     "a_fly"),
+    "en-late": ("en_q         <= !skid_valid_d;", "en_q         <= !skid_valid_d && !skid_valid_q;",
+                "a_rdy_rule"),
+    "ready-swap": ("assign ready_o = en_q;", "assign ready_o = en_q && !swap_i;",
+                   ("a_rdy_rule", "a_rdy_en", "a_rdy_first")),
+    "ready-readyi": ("assign ready_o = en_q;", "assign ready_o = en_q && ready_i;",
+                     ("a_rdy_rule", "a_rdy_en", "a_rdy_first")),
+    "ready-valid": ("assign ready_o = en_q;", "assign ready_o = en_q && valid_i;",
+                    ("a_rdy_rule", "a_rdy_en", "a_rdy_first")),
+    "ready-write": ("assign ready_o = en_q;", "assign ready_o = en_q || wr_en_i;", "a_rdy_reset"),
+    "en-swap-reg": ("en_q         <= !skid_valid_d;", "en_q         <= !skid_valid_d && !swap_i;",
+                    ("a_rdy_rule", "a_rdy_first")),
+    "en-swap-busy": ("en_q         <= !skid_valid_d;",
+                     "en_q         <= !skid_valid_d && !(valid_q && swap_i);", "a_rdy_rule"),
+    "rd-buf-zero": (".d_i   (front_d),", ".d_i   (1'b0),", "a_rd_buf"),
+    "valid-ready": ("assign valid_o = valid_q;", "assign valid_o = valid_q && ready_i;", "a_head"),
+    "valid-swap": ("assign valid_o = valid_q;", "assign valid_o = valid_q && !swap_i;", "a_head"),
+    "valid-en": ("assign valid_o = valid_q;", "assign valid_o = valid_q && en_q;", "a_head"),
     # Seen only with a reset in the middle of the stream: the skid entry starts empty (an
     # initial value, as on an FPGA) but a reset does not clear it.
     "skid-noreset": ([("      skid_valid_q <= 1'b0;\n", ""),
@@ -223,10 +252,15 @@ def main():
     ap.add_argument("--build", type=Path, default=Path("build/formal"))
     ap.add_argument("--depth", type=int, default=1, help="induction depth (sby depth)")
     ap.add_argument("--plant", action="append", default=[], choices=sorted(PLANTS))
+    ap.add_argument("--all-plants", action="store_true",
+                    help="every plant, then check that each property is broken by three or more")
     a = ap.parse_args()
+    if a.all_plants:
+        a.plant = list(PLANTS)
     design = a.design.resolve()
     build = a.build.resolve()
     ok = bad = 0
+    broke = {}  # plant -> the assertions it made fail
     for name in a.plant or [None]:
         d = design if name is None else plant(design, build, name)
         run_dir = build / (name or "proof")
@@ -240,11 +274,23 @@ def main():
             want = PLANTS[name][2]
             want = want if isinstance(want, tuple) else (want,)
             good = status == "FAIL" and any(f.split()[0] in want for f in failed)
+            broke[name] = {f.split()[0] for f in failed}
             what = (f"plant {name}: {status} (bmc from reset), failed "
                     f"{', '.join(failed) or 'nothing'}"
                     f" ({'caught' if good else 'expected ' + ' or '.join(want) + ' to fail'})")
         print(f"run_formal: {what}, {secs:.1f} s ({where})", flush=True)
         ok, bad = (ok + 1, bad) if good else (ok, bad + 1)
+    # Every property of the harness must be broken by at least three of the plants (the
+    # assertions that failed at each plant's first failing step), when all of them ran.
+    if set(a.plant) == set(PLANTS):
+        props = re.findall(r"\b(a_\w+):\s+assert", HARNESS.read_text())
+        counts = {p: sum(1 for f in broke.values() if p in f) for p in props}
+        print("run_formal: plants per property: "
+              + ", ".join(f"{p} {n}" for p, n in counts.items()), flush=True)
+        for p, n in counts.items():
+            if n < 3:
+                print(f"run_formal: property {p} is broken by {n} plant(s), fewer than 3")
+                bad += 1
     print(f"{ok} passed, {bad} failed")
     sys.exit(0 if bad == 0 else 1)
 
