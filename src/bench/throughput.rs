@@ -189,7 +189,8 @@ fn configuration(
         let mut placed = fpga::place(&syn, &opts);
         // Too few pins for the ports (ECP5 only: the first seed in context tells): the row is
         // placed out of context from here on, every seed alike. The in-context attempt's log
-        // is kept beside the others.
+        // is kept beside the others. Like the seeds' files below, it is renamed only inside
+        // `logs`, in the sweep's own staging directory, where `fpga::place` has just written it.
         let pins = placed
             .as_ref()
             .err()

@@ -340,6 +340,38 @@ pub fn fingerprint(values: &[u16]) -> u64 {
     h
 }
 
+/// Test volume shared by the casters' skipping tests: 24^3 smoothed noise (two box blurs along
+/// x give gradients of all sizes) with a flat lower half (opaque by value, transparent by a
+/// gradient-magnitude ramp), so much of it is transparent by the ramp alone and rays see
+/// through: a cell or brick wrongly skipped changes the image.
+#[cfg(test)]
+pub(crate) fn smoothed_noise() -> super::Volume {
+    let n = 24;
+    let mut seed = 12345u64;
+    let mut d: Vec<f32> = (0..n * n * n)
+        .map(|_| {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 40) as f32 / (1u64 << 24) as f32 * 100.0
+        })
+        .collect();
+    for _ in 0..2 {
+        let c = d.clone();
+        for i in 1..d.len() - 1 {
+            d[i] = (c[i - 1] + c[i] + c[i + 1]) / 3.0;
+        }
+    }
+    for v in &mut d[..n * n * n / 2] {
+        *v = 60.0;
+    }
+    let info = super::VolumeInfo {
+        source: "noise".into(),
+        voxel_type: "float".into(),
+    };
+    super::Volume::new([n, n, n], [1.0; 3], d, info).unwrap()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

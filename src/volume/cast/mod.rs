@@ -310,32 +310,7 @@ mod tests {
         // Smoothed noise, a ramp on gradient magnitudes around its typical ones and a
         // minimum opacity: many bricks are transparent for the ramp alone, rays see through
         // them (no termination), so a brick wrongly marked empty changes the image.
-        let n = 24;
-        let mut seed = 12345u64;
-        let mut d: Vec<f32> = (0..n * n * n)
-            .map(|_| {
-                seed = seed
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                (seed >> 40) as f32 / (1u64 << 24) as f32 * 100.0
-            })
-            .collect();
-        // Two box blurs along x give gradients of all sizes; the lower half is flat
-        // (opaque by value, transparent by the ramp).
-        for _ in 0..2 {
-            let c = d.clone();
-            for i in 1..d.len() - 1 {
-                d[i] = (c[i - 1] + c[i] + c[i + 1]) / 3.0;
-            }
-        }
-        for v in &mut d[..n * n * n / 2] {
-            *v = 60.0;
-        }
-        let info = VolumeInfo {
-            source: "noise".into(),
-            voxel_type: "float".into(),
-        };
-        let vol = Volume::new([n, n, n], [1.0; 3], d, info).unwrap();
+        let vol = crate::volume::synthetic::smoothed_noise();
         let cfg = Config::default();
         let model = ModelShader::new(&cfg, &Scene::standard());
         let p = Prepared::new(&vol, cfg.grad_bits, 2);

@@ -486,7 +486,7 @@ mod tests {
     use crate::volume::cast::shader::ModelShader;
     use crate::volume::cast::Caster;
     use crate::volume::prepared::Prepared;
-    use crate::volume::{camera, synthetic, Volume, VolumeInfo};
+    use crate::volume::{camera, synthetic};
 
     fn opts(size: u32, skip: bool) -> CastOptions {
         CastOptions {
@@ -585,36 +585,9 @@ mod tests {
     /// Smoothed noise with a flat lower half, and a gradient-magnitude ramp around its
     /// typical gradients: much of it is transparent by the ramp alone and rays see through
     /// (no termination), so a cell wrongly skipped changes the image.
-    fn noise() -> Volume {
-        let n = 24;
-        let mut seed = 12345u64;
-        let mut d: Vec<f32> = (0..n * n * n)
-            .map(|_| {
-                seed = seed
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                (seed >> 40) as f32 / (1u64 << 24) as f32 * 100.0
-            })
-            .collect();
-        for _ in 0..2 {
-            let c = d.clone();
-            for i in 1..d.len() - 1 {
-                d[i] = (c[i - 1] + c[i] + c[i + 1]) / 3.0;
-            }
-        }
-        for v in &mut d[..n * n * n / 2] {
-            *v = 60.0;
-        }
-        let info = VolumeInfo {
-            source: "noise".into(),
-            voxel_type: "float".into(),
-        };
-        Volume::new([n, n, n], [1.0; 3], d, info).unwrap()
-    }
-
     #[test]
     fn skipping_on_noise_and_a_planted_wrong_skip_is_caught() {
-        let vol = noise();
+        let vol = synthetic::smoothed_noise();
         let p = Prepared::new(&vol, 12, 2);
         let tf = Transfer {
             points: vec![[30.0, 0.0], [70.0, 1.0]],
