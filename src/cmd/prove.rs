@@ -6,7 +6,7 @@
 use super::force::ForceArg;
 use crate::design_dir::DesignDir;
 use crate::output::{absolute, StagedDir, StagedFile};
-use crate::prove::{self, report, Options, Shard};
+use crate::prove::{self, report, FrontEngine, Options, Shard};
 use anyhow::Result;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -33,11 +33,16 @@ pub struct ProveArgs {
     /// front; with --direct: structure, direct. Such a report does not merge.
     #[arg(long, value_name = "NAME", value_delimiter = ',')]
     pub part: Vec<String>,
+    /// What evaluates the front on every gradient: gates (Yosys's gates of the generated
+    /// front, its registers made wires, bit-parallel on all cores) or verilator (the front
+    /// Verilated and clocked). Both read the generated files.
+    #[arg(long, value_name = "ENGINE", value_enum, default_value = "gates")]
+    pub front_engine: FrontEngine,
     /// Write the shard's report (JSON) to FILE, for --merge.
     #[arg(long, value_name = "FILE")]
     pub report: Option<PathBuf>,
     /// Combine these shard reports of one run into one verdict.
-    #[arg(long, value_name = "REPORT", num_args = 1.., conflicts_with_all = ["shard", "direct", "report", "part"])]
+    #[arg(long, value_name = "REPORT", num_args = 1.., conflicts_with_all = ["shard", "direct", "report", "part", "front_engine"])]
     pub merge: Vec<PathBuf>,
     /// Build products and logs go to BUILD/<name of the design directory>-<K>of<N> (replaced
     /// whole).
@@ -62,6 +67,7 @@ pub fn run(a: &ProveArgs) -> Result<ExitCode> {
     let opts = Options {
         shard: a.shard.unwrap_or(Shard::WHOLE),
         direct: a.direct,
+        front_engine: a.front_engine,
         parts: a.part.clone(),
     };
     prove::check_design(&design, opts.direct)?;

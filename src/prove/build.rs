@@ -21,12 +21,12 @@ pub const FRONT_MODULE: &str = "prove_front";
 /// them all, which spreads its fixed cost (about a fifth of the time at one copy).
 pub const FRONT_LANES: usize = 4;
 
-/// The front wrapper: [`FRONT_LANES`] copies of each module of [`FRONT`] as the design
+/// The front wrapper: `copies` copies of each module of [`FRONT`] as the design
 /// instantiates it (enable high, the gradient on its gradient ports), copy k's gradient on
-/// `g{x,y,z}<k>_i`, its valid bit on `<name>_valid_o` (copy 0's: all move together) and its
+/// `g{x,y,z}<k>_i`, with `valid` its valid bit on `<name>_valid_o` (copy 0's: all move together) and its
 /// other outputs packed into `<name><k>_o`, the first output field in the low bits (the order
 /// [`super::front::pack`] uses). Not part of the design: it only gives the harness ports.
-pub fn front_wrapper(d: &DesignDir) -> String {
+pub fn front_wrapper(d: &DesignDir, copies: usize, valid: bool) -> String {
     let cfg = &d.config;
     let g = cfg.grad_bits;
     let mut ports = vec![
@@ -35,7 +35,7 @@ pub fn front_wrapper(d: &DesignDir) -> String {
         "  input  wire valid_i".to_string(),
     ];
     let mut body = String::new();
-    for k in 0..FRONT_LANES {
+    for k in 0..copies {
         for c in ["gx", "gy", "gz"] {
             ports.push(format!("  input  wire [{}:0] {c}{k}_i", g - 1));
         }
@@ -48,10 +48,12 @@ pub fn front_wrapper(d: &DesignDir) -> String {
             .filter(|f| f.dir == Dir::Out)
             .collect();
         let width: u32 = outs.iter().map(|f| f.bits).sum();
-        ports.push(format!("  output wire {name}_valid_o"));
-        for k in 0..FRONT_LANES {
+        if valid {
+            ports.push(format!("  output wire {name}_valid_o"));
+        }
+        for k in 0..copies {
             ports.push(format!("  output wire [{}:0] {name}{k}_o", width - 1));
-            let valid = if k == 0 {
+            let valid = if k == 0 && valid {
                 format!("{name}_valid_o")
             } else {
                 String::new()
@@ -77,8 +79,8 @@ pub fn front_wrapper(d: &DesignDir) -> String {
         }
     }
     format!(
-        "// {FRONT_MODULE}.v: written by `rmapgen prove` for Verilator; not part of the design.\n\
-         // The modules of the design that read the gradient, unchanged, {FRONT_LANES} copies side by side.\n\
+        "// {FRONT_MODULE}.v: written by `rmapgen prove` for the front's engine; not part of the design.\n\
+         // The modules of the design that read the gradient, unchanged, {copies} copies side by side.\n\
          `default_nettype none\n\nmodule {FRONT_MODULE} (\n{}\n);\n\n{body}\nendmodule\n\n`default_nettype wire\n",
         ports.join(",\n")
     )
@@ -150,7 +152,7 @@ pub fn front(d: &DesignDir, build: &Path) -> Result<PathBuf> {
     let dir = build.join("front");
     std::fs::create_dir_all(&dir)?;
     let wrapper = dir.join(format!("{FRONT_MODULE}.v"));
-    std::fs::write(&wrapper, front_wrapper(d))?;
+    std::fs::write(&wrapper, front_wrapper(d, FRONT_LANES, true))?;
     let harness = dir.join("prove_front.cpp");
     std::fs::write(&harness, FRONT_HARNESS)?;
     std::fs::write(dir.join("prove_front_lanes.h"), front_lanes_header())?;

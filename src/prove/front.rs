@@ -45,7 +45,7 @@ pub fn pack(values: &[u64], widths: &[(&str, u32)]) -> u64 {
 }
 
 /// "m: expected 0x80, got 0x40; ..." for the fields that differ.
-fn differences(want: u64, got: u64, widths: &[(&str, u32)]) -> String {
+pub(super) fn differences(want: u64, got: u64, widths: &[(&str, u32)]) -> String {
     let mut lsb = 0;
     let mut out = Vec::new();
     for (name, w) in widths {
@@ -73,7 +73,7 @@ pub fn gradient(cfg: &Config, idx: u64) -> [u64; 3] {
 /// store-forwarding stall).
 #[cold]
 #[inline(never)]
-fn missing_state(cfg: &Config, idx: u64) -> String {
+pub(super) fn missing_state(cfg: &Config, idx: u64) -> String {
     let g = gradient(cfg, idx).map(|v| dec_grad(cfg, v));
     let s = sort_shift::eval(cfg, g);
     format!(

@@ -30,6 +30,9 @@ pub struct Part {
     /// CPU seconds of this process in the part (not the builds', which run in children).
     #[serde(default)]
     pub cpu_seconds: f64,
+    /// What evaluated the part, when it has a choice (the front: gates or verilator).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub engine: String,
 }
 
 impl Part {
@@ -43,7 +46,14 @@ impl Part {
             examples: f.kept,
             seconds: 0.0,
             cpu_seconds: 0.0,
+            engine: String::new(),
         }
+    }
+
+    /// The part, evaluated by `engine`.
+    pub fn engine(mut self, engine: &str) -> Part {
+        self.engine = engine.into();
+        self
     }
 
     /// The part, timed from `start`.
@@ -143,9 +153,14 @@ impl Report {
             self.design, self.config, self.shard.index, self.shard.count, self.mode
         );
         for p in &self.parts {
+            let name = if p.engine.is_empty() {
+                p.name.clone()
+            } else {
+                format!("{} ({})", p.name, p.engine)
+            };
             s += &format!(
-                "  {:<10} {:>14} of {:>14} inputs [{}..{}) {:>7.1} s ({:.1} s CPU): {}\n",
-                p.name,
+                "  {:<17} {:>14} of {:>14} inputs [{}..{}) {:>7.1} s ({:.1} s CPU): {}\n",
+                name,
                 p.end - p.first,
                 p.total,
                 p.first,
@@ -257,8 +272,21 @@ pub fn merge(files: &[PathBuf]) -> Result<Merged> {
         );
         let failures: u64 = ranges.iter().map(|p| p.failures).sum();
         passed &= failures == 0;
+        // The engines the shards used for the part (shards may differ: each proves its range).
+        let mut engines: Vec<&str> = ranges
+            .iter()
+            .map(|p| p.engine.as_str())
+            .filter(|e| !e.is_empty())
+            .collect();
+        engines.sort();
+        engines.dedup();
+        let label = if engines.is_empty() {
+            name.to_string()
+        } else {
+            format!("{name} ({})", engines.join(", "))
+        };
         text += &format!(
-            "  {name:<10} {total:>14} inputs: {}\n",
+            "  {label:<17} {total:>14} inputs: {}\n",
             if failures == 0 {
                 "pass".to_string()
             } else {

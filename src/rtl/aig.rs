@@ -22,17 +22,19 @@ const WORDS: usize = 8;
 /// Inputs per block.
 const BLOCK_BITS: u32 = 9;
 
-/// An and-inverter graph with named inputs and one output.
+/// An and-inverter graph with named inputs and outputs.
 #[derive(Clone, Debug)]
 pub struct Aig {
     /// For each input (in AIGER order): its signal name and bit.
     pub inputs: Vec<(String, u32)>,
+    /// For each output (in AIGER order): its signal name and bit.
+    pub outputs: Vec<(String, u32)>,
     /// Variable of each input (the AIGER literal / 2).
     input_vars: Vec<u32>,
     /// AND gates in topological order: (lhs variable, rhs literal, rhs literal).
     ands: Vec<(u32, u32, u32)>,
-    /// The output literal.
-    output: u32,
+    /// The output literals, in AIGER order.
+    output_lits: Vec<u32>,
     max_var: u32,
 }
 
@@ -43,8 +45,8 @@ fn num(s: Option<&str>, what: &str) -> Result<u32> {
 }
 
 impl Aig {
-    /// Parses Yosys's ASCII AIGER (`aag M I L O A`, no latches, one output) and its `-map`
-    /// file (`input INDEX BIT NAME`).
+    /// Parses Yosys's ASCII AIGER (`aag M I L O A`, no latches) and its `-map` file
+    /// (`input INDEX BIT NAME`, `output INDEX BIT NAME`).
     pub fn parse(aag: &str, map: &str) -> Result<Aig> {
         let mut lines = aag.lines();
         let head: Vec<&str> = lines
@@ -63,9 +65,6 @@ impl Aig {
         if nl != 0 {
             bail!("{nl} latches: the miter must be combinational");
         }
-        if no != 1 {
-            bail!("{no} outputs: the miter has one (ok)");
-        }
         let mut input_vars = Vec::with_capacity(ni as usize);
         for _ in 0..ni {
             let lit = num(lines.next(), "input literal")?;
@@ -74,7 +73,14 @@ impl Aig {
             }
             input_vars.push(lit / 2);
         }
-        let output = num(lines.next(), "output literal")?;
+        let mut output_lits = Vec::with_capacity(no as usize);
+        for _ in 0..no {
+            let lit = num(lines.next(), "output literal")?;
+            if lit / 2 > max_var {
+                bail!("output literal {lit} out of range");
+            }
+            output_lits.push(lit);
+        }
         let mut ands = Vec::with_capacity(na as usize);
         for _ in 0..na {
             let l = lines.next().context("missing AND gate")?;
@@ -92,29 +98,54 @@ impl Aig {
             ands.push((lhs / 2, a, b));
         }
         let mut inputs = vec![(String::new(), 0); ni as usize];
-        let mut named = 0;
+        let mut outputs = vec![(String::new(), 0); no as usize];
+        let (mut named_in, mut named_out) = (0, 0);
         for l in map.lines() {
             let f: Vec<&str> = l.split_whitespace().collect();
-            if f.len() == 4 && f[0] == "input" {
-                let i: usize = f[1].parse().context("bad map index")?;
-                let bit: u32 = f[2].parse().context("bad map bit")?;
-                let slot = inputs
-                    .get_mut(i)
-                    .with_context(|| format!("map names input {i} of {ni}"))?;
-                *slot = (f[3].to_string(), bit);
-                named += 1;
+            if f.len() != 4 || (f[0] != "input" && f[0] != "output") {
+                continue;
             }
+            let i: usize = f[1].parse().context("bad map index")?;
+            let bit: u32 = f[2].parse().context("bad map bit")?;
+            let (list, count) = if f[0] == "input" {
+                (&mut inputs, &mut named_in)
+            } else {
+                (&mut outputs, &mut named_out)
+            };
+            let total = list.len();
+            let slot = list
+                .get_mut(i)
+                .with_context(|| format!("map names {} {i} of {total}", f[0]))?;
+            // Yosys 0.23 numbers two output ports on one net with one index (and skips
+            // another): such a map cannot say which literal is which port.
+            if !slot.0.is_empty() {
+                bail!("the map names {} {i} twice ({} and {})", f[0], slot.0, f[3]);
+            }
+            *slot = (f[3].to_string(), bit);
+            *count += 1;
         }
-        if named != ni as usize {
-            bail!("the map names {named} of {ni} inputs");
+        if named_in != ni as usize {
+            bail!("the map names {named_in} of {ni} inputs");
+        }
+        if named_out != no as usize {
+            bail!("the map names {named_out} of {no} outputs");
         }
         Ok(Aig {
             inputs,
+            outputs,
             input_vars,
             ands,
-            output,
+            output_lits,
             max_var,
         })
+    }
+
+    /// The one output of a miter (its `ok`).
+    fn single_output(&self) -> Result<u32> {
+        match self.output_lits[..] {
+            [lit] => Ok(lit),
+            _ => bail!("{} outputs: the miter has one (ok)", self.output_lits.len()),
+        }
     }
 
     /// AND gates.
@@ -122,11 +153,13 @@ impl Aig {
         self.ands.len()
     }
 
-    /// Whether input `i` drives any gate or the output (an unused port, such as the miter's
+    /// Whether input `i` drives any gate or output (an unused port, such as the miter's
     /// clock once the registers are wires, cannot change `ok`).
-    fn used(&self) -> Vec<bool> {
+    pub fn used(&self) -> Vec<bool> {
         let mut used = vec![false; self.max_var as usize + 1];
-        used[(self.output / 2) as usize] = true;
+        for &o in &self.output_lits {
+            used[(o / 2) as usize] = true;
+        }
         for &(_, a, b) in &self.ands {
             used[(a / 2) as usize] = true;
             used[(b / 2) as usize] = true;
@@ -139,14 +172,20 @@ impl Aig {
 type Lit = u32;
 
 /// The graph simplified for one case: free inputs are variables 1..=free, then the gates.
-struct Program {
+pub struct Program {
     /// (lhs variable, a, b) with a, b literals of earlier variables.
     gates: Vec<(u32, Lit, Lit)>,
-    output: Lit,
+    /// Every output of the graph, in AIGER order.
+    outputs: Vec<Lit>,
+    /// Free inputs (variables 1..=free).
+    free: usize,
     vars: usize,
 }
 
-fn compile(aig: &Aig, fixed: &[Option<bool>], free: &[usize]) -> Program {
+/// Simplifies `aig` for the inputs `fixed` gives a value: input `i` with `fixed[i] ==
+/// Some(b)` is the constant b, the `k`-th input of `free` becomes the program's free input
+/// k; an input in neither drives nothing (see [`Aig::used`]).
+pub fn compile(aig: &Aig, fixed: &[Option<bool>], free: &[usize]) -> Program {
     const NONE: Lit = u32::MAX;
     let mut map = vec![NONE; aig.max_var as usize + 1];
     map[0] = 0;
@@ -177,10 +216,50 @@ fn compile(aig: &Aig, fixed: &[Option<bool>], free: &[usize]) -> Program {
         };
     }
     Program {
-        output: lit(&map, aig.output),
+        outputs: aig.output_lits.iter().map(|&o| lit(&map, o)).collect(),
+        free: free.len(),
         gates,
         vars: next as usize,
     }
+}
+
+impl Program {
+    /// AND gates left after the constants.
+    pub fn gates(&self) -> usize {
+        self.gates.len()
+    }
+
+    /// Evaluates the program on `W * 64` inputs at once (bit-parallel: one bit of each word
+    /// per input): free input `j` takes the words `free(j)`; `out[o]` receives output o's
+    /// words. `vals` is scratch space, reused between calls.
+    pub fn eval<const W: usize>(
+        &self,
+        vals: &mut Vec<[u64; W]>,
+        free: impl Fn(usize) -> [u64; W],
+        out: &mut [[u64; W]],
+    ) {
+        vals.resize(self.vars, [0; W]);
+        vals[0] = [0; W];
+        for j in 0..self.free {
+            vals[j + 1] = free(j);
+        }
+        for &(v, a, b) in &self.gates {
+            let (x, y) = (word(vals, a), word(vals, b));
+            vals[v as usize] = std::array::from_fn(|k| x[k] & y[k]);
+        }
+        for (o, &l) in out.iter_mut().zip(&self.outputs) {
+            *o = word(vals, l);
+        }
+    }
+}
+
+/// The words of literal `l`: its variable's, complemented when `l` is odd. Variable 0 is
+/// the constant false (its words stay 0).
+#[inline(always)]
+fn word<const W: usize>(vals: &[[u64; W]], l: Lit) -> [u64; W] {
+    let m = if l & 1 == 1 { !0 } else { 0 };
+    let v = &vals[(l / 2) as usize];
+    std::array::from_fn(|k| v[k] ^ m)
 }
 
 /// The word pattern of free input `j` in word `w` of block `block`: inputs are numbered
@@ -223,20 +302,14 @@ fn sweep(p: &Program, free: usize) -> Option<u64> {
             }
         })
     };
-    let get = |vals: &[[u64; WORDS]], l: Lit| -> [u64; WORDS] {
-        let m = if l & 1 == 1 { !0 } else { 0 };
-        let v = &vals[(l / 2) as usize];
-        std::array::from_fn(|k| v[k] ^ m)
-    };
+    let mut out = [[0u64; WORDS]];
     for block in 0..blocks {
-        for j in 0..free {
-            vals[j + 1] = std::array::from_fn(|w| pattern(j, w, block));
-        }
-        for &(v, a, b) in &p.gates {
-            let (x, y) = (get(&vals, a), get(&vals, b));
-            vals[v as usize] = std::array::from_fn(|k| x[k] & y[k]);
-        }
-        let out = get(&vals, p.output);
+        p.eval(
+            &mut vals,
+            |j| std::array::from_fn(|w| pattern(j, w, block)),
+            &mut out,
+        );
+        let out = out[0];
         for w in 0..WORDS {
             let bad = !out[w] & valid[w];
             if bad != 0 {
@@ -254,6 +327,7 @@ pub type Assignment = Vec<(String, u128)>;
 /// enumerated). Returns the first failing input (cases in order, then input order), or None
 /// when `ok` is 1 everywhere. Signals named in a case must be inputs of the graph.
 pub fn exhaustive(aig: &Aig, cases: &[Vec<(String, u128)>]) -> Result<Option<Assignment>> {
+    aig.single_output()?;
     let used = aig.used();
     for case in cases {
         for (s, _) in case {
@@ -343,7 +417,8 @@ mod tests {
             aag += &format!("{lhs} {} {prev}\n", 2 * (k + 2));
             prev = lhs;
         }
-        let map: String = (0..n).map(|i| format!("input {i} {i} x\n")).collect();
+        let mut map: String = (0..n).map(|i| format!("input {i} {i} x\n")).collect();
+        map += "output 0 0 ok\n";
         let g = Aig::parse(&aag, &map).unwrap();
         let f = exhaustive(&g, &[Vec::new()]).unwrap().unwrap();
         assert_eq!(f, vec![("x".into(), 4095)]);

@@ -372,6 +372,43 @@ pub fn structure(
     Ok((hier, flat))
 }
 
+/// The and-inverter graph `rmapgen prove`'s gate-level front evaluates: `top` (a wrapper
+/// around design modules, from `files`, absolute paths) with every flip-flop made a wire from
+/// D to Q by the techmap file `transparent` (a file name in `logs`: what the value would be at
+/// an enabled clock edge without reset), mapped to AND and NOT gates and written as ASCII
+/// AIGER with its map (`front.aag`, `front.map` in `logs`, where Yosys runs: `write_aiger`
+/// takes its file names unquoted).
+///
+/// `opt_expr -mux_undef` takes the undefined inputs of multiplexers as "any value": `proc`
+/// writes `x` as the default of a variable an `always @*` block assigns on every path, into
+/// a multiplexer input no path selects, and AIGER has no `x`. Nothing else is optimised
+/// before the gates: the graph is the generated logic as Yosys reads it.
+pub fn aig(
+    top: &str,
+    files: &[String],
+    transparent: &str,
+    logs: &Path,
+) -> Result<(PathBuf, PathBuf)> {
+    std::fs::create_dir_all(logs)?;
+    let (aag, map) = ("front.aag", "front.map");
+    let script = format!(
+        "read_verilog {}; hierarchy -check -top {top}; proc; opt_expr -mux_undef; flatten; \
+         opt_clean; opt_dff; techmap -map {transparent}; opt_expr -mux_undef; opt_clean; \
+         techmap; opt_expr -mux_undef; opt_clean; aigmap; opt_clean; \
+         write_aiger -ascii -map {map} {aag}",
+        files.join(" "),
+    );
+    let ran = super::run_logged(&mut command(logs, logs, &script), &logs.join("yosys.out"))?;
+    if !ran.success() {
+        bail!(
+            "Yosys could not map the front to gates ({}): {}",
+            ran.exit(),
+            super::complaint(&ran.output)
+        );
+    }
+    Ok((logs.join(aag), logs.join(map)))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

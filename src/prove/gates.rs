@@ -1,0 +1,395 @@
+//! The front's gate-level engine (`--front-engine gates`, the default): the front modules
+//! (the design's `zero_detect.v` and `sort_shift.v`, unchanged, in the wrapper of
+//! [`super::build::front_wrapper`] with one copy) read by Yosys, every flip-flop made a wire
+//! from D to Q, mapped to an and-inverter graph ([`crate::toolchain::yosys::aig`]) and
+//! evaluated here on every gradient of the range, 512 at a time (one bit of a machine word per
+//! gradient), against the model.
+//!
+//! Why: the front sees all 2^(3G) gradients, 2^36 for the default design. Verilator spends
+//! about 40 ns a gradient in its modules' logic and its `eval` calls; the graph of the default
+//! front has about 1,500 AND gates, and with a row's gy and gz fixed (4,096 gradients,
+//! one compile of the graph for their constants) fewer, so a gradient costs a few ns of gates
+//! and the model check dominates.
+//!
+//! Why the wires are the clocked front's behaviour: part `structure` shows from the same
+//! Yosys reading that every register the gradient reaches moves on one enable and that every
+//! path from a sample input to the output register crosses the same number of registers. So
+//! every path from the gradient to a front output that reaches the output register crosses
+//! the same number of registers, and in a stream each register holds the value computed from
+//! the sample that entered as many enabled clocks before: the output for a sample is the
+//! combinational function with the registers as wires (docs/VERIFICATION.md, "The front by
+//! gates").
+
+use super::front::{differences, gradient, missing_state, pack, widths, FRONT};
+use super::states::StateSet;
+use super::{build, Failures, Progress};
+use crate::config::Config;
+use crate::design_dir::DesignDir;
+use crate::model::{sort_shift, zero_detect};
+use crate::rtl::aig::{self, Aig};
+use crate::stages;
+use crate::toolchain::yosys;
+use crate::vectors::inputs::dec_grad;
+use anyhow::{bail, Context, Result};
+use rayon::prelude::*;
+use std::ops::Range;
+use std::path::Path;
+
+/// Machine words per evaluation: 8 x 64 = 512 gradients of a row at once.
+const WORDS: usize = 8;
+const LANES: u64 = 64 * WORDS as u64;
+/// Rows (gradients sharing gy and gz) per parallel batch between progress reports.
+const BATCH_ROWS: u64 = 64;
+
+/// What a graph input is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Role {
+    /// Bit `b` of component `c` (0 gx, 1 gy, 2 gz).
+    Grad(usize, u32),
+    /// A control input held at this value for a stream of samples.
+    Held(bool),
+}
+
+/// The front as a graph, its inputs and outputs placed.
+pub struct GateFront {
+    aig: Aig,
+    roles: Vec<Role>,
+    /// For each graph output: the front module (index in [`FRONT`]) and the bit of its packed
+    /// outputs, or None for an output that is not sample data (the valid bits).
+    places: Vec<Option<(usize, u32)>>,
+    /// AND gates of the whole graph.
+    pub gates: usize,
+}
+
+/// Which wrapper input is which: the gradient ports of copy 0, the reset released, `valid_i`
+/// high (a stream of samples), the clock unused once the registers are wires.
+fn role(name: &str, bit: u32) -> Option<Role> {
+    Some(match name {
+        "gx0_i" => Role::Grad(0, bit),
+        "gy0_i" => Role::Grad(1, bit),
+        "gz0_i" => Role::Grad(2, bit),
+        "rst_ni" | "valid_i" => Role::Held(true),
+        "clk_i" => Role::Held(false),
+        _ => return None,
+    })
+}
+
+/// Builds the graph of `d`'s front in `build/gates` (the wrapper, the techmap file, Yosys's
+/// log and the graph).
+pub fn build(d: &DesignDir, build: &Path) -> Result<GateFront> {
+    let dir = build.join("gates");
+    std::fs::create_dir_all(&dir)?;
+    for u in FRONT {
+        no_undefined_literal(&d.path().join(u.file(&d.config)))?;
+    }
+    let wrapper = dir.join(format!("{}.v", build::FRONT_MODULE));
+    std::fs::write(&wrapper, build::front_wrapper(d, 1, false))?;
+    let transparent = dir.join(crate::rtl::mult_proof::TRANSPARENT_FILE);
+    std::fs::write(&transparent, crate::rtl::mult_proof::TRANSPARENT)?;
+    let mut files: Vec<String> = FRONT
+        .iter()
+        .map(|u| crate::toolchain::quoted(&d.path().join(u.file(&d.config)).to_string_lossy()))
+        .collect();
+    files.push(crate::toolchain::quoted(&wrapper.to_string_lossy()));
+    let (aag, map) = yosys::aig(
+        build::FRONT_MODULE,
+        &files,
+        crate::rtl::mult_proof::TRANSPARENT_FILE,
+        &dir,
+    )?;
+    let read = |p: &Path| std::fs::read_to_string(p).with_context(|| format!("{}", p.display()));
+    let graph = Aig::parse(&read(&aag)?, &read(&map)?)
+        .with_context(|| format!("the front's graph {}", aag.display()))?;
+    place(graph, &d.config)
+}
+
+/// The front's files must not write an undefined value (`'bx`, `'hz`, ...): the gates take
+/// every `x` as "any value" (see [`yosys::aig`]), which is right only for the defaults
+/// Yosys itself writes where no path selects them. Comments are skipped.
+fn no_undefined_literal(file: &Path) -> Result<()> {
+    let text =
+        std::fs::read_to_string(file).with_context(|| format!("cannot read {}", file.display()))?;
+    for (n, line) in text.lines().enumerate() {
+        let code = line.split("//").next().unwrap_or("");
+        let mut rest = code;
+        while let Some(q) = rest.find('\'') {
+            let lit: String = rest[q + 1..]
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_' || *c == '?')
+                .collect();
+            let lower = lit.to_ascii_lowercase();
+            let base = lower.trim_start_matches('s');
+            if base.starts_with(['b', 'o', 'd', 'h']) && base[1..].contains(['x', 'z', '?']) {
+                bail!(
+                    "{}:{}: the undefined literal '{lit} (the front's gates cannot keep an x or z)",
+                    file.display(),
+                    n + 1
+                );
+            }
+            rest = &rest[q + 1..];
+        }
+    }
+    Ok(())
+}
+
+/// Places every input and output of the front's graph; anything the wrapper does not have is
+/// an error, as is an output bit missing.
+fn place(aig: Aig, cfg: &Config) -> Result<GateFront> {
+    let roles = aig
+        .inputs
+        .iter()
+        .map(|(n, b)| {
+            role(n, *b).with_context(|| format!("the front's graph has the input {n}[{b}]"))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let widths: Vec<u32> = FRONT
+        .iter()
+        .map(|u| widths(*u, cfg).iter().map(|(_, w)| w).sum())
+        .collect();
+    let mut seen: Vec<Vec<bool>> = widths.iter().map(|&w| vec![false; w as usize]).collect();
+    let mut places = Vec::with_capacity(aig.outputs.len());
+    for (name, bit) in &aig.outputs {
+        let unit = FRONT
+            .iter()
+            .position(|u| *name == format!("{}0_o", u.name()));
+        if let Some(u) = unit {
+            let slot = seen[u]
+                .get_mut(*bit as usize)
+                .with_context(|| format!("the front's output {name}[{bit}] is past its width"))?;
+            *slot = true;
+            places.push(Some((u, *bit)));
+        } else if FRONT
+            .iter()
+            .any(|u| *name == format!("{}_valid_o", u.name()))
+        {
+            places.push(None);
+        } else {
+            bail!("the front's graph has the output {name}[{bit}]");
+        }
+    }
+    for (u, s) in seen.iter().enumerate() {
+        if let Some(b) = s.iter().position(|x| !x) {
+            bail!("the front's graph lacks {}0_o[{b}]", FRONT[u].name());
+        }
+    }
+    let gates = aig.gates();
+    Ok(GateFront {
+        aig,
+        roles,
+        places,
+        gates,
+    })
+}
+
+/// Transposes a 64 x 64 bit matrix in place: bit `j` of word `i` goes to bit `i` of word
+/// `j` (Hacker's Delight 7-3, least significant bit first).
+fn transpose64(a: &mut [u64; 64]) {
+    let mut j = 32;
+    let mut m: u64 = 0x0000_0000_FFFF_FFFF;
+    while j != 0 {
+        let mut k = 0;
+        while k < 64 {
+            let t = ((a[k] >> j) ^ a[k + j]) & m;
+            a[k] ^= t << j;
+            a[k + j] ^= t;
+            k = (k + j + 1) & !j;
+        }
+        j >>= 1;
+        m ^= m << j;
+    }
+}
+
+/// The words of gx bit `b` for evaluation `pass` of a row: gradient `pass * 512 + w * 64 +
+/// lane` of the row has gx equal to its number.
+fn gx_pattern(b: u32, pass: u64) -> [u64; WORDS] {
+    const LANE: [u64; 6] = [
+        0xAAAA_AAAA_AAAA_AAAA,
+        0xCCCC_CCCC_CCCC_CCCC,
+        0xF0F0_F0F0_F0F0_F0F0,
+        0xFF00_FF00_FF00_FF00,
+        0xFFFF_0000_FFFF_0000,
+        0xFFFF_FFFF_0000_0000,
+    ];
+    std::array::from_fn(|w| {
+        let n = pass * LANES + 64 * w as u64;
+        if b < 6 {
+            LANE[b as usize]
+        } else {
+            0u64.wrapping_sub((n >> b) & 1)
+        }
+    })
+}
+
+/// Checks the gradients `range` of one row (`row` = the gradient index >> G: gy and gz
+/// fixed) and returns its failures.
+fn check_row(
+    gf: &GateFront,
+    cfg: &Config,
+    states: &StateSet,
+    row: u64,
+    range: Range<u64>,
+    scratch: &mut Vec<[u64; WORDS]>,
+) -> Failures {
+    let g = cfg.grad_bits;
+    let mut fails = Failures::default();
+    let [zw, sw] = FRONT.map(|u| widths(u, cfg));
+    // The row's constants: gy and gz, the held controls. gx stays free, bit by bit.
+    let (mut fixed, mut free, mut free_bits) = (Vec::new(), Vec::new(), Vec::new());
+    for (i, r) in gf.roles.iter().enumerate() {
+        fixed.push(match *r {
+            Role::Held(v) => Some(v),
+            Role::Grad(0, b) => {
+                free.push(i);
+                free_bits.push(b);
+                None
+            }
+            Role::Grad(c, b) => Some((row >> ((c - 1) as u32 * g + b)) & 1 == 1),
+        });
+    }
+    let p = aig::compile(&gf.aig, &fixed, &free);
+    let mut out = vec![[0u64; WORDS]; gf.places.len()];
+    let first = row << g;
+    let (lo, hi) = (range.start - first, range.end - first);
+    for pass in lo / LANES..hi.div_ceil(LANES) {
+        p.eval(scratch, |k| gx_pattern(free_bits[k], pass), &mut out);
+        for w in 0..WORDS {
+            // Each module's packed outputs for the word's 64 gradients.
+            let mut got = [[0u64; 64]; 2];
+            for (words, place) in out.iter().zip(&gf.places) {
+                if let Some((u, bit)) = *place {
+                    got[u][bit as usize] = words[w];
+                }
+            }
+            transpose64(&mut got[0]);
+            transpose64(&mut got[1]);
+            let base = pass * LANES + 64 * w as u64;
+            for lane in 0..64 {
+                let gx = base + lane;
+                if gx < lo || gx >= hi {
+                    continue;
+                }
+                let idx = first + gx;
+                let gr = gradient(cfg, idx).map(|v| dec_grad(cfg, v));
+                let z = zero_detect::eval(gr);
+                let s = sort_shift::eval(cfg, gr);
+                let want_z = z as u64;
+                let want_s = pack(&stages::sort_shift::outputs(&s), &sw);
+                let (gz, gs) = (got[0][lane as usize], got[1][lane as usize]);
+                if !z && !states.contains(&s) {
+                    fails.add(missing_state(cfg, idx));
+                }
+                if gz != want_z {
+                    fails.add(format!(
+                        "front: {} on gradient {gr:?}: {}",
+                        FRONT[0].name(),
+                        differences(want_z, gz, &zw)
+                    ));
+                }
+                if gs != want_s {
+                    fails.add(format!(
+                        "front: {} on gradient {gr:?}: {}",
+                        FRONT[1].name(),
+                        differences(want_s, gs, &sw)
+                    ));
+                }
+            }
+        }
+    }
+    fails
+}
+
+/// Runs the front's graph over the gradients `range` (input indices,
+/// [`super::front::gradient`]), on all cores, row by row.
+pub fn check(
+    gf: &GateFront,
+    cfg: &Config,
+    states: &StateSet,
+    range: Range<u64>,
+    failures: &mut Failures,
+    progress: &Progress,
+) -> Result<()> {
+    if range.is_empty() {
+        return Ok(());
+    }
+    let g = cfg.grad_bits;
+    let (first_row, end_row) = (range.start >> g, (range.end - 1) >> g);
+    let mut row = first_row;
+    while row <= end_row {
+        let last = (row + BATCH_ROWS - 1).min(end_row);
+        let results: Vec<(u64, Failures)> = (row..=last)
+            .into_par_iter()
+            .map_init(Vec::new, |scratch, r| {
+                let lo = range.start.max(r << g);
+                let hi = range.end.min((r + 1) << g);
+                (hi - lo, check_row(gf, cfg, states, r, lo..hi, scratch))
+            })
+            .collect();
+        for (n, f) in results {
+            failures.count += f.count - f.kept.len() as u64;
+            for m in f.kept {
+                failures.add(m);
+            }
+            progress(n);
+        }
+        row = last + 1;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn transpose64_moves_bit_j_of_word_i_to_bit_i_of_word_j() {
+        let mut a = [0u64; 64];
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        for w in a.iter_mut() {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            *w = x;
+        }
+        let orig = a;
+        transpose64(&mut a);
+        for (i, row) in orig.iter().enumerate() {
+            for (j, col) in a.iter().enumerate() {
+                assert_eq!((col >> i) & 1, (row >> j) & 1, "word {i} bit {j}");
+            }
+        }
+    }
+
+    #[test]
+    fn gx_patterns_number_the_gradients_of_a_pass() {
+        for pass in [0u64, 3, 7] {
+            for w in 0..WORDS {
+                for lane in 0..64u64 {
+                    let n = pass * LANES + 64 * w as u64 + lane;
+                    let got: u64 = (0..12)
+                        .map(|b| ((gx_pattern(b, pass)[w] >> lane) & 1) << b)
+                        .sum();
+                    assert_eq!(got, n);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn undefined_literals_are_refused_outside_comments() {
+        let dir = std::env::temp_dir().join(format!("rmapgen-undef-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let f = dir.join("m.v");
+        std::fs::write(
+            &f,
+            "assign a = 4'hF; // 4'bx in a comment\nassign b = 8'd3;\n",
+        )
+        .unwrap();
+        assert!(no_undefined_literal(&f).is_ok());
+        std::fs::write(&f, "assign a = 4'hF;\nassign b = c ? 2'b1x : 2'b00;\n").unwrap();
+        let e = no_undefined_literal(&f).unwrap_err().to_string();
+        assert!(e.contains("m.v:2") && e.contains("'b1x"), "{e}");
+        std::fs::write(&f, "assign b = 1'bz;\n").unwrap();
+        assert!(no_undefined_literal(&f).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
