@@ -260,8 +260,14 @@ fn check_row(
                     got[u][bit as usize] = words[w];
                 }
             }
-            transpose64(&mut got[0]);
-            transpose64(&mut got[1]);
+            // A one-bit module's word is already its 64 results; wider ones are transposed to
+            // one packed word per gradient.
+            let wide = [zw.len() > 1 || zw[0].1 > 1, true];
+            for (m, &w) in got.iter_mut().zip(&wide) {
+                if w {
+                    transpose64(m);
+                }
+            }
             let base = pass * LANES + 64 * w as u64;
             for lane in 0..64 {
                 let gx = base + lane;
@@ -274,7 +280,12 @@ fn check_row(
                 let s = sort_shift::eval(cfg, gr);
                 let want_z = z as u64;
                 let want_s = pack(&stages::sort_shift::outputs(&s), &sw);
-                let (gz, gs) = (got[0][lane as usize], got[1][lane as usize]);
+                let gz = if wide[0] {
+                    got[0][lane as usize]
+                } else {
+                    (got[0][0] >> lane) & 1
+                };
+                let gs = got[1][lane as usize];
                 if !z && !states.contains(&s) {
                     fails.add(missing_state(cfg, idx));
                 }
