@@ -403,27 +403,33 @@ fn timing(
     // gradients are; a frame rebuilds what depends on the scene (the maps, and the fused
     // intensity table when it is no larger than the previous frame's shaded samples, as an
     // interactive preview would know them).
+    // Frames render into one image buffer, as VolPack's into the image its caller set
+    // once (the ray caster replaces it).
     let mut m = ModelShader::new(cfg, scene);
     let shaded = frame_on.stats.shaded as usize;
+    let mut image = frame_on.clone();
     let model_on = time(repeat, || {
         m.set_scene_for(scene, shaded);
         Renderer::new(&classified, view, on)
             .expect("checked")
-            .render(&m);
+            .render_into(&m, &mut image);
     });
+    if image != frame_on {
+        bail!("internal error: a repeated frame differs from the first");
+    }
     let model_shader = time(repeat, || {
         m.set_scene_for(scene, shaded);
     });
     let model_image = time(repeat, || {
         Renderer::new(&classified, view, on)
             .expect("checked")
-            .render(&model);
+            .render_into(&model, &mut image);
     });
     let float_on = time(repeat, || {
         let r = Reference::new(cfg, scene);
         Renderer::new(&classified, view, on)
             .expect("checked")
-            .render(&r);
+            .render_into(&r, &mut image);
     });
     let model_off = time(repeat.min(2), || {
         m.set_scene_for(scene, shaded);

@@ -35,6 +35,15 @@ impl<'a> Renderer<'a> {
         }
     }
 
+    /// [`Self::render`] into `out`; shear-warp reuses its buffers (the ray caster replaces
+    /// it).
+    pub fn render_into<S: Shader>(&self, shader: &S, out: &mut Frame) {
+        match self {
+            Renderer::Ray(c) => *out = c.render(shader),
+            Renderer::ShearWarp(s) => s.render_into(shader, out),
+        }
+    }
+
     pub fn camera(&self) -> &super::camera::Camera {
         match self {
             Renderer::Ray(c) => c.camera(),

@@ -55,7 +55,7 @@ impl Stats {
 }
 
 /// A rendered image before quantisation.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Frame {
     pub size: u32,
     /// Composited intensity per pixel, in output LSBs (row 0 at the top).

@@ -91,8 +91,11 @@ pub struct ShearWarp<'a> {
 /// adds to, its weight and gradient, in compositing order.
 #[derive(Clone, Debug)]
 pub struct ShearSamples {
-    /// Accumulated opacity per intermediate pixel.
-    pub alpha: Vec<f32>,
+    /// The padded intermediate image with the accumulated opacities (values 0).
+    pub image: Vec<[f32; 2]>,
+    /// Its non-transparent pixels' bounding box.
+    pub bbox: Bbox,
+    /// Indices into `image`.
     pub pixels: Vec<u32>,
     pub weights: Vec<f32>,
     pub gradients: Vec<[i32; 3]>,
@@ -123,6 +126,19 @@ impl<'a> ShearWarp<'a> {
         let d = vol.dims;
         let nc = d[c];
         let (sa, sb) = (dv[a] / dv[c], dv[b] / dv[c]);
+        #[cfg(test)]
+        let (sa, sb) = match cl.plant_geometry {
+            Some(GeometryFault::ShearSign) => (-sa, -sb),
+            _ => (sa, sb),
+        };
+        // The slice whose shift slice k takes (k itself; the next one for a planted fault).
+        #[cfg(not(test))]
+        let shifted = |k: usize| k;
+        #[cfg(test)]
+        let shifted = |k: usize| match cl.plant_geometry {
+            Some(GeometryFault::SliceOffByOne) => k + 1,
+            _ => k,
+        };
         // shift(k) = k s - off lies in [-(nc - 1)|s|, 0], so every intermediate index is >= 0.
         let (oa, ob) = (
             (sa * (nc - 1) as f64).max(0.0),
@@ -130,7 +146,8 @@ impl<'a> ShearWarp<'a> {
         );
         let slices: Vec<Slice> = (0..nc)
             .map(|k| {
-                let (ha, hb) = (k as f64 * sa - oa, k as f64 * sb - ob);
+                let k = shifted(k) as f64;
+                let (ha, hb) = (k * sa - oa, k * sb - ob);
                 let (fa, fb) = (ha.floor(), hb.floor());
                 Slice {
                     i0: (-fa) as usize,
@@ -161,6 +178,9 @@ impl<'a> ShearWarp<'a> {
         // Samples are one slice apart: |dv_c|^-1 world units along the (unit) ray.
         let step = 1.0 / (dv[c].abs() * vol.unit());
         let tf = cl.transfer.compile(step as f32, cl.prepared.grads.scale);
+        let forward = dv[c] > 0.0;
+        #[cfg(test)]
+        let forward = forward != (cl.plant_geometry == Some(GeometryFault::ReversedOrder));
         Ok(ShearWarp {
             cl,
             runs: cl.runs(c)?,
@@ -169,7 +189,7 @@ impl<'a> ShearWarp<'a> {
             opts,
             axes: [c, a, b],
             stride: [d[a] * d[b], 1, d[a]],
-            forward: dv[c] > 0.0,
+            forward,
             slices,
             width,
             height,
@@ -203,17 +223,18 @@ impl<'a> ShearWarp<'a> {
         self.runs.empty_fraction()
     }
 
-    /// Composites the slab of intermediate rows `rows` (opacities `acc`, row-major, width
-    /// [`Self::width`]), handing each sample to be shaded to `sink` with its pixel (within
-    /// the slab) and weight.
+    /// Composites the slab of intermediate rows `rows` into `im` (those rows of the padded
+    /// intermediate image, [`Self::padded`]): each sample to be shaded goes to `sink` with
+    /// its pixel (index into `im`), weight and gradient, and `sink` returns what it adds to
+    /// the pixel's value. Returns the bounding box of the pixels it made non-transparent.
     #[inline]
-    fn slab<F: FnMut(usize, f32, [i32; 3])>(
+    fn slab<F: FnMut(usize, f32, [i32; 3]) -> f32>(
         &self,
         rows: std::ops::Range<usize>,
-        acc: &mut [f32],
+        im: &mut [[f32; 2]],
         st: &mut Stats,
         mut sink: F,
-    ) {
+    ) -> Bbox {
         let skip = self.opts.skip;
         let ert = self.opts.ert as f32;
         let vox = &self.runs.voxels[..];
@@ -221,12 +242,14 @@ impl<'a> ShearWarp<'a> {
         let (cells, lines) = (self.runs.cells, self.runs.lines);
         let full = [[0u32, cells as u32]];
         let nc = self.slices.len();
+        let pw = self.width + 2;
         let tf = &self.tf;
         let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
+        let mut bbox = Bbox::EMPTY;
         // Early ray termination without visiting opaque pixels (VolPack's pixel skip links):
         // `link[p]` is 0 for a pixel still open, else a distance to jump towards the next
         // open pixel of its row (shortened as chains are followed).
-        let mut link = vec![0u32; acc.len()];
+        let mut link = vec![0u32; im.len()];
         for step in 0..nc {
             let k = if self.forward { step } else { nc - 1 - step };
             let sl = self.slices[k];
@@ -237,8 +260,9 @@ impl<'a> ShearWarp<'a> {
                 };
                 st.samples += cells as u64;
                 let spans = if skip { self.runs.line(k, cb) } else { &full };
-                let row = (j - rows.start) * self.width + sl.i0;
-                let row_end = (j - rows.start + 1) * self.width;
+                let row = (j - rows.start) * pw + 1 + sl.i0;
+                // The row's right border pixel: never opaque, so every chain stops there.
+                let row_end = (j - rows.start) * pw + 1 + self.width;
                 let base = k * sc + cb * sb;
                 let mut visited = 0u64;
                 for &[first, end] in spans {
@@ -266,7 +290,7 @@ impl<'a> ShearWarp<'a> {
                             continue;
                         }
                         ca += 1;
-                        let before = acc[px];
+                        let before = im[px][1];
                         st.evaluated += 1;
                         let i = base + (ca - 1) * sa;
                         let (q00, q10, q01, q11) =
@@ -293,43 +317,69 @@ impl<'a> ShearWarp<'a> {
                         let w = (1.0 - before) * alpha;
                         if !skip || g != [0; 3] {
                             st.shaded += 1;
-                            sink(px, w, g);
+                            im[px][0] += sink(px, w, g);
                         }
                         let after = before + w;
+                        if after > 0.0 {
+                            bbox.add(sl.i0 + ca - 1, j);
+                        }
                         if after >= ert {
-                            acc[px] = 1.0;
+                            im[px][1] = 1.0;
                             link[px] = 1;
                         } else {
-                            acc[px] = after;
+                            im[px][1] = after;
                         }
                     }
                 }
                 st.empty_skipped += cells as u64 - visited;
             }
         }
+        bbox
+    }
+
+    /// Composites every slab of the padded intermediate image `im` in parallel; `slab`
+    /// composites one (its first intermediate row, its rows of `im`) and returns its
+    /// bounding box and anything else.
+    fn slabs<T: Send, F>(&self, im: &mut [[f32; 2]], slab: F) -> Vec<T>
+    where
+        F: Fn(usize, &mut [[f32; 2]]) -> T + Sync,
+    {
+        let pw = self.width + 2;
+        let inner = &mut im[pw..pw * (self.height + 1)];
+        inner
+            .par_chunks_mut(pw * SLAB_ROWS)
+            .enumerate()
+            .map(|(s, rows)| slab(s * SLAB_ROWS, rows))
+            .collect()
     }
 
     /// The image shaded by `shader`: slabs of intermediate scanlines in parallel, then the
     /// warp.
     pub fn render<S: Shader>(&self, shader: &S) -> Frame {
-        let w = self.width;
-        let mut value = vec![0.0f32; w * self.height];
-        let mut acc = vec![0.0f32; w * self.height];
-        let stats = value
-            .par_chunks_mut(w * SLAB_ROWS)
-            .zip(acc.par_chunks_mut(w * SLAB_ROWS))
-            .enumerate()
-            .map(|(s, (vslab, aslab))| {
-                let mut st = Stats::default();
-                let j0 = s * SLAB_ROWS;
-                let rows = j0..j0 + aslab.len() / w;
-                self.slab(rows, aslab, &mut st, |px, wt, g| {
-                    vslab[px] += wt * shader.intensity(g) as f32
-                });
-                st
-            })
-            .reduce(Stats::default, Stats::add);
-        self.warp(&value, &acc, self.with_rays(stats))
+        let mut out = Frame::default();
+        self.render_into(shader, &mut out);
+        out
+    }
+
+    /// [`Self::render`] into `out`, reusing its buffers (as VolPack renders into the image
+    /// its caller set once): a fresh 512² frame costs about 1 ms of page faults, as much as
+    /// the compositing.
+    pub fn render_into<S: Shader>(&self, shader: &S, out: &mut Frame) {
+        let pw = self.width + 2;
+        let mut im = self.cl.take_image((self.width + 2) * (self.height + 2));
+        let parts = self.slabs(&mut im, |j0, rows| {
+            let mut st = Stats::default();
+            let r = j0..j0 + rows.len() / pw;
+            let b = self.slab(r, rows, &mut st, |_, wt, g| wt * shader.intensity(g) as f32);
+            (st, b)
+        });
+        let (stats, bbox) = parts
+            .into_iter()
+            .fold((Stats::default(), Bbox::EMPTY), |(s, b), (s2, b2)| {
+                (s.add(s2), b.union(b2))
+            });
+        self.warp(&im, bbox, self.with_rays(stats), out);
+        self.cl.give_image(im);
     }
 
     /// Every sample the fused path would shade, for a batch shader; refused once more than
@@ -340,22 +390,23 @@ impl<'a> ShearWarp<'a> {
 
     fn collect_at_most(&self, limit: usize) -> Result<ShearSamples> {
         use std::sync::atomic::{AtomicUsize, Ordering};
-        let w = self.width;
-        let mut acc = vec![0.0f32; w * self.height];
+        let pw = self.width + 2;
+        let mut im = vec![[0.0f32; 2]; pw * (self.height + 2)];
         let gathered = AtomicUsize::new(0);
-        type Slab = (Vec<u32>, Vec<f32>, Vec<[i32; 3]>, Stats);
-        let slabs: Result<Vec<Slab>> = acc
-            .par_chunks_mut(w * SLAB_ROWS)
-            .enumerate()
-            .map(|(s, aslab)| {
+        type Slab = (Vec<u32>, Vec<f32>, Vec<[i32; 3]>, Stats, Bbox);
+        let slabs: Result<Vec<Slab>> = self
+            .slabs(&mut im, |j0, rows| {
                 let mut st = Stats::default();
-                let j0 = s * SLAB_ROWS;
-                let rows = j0..j0 + aslab.len() / w;
+                let r = j0..j0 + rows.len() / pw;
                 let (mut p, mut wt, mut g) = (Vec::new(), Vec::new(), Vec::new());
-                self.slab(rows, aslab, &mut st, |px, wi, gi| {
-                    p.push((j0 * w + px) as u32);
+                // Pixels as indices into the whole padded image (the slab starts at row
+                // j0 + 1).
+                let at = (j0 + 1) * pw;
+                let b = self.slab(r, rows, &mut st, |px, wi, gi| {
+                    p.push((at + px) as u32);
                     wt.push(wi);
                     g.push(gi);
+                    0.0
                 });
                 if gathered.fetch_add(p.len(), Ordering::Relaxed) + p.len() > limit {
                     bail!(
@@ -364,24 +415,27 @@ impl<'a> ShearWarp<'a> {
                         super::human_bytes(super::MEMORY_BUDGET)
                     );
                 }
-                Ok((p, wt, g, st))
+                Ok((p, wt, g, st, b))
             })
+            .into_iter()
             .collect();
         let mut out = ShearSamples {
-            alpha: Vec::new(),
+            image: Vec::new(),
+            bbox: Bbox::EMPTY,
             pixels: Vec::new(),
             weights: Vec::new(),
             gradients: Vec::new(),
             stats: Stats::default(),
         };
-        for (p, wt, g, st) in slabs? {
+        for (p, wt, g, st, b) in slabs? {
             out.pixels.extend(p);
             out.weights.extend(wt);
             out.gradients.extend(g);
             out.stats = out.stats.add(st);
+            out.bbox = out.bbox.union(b);
         }
         out.stats = self.with_rays(out.stats);
-        out.alpha = acc;
+        out.image = im;
         Ok(out)
     }
 
@@ -395,11 +449,13 @@ impl<'a> ShearWarp<'a> {
                 s.gradients.len()
             );
         }
-        let mut value = vec![0.0f32; s.alpha.len()];
+        let mut im = s.image.clone();
         for ((&p, &w), &i) in s.pixels.iter().zip(&s.weights).zip(intensities) {
-            value[p as usize] += w * i as f32;
+            im[p as usize][0] += w * i as f32;
         }
-        Ok(self.warp(&value, &s.alpha, s.stats))
+        let mut out = Frame::default();
+        self.warp(&im, s.bbox, s.stats, &mut out);
+        Ok(out)
     }
 
     /// The work counts with `rays` set: the intermediate image's pixels.
@@ -408,71 +464,121 @@ impl<'a> ShearWarp<'a> {
         st
     }
 
-    /// The final image: each pixel the bilinear interpolation of the intermediate image
-    /// (composited values and opacities) where its ray meets it.
-    fn warp(&self, value: &[f32], acc: &[f32], stats: Stats) -> Frame {
+    /// The final image into `out`: each pixel the bilinear interpolation of the padded
+    /// intermediate image `im` (composited values and opacities) where its ray meets it.
+    /// Only the pixels whose four intermediate pixels can reach `bbox` (every
+    /// non-transparent intermediate pixel) are interpolated; the others are exactly 0 either
+    /// way and are written 0 in the same pass (the image's background costs a store).
+    fn warp(&self, im: &[[f32; 2]], bbox: Bbox, stats: Stats, out: &mut Frame) {
         let n = self.opts.size as usize;
-        let (w, h) = (self.width, self.height);
+        let pw = self.width + 2;
         let m = self.warp;
-        // The intermediate image with a border of one zero pixel, value and opacity side by
-        // side: every position in (-1, w) x (-1, h) reads its four pixels without checks.
-        let pw = w + 2;
-        let mut pad = vec![[0.0f32; 2]; pw * (h + 2)];
-        for j in 0..h {
-            for i in 0..w {
-                pad[(j + 1) * pw + i + 1] = [value[j * w + i], acc[j * w + i]];
-            }
-        }
-        let mut out_v = vec![0.0f32; n * n];
-        let mut out_a = vec![0.0f32; n * n];
-        // Pixels whose position is outside (-1, w) x (-1, h) stay 0; each row's range of
-        // the others is found from the affine map, and floor is a truncation there
-        // (positions > -1), not a libm call.
-        let (wf, hf) = (w as f64, h as f64);
-        out_v
+        out.size = self.opts.size;
+        out.stats = stats;
+        // Every pixel is written below: resizing keeps (and does not clear) a reused buffer.
+        out.value.resize(n * n, 0.0);
+        out.alpha.resize(n * n, 0.0);
+        let Some([ilo, ihi, jlo, jhi]) = bbox.bounds() else {
+            out.value.par_iter_mut().for_each(|v| *v = 0.0);
+            out.alpha.par_iter_mut().for_each(|v| *v = 0.0);
+            return;
+        };
+        // A position is interpolated when it lies in (ilo - 1, ihi + 1) x (jlo - 1, jhi + 1):
+        // outside, its four pixels are all transparent (value and opacity 0). Each row's
+        // range of such positions is found from the affine map, so floor is a truncation
+        // there (positions > -1), not a libm call.
+        let bi = (ilo as f64 - 1.0, ihi as f64 + 1.0);
+        let bj = (jlo as f64 - 1.0, jhi as f64 + 1.0);
+        out.value
             .par_chunks_mut(n)
-            .zip(out_a.par_chunks_mut(n))
+            .zip(out.alpha.par_chunks_mut(n))
             .enumerate()
             .for_each(|(y, (vr, ar))| {
                 let yf = y as f64;
                 let (i0, j0) = (m[0] + m[2] * yf, m[3] + m[5] * yf);
-                // x range where -1 < i0 + m1 x < w and -1 < j0 + m4 x < h.
                 let (mut lo, mut hi) = (0.0f64, n as f64);
-                for (p0, d, top) in [(i0, m[1], wf), (j0, m[4], hf)] {
+                for (p0, d, (bot, top)) in [(i0, m[1], bi), (j0, m[4], bj)] {
                     if d == 0.0 {
-                        if p0 <= -1.0 || p0 >= top {
-                            return;
+                        if p0 <= bot || p0 >= top {
+                            hi = 0.0;
                         }
                     } else {
-                        let (a, b) = ((-1.0 - p0) / d, (top - p0) / d);
+                        let (a, b) = ((bot - p0) / d, (top - p0) / d);
                         lo = lo.max(a.min(b));
                         hi = hi.min(a.max(b));
                     }
                 }
-                let x0 = lo.max(0.0).floor() as usize;
-                let x1 = (hi.ceil().max(0.0) as usize).min(n);
+                let x0 = (lo.max(0.0).floor() as usize).min(n);
+                let x1 = (hi.ceil().max(0.0) as usize).clamp(x0, n);
+                vr[..x0].fill(0.0);
+                ar[..x0].fill(0.0);
+                vr[x1..].fill(0.0);
+                ar[x1..].fill(0.0);
                 let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
                 for x in x0..x1 {
                     let xf = x as f64;
+                    // Padded positions.
                     let (pi, pj) = (i0 + m[1] * xf + 1.0, j0 + m[4] * xf + 1.0);
-                    // Padded positions in (0, w + 1) x (0, h + 1).
-                    if pi <= 0.0 || pj <= 0.0 || pi >= wf + 1.0 || pj >= hf + 1.0 {
+                    if pi <= bi.0 + 1.0 || pj <= bj.0 + 1.0 || pi >= bi.1 + 1.0 || pj >= bj.1 + 1.0
+                    {
+                        vr[x] = 0.0;
+                        ar[x] = 0.0;
                         continue;
                     }
-                    let (i, j) = (pi as usize, pj as usize);
+                    let (i, j) = (pi as u32 as usize, pj as u32 as usize);
                     let (ti, tj) = ((pi - i as f64) as f32, (pj - j as f64) as f32);
                     let q = j * pw + i;
-                    let (p00, p10, p01, p11) = (pad[q], pad[q + 1], pad[q + pw], pad[q + pw + 1]);
+                    let (p00, p10, p01, p11) = (im[q], im[q + 1], im[q + pw], im[q + pw + 1]);
                     vr[x] = lerp(lerp(p00[0], p10[0], ti), lerp(p01[0], p11[0], ti), tj);
                     ar[x] = lerp(lerp(p00[1], p10[1], ti), lerp(p01[1], p11[1], ti), tj);
                 }
             });
-        Frame {
-            size: self.opts.size,
-            value: out_v,
-            alpha: out_a,
-            stats,
+    }
+}
+
+/// A planted geometry fault (tests only): each must make the geometry test against the ray
+/// caster fail.
+#[cfg(test)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum GeometryFault {
+    /// The shear's direction reversed.
+    ShearSign,
+    /// Every slice drawn with the next slice's shift (one slice off).
+    SliceOffByOne,
+    /// Slices composited back to front.
+    ReversedOrder,
+}
+
+/// The bounding box of the non-transparent pixels of an intermediate image (inclusive
+/// bounds along a and b), or empty.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Bbox {
+    lo: [usize; 2],
+    hi: [usize; 2],
+}
+
+impl Bbox {
+    const EMPTY: Bbox = Bbox {
+        lo: [usize::MAX; 2],
+        hi: [0; 2],
+    };
+
+    #[inline]
+    fn add(&mut self, i: usize, j: usize) {
+        self.lo = [self.lo[0].min(i), self.lo[1].min(j)];
+        self.hi = [self.hi[0].max(i), self.hi[1].max(j)];
+    }
+
+    fn union(self, o: Bbox) -> Bbox {
+        Bbox {
+            lo: [self.lo[0].min(o.lo[0]), self.lo[1].min(o.lo[1])],
+            hi: [self.hi[0].max(o.hi[0]), self.hi[1].max(o.hi[1])],
         }
+    }
+
+    /// `[i_lo, i_hi, j_lo, j_hi]`, or `None` when empty.
+    fn bounds(self) -> Option<[usize; 4]> {
+        (self.lo[0] <= self.hi[0]).then_some([self.lo[0], self.hi[0], self.lo[1], self.hi[1]])
     }
 }
 
@@ -637,6 +743,33 @@ mod tests {
     }
 
     #[test]
+    fn a_reused_frame_and_intermediate_image_give_the_same_image() {
+        // Frames rendered into one buffer (and one kept intermediate image) after other
+        // views and sizes: nothing of the earlier frame shows (the warp writes every pixel,
+        // the intermediate image is cleared).
+        let vol = synthetic::engine_block([48, 40, 24], [1.0, 1.0, 1.5]).unwrap();
+        let p = Prepared::new(&vol, 12, 8);
+        let cl = Classified::new(&p, &classified_tf()).unwrap();
+        let model = ModelShader::new(&Config::default(), &Scene::standard());
+        let mut buf = Frame::default();
+        for (view, size) in [
+            ([-0.5, -0.7, 0.5], 64),
+            ([0.9, 0.1, 0.2], 40),
+            ([0.0, 0.0, 1.0], 40),
+            ([-0.5, -0.7, 0.5], 48),
+        ] {
+            let sw = ShearWarp::new(&cl, view, opts(size, true)).unwrap();
+            sw.render_into(&model, &mut buf);
+            let fresh = Classified::new(&p, &classified_tf()).unwrap();
+            let once = ShearWarp::new(&fresh, view, opts(size, true))
+                .unwrap()
+                .render(&model);
+            assert!(once.alpha.iter().any(|&a| a > 0.0), "{view:?}");
+            assert_eq!(buf, once, "{view:?} {size}");
+        }
+    }
+
+    #[test]
     fn batch_path_equals_fused_path() {
         let vol = synthetic::engine_block([48, 40, 24], [1.0, 1.0, 1.5]).unwrap();
         let small = Config {
@@ -678,18 +811,20 @@ mod tests {
         }
     }
 
-    #[test]
-    fn the_image_matches_the_ray_casters() {
-        // Same camera, same shading: the two renderers sample differently (slices against
-        // half-voxel steps, bilinear against trilinear, a warp), so the images differ a
-        // little, but a wrong shear, order or warp (mirrored, shifted, transposed) differs
-        // by far more.
+    /// Whether shear-warp's image of the engine block is close to the ray caster's on
+    /// three views (same camera, same shading): the two renderers sample differently
+    /// (slices against half-voxel steps, bilinear against trilinear, a warp), so the images
+    /// differ a little, but a wrong shear, slice or order differs by more. Returns the
+    /// failures, one line each.
+    fn geometry_failures(fault: Option<GeometryFault>) -> Vec<String> {
         let vol = synthetic::engine_block([64, 64, 32], [1.0, 1.0, 1.2]).unwrap();
         let cfg = Config::default();
         let p = Prepared::new(&vol, cfg.grad_bits, 8);
         let tf = Transfer::new(vec![[1100.0, 0.0], [1900.0, 1.0]]);
-        let cl = Classified::new(&p, &tf).unwrap();
+        let mut cl = Classified::new(&p, &tf).unwrap();
+        cl.plant_geometry = fault;
         let model = ModelShader::new(&cfg, &Scene::standard());
+        let mut failures = Vec::new();
         for (view, up) in [
             ([-0.5, -0.7, 0.5], None),
             ([0.6, 0.2, -0.75], Some([0.0, 1.0, 0.0])),
@@ -717,8 +852,34 @@ mod tests {
                 .filter(|(&x, &y)| (x > 0.5) != (y > 0.5))
                 .count();
             assert!(covered > 96 * 96 / 5, "{view:?} {covered}");
-            assert!(disagree * 50 < covered, "{view:?} {disagree} of {covered}");
-            assert!(mean < 12.0, "{view:?}: mean |difference| {mean}");
+            if disagree * 50 >= covered || mean >= GEOMETRY_MEAN {
+                failures.push(format!(
+                    "{view:?}: {disagree} of {covered} covered pixels disagree, mean |difference| {mean:.2}"
+                ));
+            }
+        }
+        failures
+    }
+
+    /// The largest mean |difference| to the ray caster's image (8-bit values over its
+    /// covered pixels) the geometry test accepts.
+    const GEOMETRY_MEAN: f64 = 12.0;
+
+    #[test]
+    fn the_image_matches_the_ray_casters() {
+        assert_eq!(geometry_failures(None), Vec::<String>::new());
+    }
+
+    #[test]
+    fn a_planted_geometry_fault_is_caught() {
+        for fault in [
+            GeometryFault::ShearSign,
+            GeometryFault::SliceOffByOne,
+            GeometryFault::ReversedOrder,
+        ] {
+            let f = geometry_failures(Some(fault));
+            eprintln!("{fault:?}: {f:?}");
+            assert!(!f.is_empty(), "{fault:?} passes the geometry test");
         }
     }
 }

@@ -20,7 +20,7 @@ use super::super::prepared::Prepared;
 use crate::scene::transfer::{Tf, Transfer};
 use anyhow::Result;
 use rayon::prelude::*;
-use std::sync::OnceLock;
+use std::sync::{Mutex, OnceLock};
 
 /// The two slice axes of principal axis `c`, in memory order (the faster one first): a
 /// scanline runs along the first.
@@ -187,10 +187,17 @@ pub struct Classified<'a> {
     tf: Tf,
     /// Per axis, the runs or why they could not be built (no memory).
     runs: [OnceLock<std::result::Result<Runs, String>>; 3],
+    /// The shear-warp intermediate image's buffer, kept between frames as VolPack's
+    /// context keeps its own: a fresh one per frame costs page faults.
+    image: Mutex<Vec<[f32; 2]>>,
     /// A deliberately wrong classification for the tests: this scanline of every slice is
     /// marked transparent, to show the skipping tests catch a wrong skip.
     #[cfg(test)]
     pub(crate) plant_wrong_skip: Option<usize>,
+    /// A deliberately wrong geometry for the tests ([`super::GeometryFault`]), to show the
+    /// geometry test catches one.
+    #[cfg(test)]
+    pub(crate) plant_geometry: Option<super::GeometryFault>,
 }
 
 impl<'a> Classified<'a> {
@@ -201,9 +208,32 @@ impl<'a> Classified<'a> {
             transfer: transfer.clone(),
             tf: transfer.compile(1.0, prepared.grads.scale),
             runs: Default::default(),
+            image: Mutex::new(Vec::new()),
             #[cfg(test)]
             plant_wrong_skip: None,
+            #[cfg(test)]
+            plant_geometry: None,
         })
+    }
+
+    /// An intermediate image of `len` zero pixels, in the kept buffer when no other render
+    /// holds it (then a new one).
+    pub fn take_image(&self, len: usize) -> Vec<[f32; 2]> {
+        let mut v = self
+            .image
+            .try_lock()
+            .map(|mut b| std::mem::take(&mut *b))
+            .unwrap_or_default();
+        v.clear();
+        v.resize(len, [0.0; 2]);
+        v
+    }
+
+    /// Keeps `v` for the next frame's [`Self::take_image`].
+    pub fn give_image(&self, v: Vec<[f32; 2]>) {
+        if let Ok(mut b) = self.image.try_lock() {
+            *b = v;
+        }
     }
 
     /// The runs for principal axis `c`, built on first use.
