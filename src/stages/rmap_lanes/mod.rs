@@ -266,9 +266,8 @@ fn pins(cfg: &Config, k: u32) -> Vec<String> {
         .map(|p| {
             let e = match (p.name, cfg.handshake) {
                 (n, _) if n == en => format!("recip_en[{k}]"),
-                (n, _) if n == addr || n == data => {
-                    format!("recip_{}{}", &n[6..n.len() - 2], recip_bus(cfg, n).range(k))
-                }
+                (n, _) if n == addr => format!("recip_addr{}", recip_bus(cfg, n).range(k)),
+                (n, _) if n == data => format!("recip_data{}", recip_bus(cfg, n).range(k)),
                 ("valid_i", true) => "beat_valid".to_string(),
                 ("valid_o", true) => format!("lane_valid[{k}]"),
                 ("ready_o", _) => format!("lane_ready[{k}]"),
