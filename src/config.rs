@@ -127,6 +127,10 @@ pub enum Target {
     /// same-address read and write, which the top never issues), and one copy of the
     /// compensation ROM per read port (an SB_RAM40_4K has one read port).
     Ice40,
+    /// Lattice ECP5 with Yosys: the iCE40's block-RAM attributes, but the compensation ROM is
+    /// one array read through both ports of a true dual-port DP16KD, and with lanes one
+    /// reciprocal ROM serves two lanes through its two ports.
+    Ecp5,
 }
 
 impl Target {
@@ -139,12 +143,21 @@ impl Target {
         match self {
             Target::Generic => "generic",
             Target::Ice40 => "ice40",
+            Target::Ecp5 => "ecp5",
         }
     }
 
-    /// Whether memories carry the iCE40/Yosys attributes and ROMs get one copy per read port.
+    /// Whether the block RAM has one read port (iCE40 SB_RAM40_4K), so a ROM gets one copy per
+    /// read; else it is true dual-port (ECP5 DP16KD, and what generic assumes): two reads of
+    /// one array.
     pub fn ice40(&self) -> bool {
         *self == Target::Ice40
+    }
+
+    /// Whether memories carry the Yosys block-RAM attributes (`ram_style = "block"`, and
+    /// `no_rw_check` on the map banks): every target but generic.
+    pub fn block_attrs(&self) -> bool {
+        !self.is_generic()
     }
 }
 

@@ -44,8 +44,9 @@ pub struct ConfigArgs {
     pub handshake: bool,
     #[arg(long, value_name = "P", value_parser = parse::prefix(), help = parse::prefix_help())]
     pub prefix: Option<String>,
-    /// Memories for these tools: generic (plain inferred memories, no vendor attributes) or
-    /// ice40 (Yosys block-RAM attributes, one compensation ROM copy per read port)
+    /// Memories for these tools: generic (plain inferred memories, no vendor attributes),
+    /// ice40 (Yosys block-RAM attributes, one compensation ROM copy per read port) or ecp5
+    /// (Yosys block-RAM attributes, true dual-port ROMs: two lanes share a reciprocal ROM)
     /// [default: generic].
     #[arg(long, value_enum, value_name = "T")]
     pub target: Option<crate::config::Target>,

@@ -119,7 +119,7 @@ mod tests {
     }
 
     #[test]
-    fn every_lane_costs_a_whole_top_in_memory() {
+    fn a_lane_costs_its_memories_and_half_a_shared_rom() {
         for l in [2, 4] {
             let cfg = Config {
                 lanes: l,
@@ -127,8 +127,21 @@ mod tests {
             };
             let m = Manifest::new(&cfg, vec![]);
             let one = Manifest::new(&Config::default(), vec![]).memory_bits;
-            assert_eq!(m.memory_bits, l as u64 * one);
-            assert_eq!(m.lanes.as_ref().unwrap().memory_bits_per_lane, one);
+            // Two lanes share a reciprocal ROM (128 x 10): half of it a lane.
+            assert_eq!(m.memory_bits, l as u64 * (one - 640));
+            assert_eq!(m.lanes.as_ref().unwrap().memory_bits_per_lane, one - 640);
+            assert_eq!(
+                m.lanes.as_ref().unwrap().own_memory_bits_per_lane,
+                one - 1280
+            );
+            // On the iCE40 every lane has its own.
+            let ice40 = cfg.for_target(crate::config::Target::Ice40);
+            let one = Manifest::new(
+                &Config::default().for_target(crate::config::Target::Ice40),
+                vec![],
+            )
+            .memory_bits;
+            assert_eq!(Manifest::new(&ice40, vec![]).memory_bits, l as u64 * one);
             assert_eq!(m.top, "rmap_lanes");
             assert_eq!(m.latency, 24);
         }

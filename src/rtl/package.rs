@@ -115,8 +115,14 @@ struct LanesReadme {
     packing: Vec<(&'static str, &'static str, u32, String, String)>,
     packing_rule: &'static str,
     memories_per_lane: usize,
+    /// A shared memory counted once per pair (half to each lane).
     bits_per_lane: u64,
+    own_bits_per_lane: u64,
     bits_total: u64,
+    /// (shared array, bits, which lane reads which port).
+    shared: Vec<(String, u64, String)>,
+    /// The target's name, and whether its block RAM has one read port (nothing shared).
+    target: &'static str,
     tb_file: String,
 }
 
@@ -151,7 +157,14 @@ impl LanesReadme {
             packing_rule: info.packing,
             memories_per_lane: TOP.memories(cfg).len(),
             bits_per_lane: info.memory_bits_per_lane,
-            bits_total: info.memory_bits_per_lane * cfg.lanes as u64,
+            own_bits_per_lane: info.own_memory_bits_per_lane,
+            bits_total: manifest::memories(cfg).iter().map(|m| m.bits).sum(),
+            shared: info
+                .shared
+                .iter()
+                .map(|m| (m.instance.clone(), m.bits, m.readers.clone()))
+                .collect(),
+            target: cfg.target.name(),
             tb_file: rmap_lanes::RmapLanes.testbench_file(cfg),
         })
     }
@@ -229,7 +242,8 @@ pub fn config_hash(cfg: &Config) -> String {
 /// the top's testbench with its vectors and the second map it loads.
 pub fn core(cfg: &Config) -> Result<String> {
     let top = TOP.vectors().expect("the top has vectors");
-    let file_params = file_params(&TOP.memories(cfg));
+    // The design top's: with lanes it also sets the shared ROMs' file.
+    let file_params = file_params(&manifest::memories(cfg));
     let mem_files = file_params.iter().map(|p| p.default.clone()).collect();
     let (tb_files, _) = super::tb::testbench_files(cfg, &format!("{}_tb", TOP.module(cfg)))?;
     let tb_params: Vec<TbFile> = tb_files

@@ -17,9 +17,10 @@ use crate::design::Design;
 use crate::model::map_set::{map_file, AXES};
 use crate::output::StagedDir;
 use crate::rtl::ports::{self, Width};
+use crate::stages::recip_rom::{self, RecipRom};
 use crate::stages::rmap_top::top_latency;
 use crate::stages::testbench::{FieldView, Sig, TbData, TbFile};
-use crate::stages::unit::{file_param, file_params, param_overrides};
+use crate::stages::unit::{file_param, file_params, param_overrides, Unit};
 use crate::stages::{self, Vectors, TOP};
 use crate::vectors::Dir;
 use anyhow::{bail, Context, Result};
@@ -38,6 +39,43 @@ fn range(bits: u32) -> String {
 /// The parameter naming the second map's file of `axis` in a testbench: `MAP2_X_FILE`.
 fn map2_param(axis: &str) -> String {
     file_param(&format!("map2_{axis}"))
+}
+
+/// The reciprocal ROM of a testbench whose module reads a shared one through
+/// [`recip_rom::READER`]: the wires, and the ROM with the module on its port a (port b idle),
+/// as rmap_lanes wires a lane.
+fn tb_rom(cfg: &Config) -> String {
+    let (en, addr, data) = recip_rom::READER;
+    let [(en_a, addr_a, data_a), (en_b, addr_b, data_b)] = recip_rom::PORTS;
+    let (ra, w) = (cfg.recip_addr_bits(), cfg.recip_bits);
+    let rw = format!("[{}:0]", ra - 1)
+        .len()
+        .max(format!("[{}:0]", w - 1).len());
+    let r = |b: u32| format!("{:rw$}", range(b));
+    let pins = [
+        ("clk_i", "clk_i".to_string()),
+        (en_a, en.to_string()),
+        (addr_a, addr.to_string()),
+        (data_a, data.to_string()),
+        (en_b, "1'b0".to_string()),
+        (addr_b, format!("{ra}'d0")),
+        (data_b, "unused_recip_data".to_string()),
+    ];
+    let pw = pins.iter().map(|(p, _)| p.len()).max().unwrap_or(0);
+    let pins: Vec<String> = pins
+        .iter()
+        .map(|(p, e)| format!("    .{p:pw$} ({e})"))
+        .collect();
+    format!(
+        "\n  // The reciprocal ROM the design reads through its recip_* ports (shared by two lanes in\n  // rmap_lanes): here on its port a alone.\n  wire {} {en};\n  wire {} {addr};\n  wire {} {data};\n  wire {} unused_recip_data;\n\n  {}{} u_recip_rom (\n{}\n  );",
+        r(1),
+        r(ra),
+        r(w),
+        r(w),
+        RecipRom.module(cfg),
+        param_overrides(cfg, &RecipRom),
+        pins.join(",\n")
+    )
 }
 
 /// The testbench data of one stage.
@@ -70,7 +108,14 @@ pub fn data(cfg: &Config, stage: &dyn Vectors) -> Result<TbData> {
             init: format!("{b}'d0"),
             pin: format!(".{:nw$} ({})", p.name, p.name),
         };
+        // The reader ports of a shared reciprocal ROM go to the testbench's own ROM.
+        let reader = [
+            recip_rom::READER.0,
+            recip_rom::READER.1,
+            recip_rom::READER.2,
+        ];
         match p.dir {
+            _ if reader.contains(&p.name) => {}
             ports::Dir::Input => inputs.push(s()),
             ports::Dir::Output => outputs.push(s()),
         }
@@ -165,6 +210,16 @@ pub fn data(cfg: &Config, stage: &dyn Vectors) -> Result<TbData> {
     // port.
     let memories = stage.memories(cfg);
     let map2 = memories.iter().any(|m| m.writable);
+    // A module that reads a reciprocal ROM shared in rmap_lanes: the testbench holds the ROM
+    // and passes it the file.
+    let reads_rom = ports.iter().any(|p| p.name == recip_rom::READER.0);
+    let memories = if reads_rom {
+        let mut m = memories;
+        m.extend(RecipRom.memories(cfg));
+        m
+    } else {
+        memories
+    };
     let map2_axes: &[&str] = if map2 { &AXES } else { &[] };
     let mut files: Vec<TbFile> = file_params(&memories)
         .into_iter()
@@ -231,6 +286,7 @@ pub fn data(cfg: &Config, stage: &dyn Vectors) -> Result<TbData> {
         out_fields,
         files,
         dut_params: param_overrides(cfg, stage),
+        rom: if reads_rom { tb_rom(cfg) } else { String::new() },
         map2_params: map2_axes.iter().map(|a| map2_param(a)).collect(),
         map2_pattern: map_file(cfg, 1, "*"),
         map_entries: cfg.map_entries(),

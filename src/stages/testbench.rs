@@ -77,6 +77,9 @@ pub struct TbData {
     pub files: Vec<TbFile>,
     /// ` #(...)` passing the design's init-file parameters to the instance under test.
     pub dut_params: String,
+    /// The declarations and instance of the reciprocal ROM the design reads through its
+    /// `recip_*` ports when rmap_lanes shares it (empty otherwise).
+    pub rom: String,
     /// The parameters naming the second map's files, loaded through the host port (map_lookup
     /// and the top), one per axis.
     pub map2_params: Vec<String>,

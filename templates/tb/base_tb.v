@@ -60,6 +60,9 @@ module {= t.module =}_tb;
 {%- for p in t.outputs %}
   wire {= p.range =} {= p.name =};
 {%- endfor %}
+{%- if !t.rom.is_empty() %}
+{= t.rom =}
+{%- endif %}
 
   {= t.module =}{= t.dut_params =} dut (
 {%- for p in t.ports %}

@@ -40,6 +40,7 @@ tests! {
     no_interp_color, bare_color, narrowest, narrowest_bare, widest, widest_depth0, grad16_red6,
     grad8_red8, no_truncation, frac4_recip20, frac12_recip13, index6_interp1, index2_interp5,
     map12, map6_nearest, index6_nearest, axis_color, lanes2, lanes2_hs, lanes4, lanes4_hs,
+    lanes2_hs_ecp5, lanes4_ecp5,
     paper_infer, color_infer, hs_infer, widest_infer,
 }
 
@@ -91,10 +92,16 @@ fn check(name: &str) {
         for m in &tbs {
             let bin = hdl::icarus(&dir, m, tmp.path());
             let what = format!("{name}: icarus {m}");
+            // rmap_lanes' testbench reads the top's vectors.
+            let vectors = if *m == checked {
+                "rmap_top"
+            } else {
+                m.as_str()
+            };
             hdl::assert_passed(
                 &what,
                 &hdl::vvp(&dir, &bin, hdl::NO_ARGS),
-                hdl::vector_count(&dir, m),
+                hdl::vector_count(&dir, vectors),
             );
         }
     }
@@ -183,6 +190,24 @@ fn grid_covers_every_range_end_and_switch() {
             );
         }
     }
+    // Lanes sharing a reciprocal ROM (every target but ice40) and lanes with their own (ice40),
+    // 2 and 4 lanes, with and without the handshake; the ecp5 target among them.
+    for l in [2, 4] {
+        for hs in [false, true] {
+            assert!(
+                rows.iter().any(|r| r.config.lanes == l
+                    && r.config.handshake == hs
+                    && rmapgen::stages::rmap_lanes::shares_recip(&r.config)),
+                "no row with {l} lanes sharing a ROM and handshake {hs}"
+            );
+        }
+    }
+    assert!(rows
+        .iter()
+        .any(|r| r.config.lanes > 1 && r.config.target == Target::Ice40));
+    assert!(rows
+        .iter()
+        .any(|r| r.config.lanes > 1 && r.config.target == Target::Ecp5 && r.icarus));
     // Icarus runs a subset that still has every optional stage and both interfaces.
     let ic: Vec<&GridRow> = rows.iter().filter(|r| r.icarus).collect();
     assert!(ic.len() >= 5);

@@ -1,8 +1,10 @@
 //! Issue 15 §1, lanes (`--lanes L`, src/stages/rmap_lanes): the lanes top's testbench passes
 //! exactly under Icarus and Verilator, with and without the handshake, and it CAN fail: each
 //! planted fault below (two lanes' outputs swapped in the packing, one lane's valid bit
-//! dropped, one lane's copy of the maps never written, one lane that does not swap) makes it
-//! fail with a line that names the lane. With one lane nothing changes: no rmap_lanes, the
+//! dropped, one lane's copy of the maps never written, one lane that does not swap, lane 1
+//! reading lane 0's address on the reciprocal ROM the two share) makes it fail with a line
+//! that names the lane. The shared ROM (every target but ice40) is checked on generic and
+//! ecp5 designs, the replicated one on an ice40 design. With one lane nothing changes: no rmap_lanes, the
 //! TOML as before. The grid rows `lanes2*` and `lanes4*` (tests/it/grid.rs) add lint,
 //! synthesis and a long stream in Verilator.
 //!
@@ -43,12 +45,21 @@ fn copy_dir(from: &Path, to: &Path) {
 
 /// `text` with `from` replaced by `to` inside lane `k`'s instance only (exactly once).
 fn in_lane(text: &str, k: u32, from: &str, to: &str) -> String {
+    in_instance(text, &format!("u_lane{k}"), from, to)
+}
+
+/// `text` with `from` replaced by `to` inside instance `inst` only (exactly once).
+fn in_instance(text: &str, inst_name: &str, from: &str, to: &str) -> String {
     let start = text
-        .find(&format!(" u_lane{k} ("))
-        .unwrap_or_else(|| panic!("no u_lane{k}"));
+        .find(&format!(" {inst_name} ("))
+        .unwrap_or_else(|| panic!("no {inst_name}"));
     let end = start + text[start..].find(");").expect("the instance ends");
     let inst = &text[start..end];
-    assert_eq!(inst.matches(from).count(), 1, "{from} in u_lane{k}: {inst}");
+    assert_eq!(
+        inst.matches(from).count(),
+        1,
+        "{from} in {inst_name}: {inst}"
+    );
     format!(
         "{}{}{}",
         &text[..start],
@@ -83,7 +94,13 @@ fn the_lanes_testbench_passes_in_both_simulators_and_catches_planted_faults() {
     }
     // Lane 1's own valid bit: its valid_i without the handshake, its side_i with it.
     let valid_pin = "(valid_i[1])";
-    for flags in [&["--lanes", "2"][..], &["--lanes", "2", "--handshake"][..]] {
+    for flags in [
+        &["--lanes", "2"][..],
+        &["--lanes", "2", "--handshake"][..],
+        &["--lanes", "2", "--target", "ecp5"][..],
+        &["--lanes", "2", "--handshake", "--target", "ice40"][..],
+    ] {
+        let shared = !flags.contains(&"ice40");
         let tmp = helpers::tempdir();
         let dir = tmp.path().join("d");
         hdl::generate(&dir, flags, VECTORS);
@@ -106,9 +123,18 @@ fn the_lanes_testbench_passes_in_both_simulators_and_catches_planted_faults() {
         );
 
         let top = std::fs::read_to_string(dir.join("rmap_lanes.v")).unwrap();
+        // Two lanes read one reciprocal ROM where the block RAM is true dual-port.
+        assert_eq!(top.contains(" u_recip_rom0 ("), shared, "{flags:?}");
+        assert_eq!(
+            std::fs::read_to_string(dir.join("normalise.v"))
+                .unwrap()
+                .contains(" u_recip_rom ("),
+            !shared,
+            "{flags:?}"
+        );
         let swapped = in_lane(&top, 0, "(i_o[7:0])", "(i_o[15:8])");
         let swapped = in_lane(&swapped, 1, "(i_o[15:8])", "(i_o[7:0])");
-        let faults = [
+        let mut faults = vec![
             ("lanes 0 and 1 swapped in i_o", swapped, "MISMATCH lane"),
             (
                 "lane 1's valid bit dropped",
@@ -126,6 +152,20 @@ fn the_lanes_testbench_passes_in_both_simulators_and_catches_planted_faults() {
                 "MISMATCH lane 1",
             ),
         ];
+        if shared {
+            // Port b of the shared ROM (lane 1's) reads lane 0's address: lane 1 gets lane 0's
+            // reciprocal.
+            faults.push((
+                "lane 1 reads lane 0's address on the shared reciprocal ROM",
+                in_instance(
+                    &top,
+                    "u_recip_rom0",
+                    "(recip_addr[13:7])",
+                    "(recip_addr[6:0])",
+                ),
+                "MISMATCH lane 1",
+            ));
+        }
         for (what, text, says) in faults {
             let bad = tmp.path().join("bad");
             let _ = std::fs::remove_dir_all(&bad);

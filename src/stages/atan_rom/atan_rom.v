@@ -28,6 +28,11 @@ module {= h.module =}{= h.params =} (
     $readmemh({= param =}, rom_v);
   end
 {%- else %}
+{%- if attrs %}
+  // ram_style (--target {= target =}): block RAM even where Yosys would build a small table
+  // from LUTs; u and v are its two read ports.
+  (* ram_style = "block" *)
+{%- endif %}
   reg [POS-1:0] rom [0:ENTRIES-1];
   initial begin
     $readmemh({= param =}, rom);

@@ -44,6 +44,9 @@ struct Verilog {
     out_reg: bool,
     param: String,
     ice40: bool,
+    /// Block-RAM attributes on the one array (true dual-port targets but generic).
+    attrs: bool,
+    target: &'static str,
     /// The arrays the u and v ports read: [`arrays`].
     rom_u: &'static str,
     rom_v: &'static str,
@@ -91,6 +94,8 @@ impl Unit for AtanRom {
             out_reg: out_reg(cfg),
             param: file_param(self.name()),
             ice40: cfg.target.ice40(),
+            attrs: cfg.target.block_attrs(),
+            target: cfg.target.name(),
             rom_u: arrays(cfg)[0],
             rom_v: arrays(cfg).last().expect("at least one array"),
             pos: cfg.pos_bits(),

@@ -13,8 +13,8 @@ module {= h.module =}{= h.params =} (
   localparam M       = {= m =};  // entry width
   localparam ENTRIES = {= entries =};  // 2^BA
 
-{%- if ice40 %}
-  // no_rw_check (--target ice40): a same-address read and write never happen (see above), so
+{%- if attrs %}
+  // no_rw_check (--target {= target =}): a same-address read and write never happen (see above), so
   // Yosys need not add logic to define their result. ram_style: block RAM at every size.
   (* no_rw_check, ram_style = "block" *)
 {%- endif %}

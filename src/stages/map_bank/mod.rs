@@ -21,7 +21,9 @@ pub const INIT_PARAM: &str = "INIT_FILE";
 struct Verilog {
     h: Head,
     param: &'static str,
-    ice40: bool,
+    /// Block-RAM attributes (every target but generic).
+    attrs: bool,
+    target: &'static str,
     m: u32,
     entries: u32,
 }
@@ -66,7 +68,8 @@ impl Unit for MapBank {
         Verilog {
             h,
             param: INIT_PARAM,
-            ice40: cfg.target.ice40(),
+            attrs: cfg.target.block_attrs(),
+            target: cfg.target.name(),
             m: cfg.map_bits,
             entries: cfg.bank_entries(),
         }

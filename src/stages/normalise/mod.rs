@@ -5,7 +5,7 @@
 pub mod model;
 mod plan;
 
-use super::recip_rom::RecipRom;
+use super::recip_rom::{self, RecipRom};
 use super::testbench::TbData;
 use super::unit::{param_overrides, Head, Memory, Unit, Vectors};
 use crate::config::Config;
@@ -30,6 +30,8 @@ struct Verilog {
     rom: String,
     /// Its init-file parameter, passed down to the ROM.
     rom_params: String,
+    /// The ROM is shared in rmap_lanes: read through the recip_* ports.
+    outside: bool,
     /// `mult = infer`: the comments describe plain products, not adder trees.
     infer: bool,
     depth: u32,
@@ -65,6 +67,7 @@ impl Unit for Normalise {
         v.push(o("valid_o", 1, ""));
         v.push(o("u_o", f, "a / m, all ones for a == m"));
         v.push(o("v_o", f, "b / m"));
+        v.extend(recip_rom::reader_ports(cfg));
         v
     }
 
@@ -72,11 +75,19 @@ impl Unit for Normalise {
         Some(Plan::new(cfg).latency)
     }
 
-    fn children(&self, _cfg: &Config) -> Vec<&'static dyn Unit> {
-        vec![&RecipRom]
+    /// The ROM, unless it is shared in rmap_lanes (then read through [`recip_rom::READER`]).
+    fn children(&self, cfg: &Config) -> Vec<&'static dyn Unit> {
+        if recip_rom::dual(cfg) {
+            vec![]
+        } else {
+            vec![&RecipRom]
+        }
     }
 
     fn memories(&self, cfg: &Config) -> Vec<Memory> {
+        if recip_rom::dual(cfg) {
+            return vec![];
+        }
         RecipRom
             .memories(cfg)
             .into_iter()
@@ -91,6 +102,7 @@ impl Unit for Normalise {
             h,
             rom: RecipRom.module(cfg),
             rom_params: param_overrides(cfg, &RecipRom),
+            outside: recip_rom::dual(cfg),
             infer: !cfg.mult.is_tree(),
             depth: cfg.pipeline_depth,
             latency: p.latency,

@@ -28,12 +28,20 @@ module {= h.module =}{= h.params =} (
 
   // ---------------------------------------------------------------- ROM read and compare
   wire [W-1:0] recip_q1;  // registered inside the ROM
+{%- if outside %}
+  // The ROM is shared with another lane in rmap_lanes: this lane reads one of its ports, on
+  // this stage's enable, and gets the data one clock later as from its own ROM.
+  assign recip_en_o   = en_i;
+  assign recip_addr_o = m_i[RA-1:0];
+  assign recip_q1     = recip_data_i;
+{%- else %}
   {= rom =}{= rom_params =} u_recip_rom (
     .clk_i  (clk_i),
     .en_i   (en_i),
     .addr_i (m_i[RA-1:0]),
     .data_o (recip_q1)
   );
+{%- endif %}
 
   reg [R-1:0] a_q1, b_q1;
   reg         a_max_q1, b_max_q1;

@@ -1,9 +1,21 @@
 //! The lanes top, rmap_lanes (`lanes` > 1): `lanes` copies of [`RmapTop`] side by side, so
-//! the design takes L samples and returns L results a clock, in order. Each lane is a whole
-//! rmap_top with its own ROMs and map banks (the first increment: nothing is shared yet); the
-//! host write port and `swap_i` reach every lane, so every copy of a map is loaded by the
-//! same writes and every lane swaps in the same clock, and the swap and write rules of a
-//! single rmap_top hold unchanged.
+//! the design takes L samples and returns L results a clock, in order. The host write port and
+//! `swap_i` reach every lane, so every copy of a map is loaded by the same writes and every
+//! lane swaps in the same clock, and the swap and write rules of a single rmap_top hold
+//! unchanged.
+//!
+//! Memories ([`recip_read`] decides, here only, which lane reads which port of which memory):
+//! - the reciprocal ROM (one read per lane per clock) is shared where the block RAM is true
+//!   dual-port (every target but `ice40`, [`shares_recip`]): ROM `u_recip_rom<j>` serves lane
+//!   2j on port a and lane 2j+1 on port b, each port on its lane's own enable; an odd last
+//!   lane has a ROM of its own (port b idle). On the iCE40 (SB_RAM40_4K: one read port) each
+//!   lane keeps its own, inside its rmap_top;
+//! - the compensation ROM is read twice per lane per clock (u and v): both ports of one array
+//!   on a dual-port target, so a second lane would need a third and fourth port: one per lane;
+//! - a map bank is read once per lane per clock and written by the host at any clock (into the
+//!   back buffer, which lives in the same array as the front one the lanes read): port a the
+//!   write, port b the lane's read, so a second lane's read would need a third port: one per
+//!   lane, every copy written by the same host writes.
 //!
 //! The per-lane ports ([`lane_ports`], defined here once) are `valid_i` / `valid_o` (one bit
 //! per lane) and every port a field of the top's vector file drives or is compared with,
@@ -21,6 +33,7 @@
 
 mod vectors;
 
+use super::recip_rom::{self, RecipRom};
 use super::rmap_top::{top_latency, RmapTop};
 use super::unit::{param_overrides, Head, Memory, Unit, Vectors};
 use super::TOP;
@@ -30,6 +43,37 @@ use askama::Template;
 use serde::Serialize;
 
 pub struct RmapLanes;
+
+/// Whether two lanes share a reciprocal ROM: with lanes, on a target whose block RAM is true
+/// dual-port (every target but `ice40`).
+pub fn shares_recip(cfg: &Config) -> bool {
+    cfg.lanes > 1 && !cfg.target.ice40()
+}
+
+/// Which shared reciprocal ROM (`u_recip_rom<rom>`) lane `k` reads, and through which of its
+/// [`recip_rom::PORTS`] (0: a, 1: b): the pairing, defined once.
+pub fn recip_read(k: u32) -> (u32, usize) {
+    (k / 2, (k % 2) as usize)
+}
+
+/// The shared reciprocal ROMs: one per pair of lanes, one more for an odd last lane.
+pub fn recip_roms(cfg: &Config) -> u32 {
+    if shares_recip(cfg) {
+        cfg.lanes.div_ceil(2)
+    } else {
+        0
+    }
+}
+
+/// The instance name of shared reciprocal ROM `j`, `u_recip_rom<j>`.
+pub fn recip_instance(j: u32) -> String {
+    format!("u_recip_rom{j}")
+}
+
+/// The lane that reads port `port` of shared ROM `rom`, if any ([`recip_read`] inverted).
+fn recip_reader(cfg: &Config, rom: u32, port: usize) -> Option<u32> {
+    (0..cfg.lanes).find(|&k| recip_read(k) == (rom, port))
+}
 
 /// One per-lane port of rmap_lanes: rmap_top's port of the same name, `bits` wide, `lanes`
 /// times, lane k in bits `[k*bits +: bits]`.
@@ -91,8 +135,23 @@ pub struct LanesInfo {
     /// The module every lane is an instance of, and the instances (`u_lane<k>`).
     pub lane_module: String,
     pub instances: Vec<String>,
-    /// Memory bits of one lane (every lane has its own copy of every memory).
+    /// Memory bits per lane, a memory shared by two lanes counted once per pair (half to
+    /// each lane): [`LanesInfo::own_memory_bits_per_lane`] plus half of each shared ROM.
     pub memory_bits_per_lane: u64,
+    /// Memory bits every lane has to itself (its rmap_top's memories).
+    pub own_memory_bits_per_lane: u64,
+    /// The memories two lanes share, and who reads which port.
+    pub shared: Vec<SharedMemory>,
+}
+
+/// A memory of rmap_lanes read by two lanes through its two ports.
+#[derive(Clone, Debug, Serialize)]
+pub struct SharedMemory {
+    /// Its array below rmap_lanes.
+    pub instance: String,
+    pub bits: u64,
+    /// `u_lane0 port a, u_lane1 port b`.
+    pub readers: String,
 }
 
 /// How a per-lane port is packed, in words (the manifest, the README and the template say it).
@@ -106,9 +165,51 @@ impl LanesInfo {
             ports: lane_ports(cfg),
             lane_module: RmapTop.module(cfg),
             instances: (0..cfg.lanes).map(instance).collect(),
-            memory_bits_per_lane: RmapTop.memories(cfg).iter().map(|m| m.bits).sum(),
+            memory_bits_per_lane: own(cfg) + shared_bits(cfg) / 2,
+            own_memory_bits_per_lane: own(cfg),
+            shared: shared_roms(cfg)
+                .into_iter()
+                .enumerate()
+                .map(|(j, m)| SharedMemory {
+                    instance: m.instance,
+                    bits: m.bits,
+                    readers: (0..2)
+                        .filter_map(|p| {
+                            recip_reader(cfg, j as u32, p)
+                                .map(|k| format!("{} port {}", instance(k), ["a", "b"][p]))
+                        })
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                })
+                .collect(),
         })
     }
+}
+
+/// Memory bits of one lane's own memories.
+fn own(cfg: &Config) -> u64 {
+    RmapTop.memories(cfg).iter().map(|m| m.bits).sum()
+}
+
+/// Bits of one shared reciprocal ROM (0 when nothing is shared).
+fn shared_bits(cfg: &Config) -> u64 {
+    if shares_recip(cfg) {
+        RecipRom.memories(cfg).iter().map(|m| m.bits).sum()
+    } else {
+        0
+    }
+}
+
+/// The shared reciprocal ROMs' arrays, `u_recip_rom<j>.rom`.
+fn shared_roms(cfg: &Config) -> Vec<Memory> {
+    (0..recip_roms(cfg))
+        .flat_map(|j| {
+            RecipRom
+                .memories(cfg)
+                .into_iter()
+                .map(move |m| m.under(&recip_instance(j)))
+        })
+        .collect()
 }
 
 /// Lane `k`'s instance name, `u_lane<k>`.
@@ -119,9 +220,11 @@ pub fn instance(k: u32) -> String {
 /// rmap_top's ports as rmap_lanes has them: the per-lane ones L times as wide, `side_i` and
 /// `side_o` (internal with the handshake) left out, the rest shared.
 fn ports(cfg: &Config) -> Vec<Port> {
+    let (en, addr, data) = recip_rom::READER;
     TOP.ports(cfg)
         .into_iter()
         .filter(|p| p.name != "side_i" && p.name != "side_o")
+        .filter(|p| ![en, addr, data].contains(&p.name))
         .map(|mut p| {
             if per_lane(cfg, p.name) {
                 let Width::Bits(b) = p.width else {
@@ -158,9 +261,13 @@ fn pins(cfg: &Config, k: u32) -> Vec<String> {
     let lanes = lane_ports(cfg);
     let top = TOP.ports(cfg);
     let w = top.iter().map(|p| p.name.len()).max().unwrap_or(0);
+    let (en, addr, data) = recip_rom::READER;
     top.iter()
         .map(|p| {
             let e = match (p.name, cfg.handshake) {
+                (n, _) if n == en => format!("recip_en[{k}]"),
+                (n, _) if n == addr => format!("recip_addr{}", recip_bus(cfg, n).range(k)),
+                (n, _) if n == data => format!("recip_data{}", recip_bus(cfg, n).range(k)),
                 ("valid_i", true) => "beat_valid".to_string(),
                 ("valid_o", true) => format!("lane_valid[{k}]"),
                 ("ready_o", _) => format!("lane_ready[{k}]"),
@@ -174,6 +281,58 @@ fn pins(cfg: &Config, k: u32) -> Vec<String> {
             format!(".{:w$} ({e})", p.name)
         })
         .collect()
+}
+
+/// The lanes' reader port `name` ([`recip_rom::READER`]) of rmap_top, packed like a per-lane
+/// port into the internal bus `recip_<...>`.
+fn recip_bus(cfg: &Config, name: &'static str) -> LanePort {
+    let p = TOP
+        .ports(cfg)
+        .into_iter()
+        .find(|p| p.name == name)
+        .expect("rmap_top reads a shared ROM");
+    let Width::Bits(bits) = p.width else {
+        unreachable!("the top's ports have fixed widths")
+    };
+    LanePort {
+        port: p.name,
+        dir: p.dir,
+        bits,
+    }
+}
+
+/// `.port (expr)` of every port of shared reciprocal ROM `j`: port a to lane 2j, port b to
+/// lane 2j+1 ([`recip_read`]), or idle (enable low, data unused) when there is no such lane.
+fn rom_pins(cfg: &Config, j: u32) -> Vec<String> {
+    let (ra, rw) = (
+        recip_bus(cfg, recip_rom::READER.1),
+        recip_bus(cfg, recip_rom::READER.2),
+    );
+    let w = RecipRom
+        .ports(cfg)
+        .iter()
+        .map(|p| p.name.len())
+        .max()
+        .unwrap_or(0);
+    let mut v = vec![format!(".{:w$} (clk_i)", "clk_i")];
+    for (p, (en, addr, data)) in recip_rom::PORTS.into_iter().enumerate() {
+        let (e, a, d) = match recip_reader(cfg, j, p) {
+            Some(k) => (
+                format!("recip_en[{k}]"),
+                format!("recip_addr{}", ra.range(k)),
+                format!("recip_data{}", rw.range(k)),
+            ),
+            None => (
+                "1'b0".to_string(),
+                format!("{{{}{{1'b0}}}}", ra.bits),
+                "unused_recip_data".to_string(),
+            ),
+        };
+        v.push(format!(".{en:w$} ({e})"));
+        v.push(format!(".{addr:w$} ({a})"));
+        v.push(format!(".{data:w$} ({d})"));
+    }
+    v
 }
 
 struct Lane {
@@ -193,6 +352,15 @@ struct Verilog {
     /// `valid_i [1:0], gx_i [11:0], ...`: the per-lane ports and one lane's range.
     packing: String,
     lanes: Vec<Lane>,
+    /// The shared reciprocal ROMs (empty: each lane has its own).
+    roms: Vec<Lane>,
+    rom: String,
+    rom_params: String,
+    /// Address and data widths of the ROM's ports.
+    ra: u32,
+    rw: u32,
+    /// The last ROM has an idle port b (an odd lane count).
+    odd: bool,
 }
 
 impl Unit for RmapLanes {
@@ -208,20 +376,26 @@ impl Unit for RmapLanes {
         Some(top_latency(cfg))
     }
 
-    fn children(&self, _cfg: &Config) -> Vec<&'static dyn Unit> {
-        vec![&RmapTop]
+    fn children(&self, cfg: &Config) -> Vec<&'static dyn Unit> {
+        if shares_recip(cfg) {
+            vec![&RmapTop, &RecipRom]
+        } else {
+            vec![&RmapTop]
+        }
     }
 
-    /// Every lane's memories, under `u_lane<k>`: one copy per lane.
+    /// Every lane's own memories, under `u_lane<k>`, then the shared reciprocal ROMs.
     fn memories(&self, cfg: &Config) -> Vec<Memory> {
-        (0..cfg.lanes)
+        let mut v: Vec<Memory> = (0..cfg.lanes)
             .flat_map(|k| {
                 RmapTop
                     .memories(cfg)
                     .into_iter()
                     .map(move |m| m.under(&instance(k)))
             })
-            .collect()
+            .collect();
+        v.extend(shared_roms(cfg));
+        v
     }
 
     fn render(&self, cfg: &Config, h: Head) -> askama::Result<String> {
@@ -244,6 +418,17 @@ impl Unit for RmapLanes {
                     pins: pins(cfg, k),
                 })
                 .collect(),
+            roms: (0..recip_roms(cfg))
+                .map(|j| Lane {
+                    inst: recip_instance(j),
+                    pins: rom_pins(cfg, j),
+                })
+                .collect(),
+            rom: RecipRom.module(cfg),
+            rom_params: param_overrides(cfg, &RecipRom),
+            ra: cfg.recip_addr_bits(),
+            rw: cfg.recip_bits,
+            odd: shares_recip(cfg) && cfg.lanes % 2 == 1,
         }
         .render()
     }
@@ -319,25 +504,79 @@ mod tests {
     }
 
     #[test]
+    fn two_lanes_share_a_reciprocal_rom_where_the_block_ram_is_dual_port() {
+        use crate::config::Target;
+        // Lane 2j on port a, lane 2j+1 on port b of ROM j.
+        assert_eq!(
+            (0..5).map(recip_read).collect::<Vec<_>>(),
+            [(0, 0), (0, 1), (1, 0), (1, 1), (2, 0)]
+        );
+        for (l, roms) in [(2, 1), (3, 2), (8, 4)] {
+            for t in [Target::Generic, Target::Ecp5] {
+                let cfg = lanes(l, false, false).for_target(t);
+                assert!(shares_recip(&cfg));
+                assert_eq!(recip_roms(&cfg), roms);
+                let m = RmapLanes.memories(&cfg);
+                let recip: Vec<&str> = m
+                    .iter()
+                    .filter(|m| m.module == RecipRom.module(&cfg))
+                    .map(|m| m.instance.as_str())
+                    .collect();
+                let want: Vec<String> = (0..roms).map(|j| format!("u_recip_rom{j}.rom")).collect();
+                assert_eq!(recip, want, "{l} lanes, {t:?}");
+                // The last ROM of an odd count has port b idle.
+                let last = rom_pins(&cfg, roms - 1);
+                assert_eq!(
+                    last.iter().any(|p| p.contains("unused_recip_data")),
+                    l % 2 == 1,
+                    "{last:?}"
+                );
+            }
+            // The iCE40's SB_RAM40_4K has one read port: each lane keeps its own ROM.
+            let cfg = lanes(l, false, false).for_target(Target::Ice40);
+            assert!(!shares_recip(&cfg));
+            assert_eq!(recip_roms(&cfg), 0);
+            assert!(RmapTop
+                .memories(&cfg)
+                .iter()
+                .any(|m| m.instance == "u_normalise.u_recip_rom.rom"));
+            assert!(LanesInfo::new(&cfg).unwrap().shared.is_empty());
+        }
+        let info = LanesInfo::new(&lanes(4, false, false)).unwrap();
+        assert_eq!(info.shared.len(), 2);
+        assert_eq!(info.shared[1].readers, "u_lane2 port a, u_lane3 port b");
+        // One lane, nothing to share.
+        assert!(!shares_recip(&Config::default()));
+    }
+
+    #[test]
     fn every_lane_has_its_own_memories_loaded_from_the_same_files() {
         let cfg = lanes(2, false, false);
         let one = RmapTop.memories(&cfg);
         let m = RmapLanes.memories(&cfg);
-        assert_eq!(m.len(), 2 * one.len());
+        // Each lane's own, and the reciprocal ROM the two share.
+        assert_eq!(m.len(), 2 * one.len() + 1);
         assert!(m[..one.len()]
             .iter()
             .all(|m| m.instance.starts_with("u_lane0.")));
-        assert!(m[one.len()..]
+        assert!(m[one.len()..2 * one.len()]
             .iter()
             .all(|m| m.instance.starts_with("u_lane1.")));
+        assert!(m[2 * one.len()..]
+            .iter()
+            .all(|m| m.instance.starts_with("u_recip_rom0.")));
         assert_eq!(
             crate::stages::unit::file_params(&m).len(),
-            crate::stages::unit::file_params(&one).len()
+            crate::stages::unit::file_params(&one).len() + 1
         );
         let info = LanesInfo::new(&cfg).unwrap();
         assert_eq!(
             info.memory_bits_per_lane * 2,
             m.iter().map(|m| m.bits).sum::<u64>()
+        );
+        assert_eq!(
+            info.memory_bits_per_lane,
+            info.own_memory_bits_per_lane + cfg.recip_entries() as u64 * cfg.recip_bits as u64 / 2
         );
         assert!(LanesInfo::new(&Config::default()).is_none());
     }

@@ -11,6 +11,7 @@ use super::interpolate::Interpolate;
 use super::map_lookup::MapLookup;
 use super::normalise::Normalise;
 use super::pipe_delay::PipeDelay;
+use super::recip_rom;
 use super::sort_shift::SortShift;
 use super::unit::{param_overrides, Head, Memory, Unit, Vectors};
 use super::zero_detect::ZeroDetect;
@@ -99,6 +100,8 @@ struct Verilog {
     /// What side_i carries: {tuser, tlast} with `axis`, else a lane's valid bit.
     axis: bool,
     side_delay: u32,
+    /// normalise reads a reciprocal ROM shared in rmap_lanes through the recip_* ports.
+    recip_out: bool,
 }
 
 /// `sort_shift 4, normalise 6, ...`: each stage of [`pipeline`] with its latency.
@@ -195,6 +198,7 @@ impl Unit for RmapTop {
         if cfg.side_bits() > 0 {
             v.push(o("side_o", cfg.side_bits(), "side_i of the sample"));
         }
+        v.extend(recip_rom::reader_ports(cfg));
         v
     }
 
@@ -259,6 +263,7 @@ impl Unit for RmapTop {
             sd: cfg.side_bits(),
             axis: cfg.axis,
             side_delay: d.side.unwrap_or(0),
+            recip_out: recip_rom::dual(cfg),
         }
         .render()
     }

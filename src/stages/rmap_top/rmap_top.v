@@ -124,7 +124,11 @@ module {= h.module =}{= h.params =} (
     .b_i     (ss_b),
     .valid_o (nm_valid),
     .u_o     (nm_u),
-    .v_o     (nm_v)
+    .v_o     (nm_v){% if recip_out %},
+    // The reciprocal ROM is shared with another lane, in rmap_lanes.
+    .recip_en_o   (recip_en_o),
+    .recip_addr_o (recip_addr_o),
+    .recip_data_i (recip_data_i){% endif %}
   );
 
   // ---------------------------------------------------------------- {= position =}
