@@ -163,6 +163,8 @@ fn place(aig: Aig, cfg: &Config) -> Result<GateFront> {
             .any(|u| *name == format!("{}_valid_o", u.name()))
         {
             places.push(None);
+        } else if name.is_empty() {
+            bail!("the front's graph has an output its map does not name (Yosys leaves out a constant output, so the front cannot be placed)");
         } else {
             bail!("the front's graph has the output {name}[{bit}]");
         }

@@ -197,7 +197,7 @@ fn grid_covers_every_range_end_and_switch() {
             assert!(
                 rows.iter().any(|r| r.config.lanes == l
                     && r.config.handshake == hs
-                    && rmapgen::stages::rmap_lanes::shares_recip(&r.config)),
+                    && rmapgen::stages::recip_rom::dual(&r.config)),
                 "no row with {l} lanes sharing a ROM and handshake {hs}"
             );
         }

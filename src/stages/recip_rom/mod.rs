@@ -1,6 +1,6 @@
 //! The reciprocal ROM that normalise reads: 1/m for every reduced max m, initialised from
 //! [`init_file`]. One synchronous read port inside normalise; where rmap_lanes shares it
-//! ([`crate::stages::rmap_lanes::shares_recip`]) two, each with its own enable ([`PORTS`]), so
+//! ([`dual`]) two, each with its own enable ([`PORTS`]), so
 //! a true dual-port block RAM serves two lanes.
 
 pub mod model;
@@ -44,9 +44,11 @@ pub fn reader_ports(cfg: &Config) -> Vec<Port> {
 }
 
 /// Whether this configuration's ROM has the two read ports of [`PORTS`] (it lives in
-/// rmap_lanes, shared by two lanes) rather than one inside normalise.
+/// rmap_lanes, shared by two lanes) rather than one inside normalise: with lanes, on a target
+/// whose block RAM is true dual-port (every target but `ice40`). Defined here, below
+/// normalise, rmap_top and rmap_lanes, which all ask it.
 pub fn dual(cfg: &Config) -> bool {
-    crate::stages::rmap_lanes::shares_recip(cfg)
+    cfg.lanes > 1 && !cfg.target.ice40()
 }
 
 /// Its `$readmemh` file, `<module>.hex`.

@@ -6,7 +6,7 @@
 //!
 //! Memories ([`recip_read`] decides, here only, which lane reads which port of which memory):
 //! - the reciprocal ROM (one read per lane per clock) is shared where the block RAM is true
-//!   dual-port (every target but `ice40`, [`shares_recip`]): ROM `u_recip_rom<j>` serves lane
+//!   dual-port (every target but `ice40`, [`recip_rom::dual`]): ROM `u_recip_rom<j>` serves lane
 //!   2j on port a and lane 2j+1 on port b, each port on its lane's own enable; an odd last
 //!   lane has a ROM of its own (port b idle). On the iCE40 (SB_RAM40_4K: one read port) each
 //!   lane keeps its own, inside its rmap_top;
@@ -44,12 +44,6 @@ use serde::Serialize;
 
 pub struct RmapLanes;
 
-/// Whether two lanes share a reciprocal ROM: with lanes, on a target whose block RAM is true
-/// dual-port (every target but `ice40`).
-pub fn shares_recip(cfg: &Config) -> bool {
-    cfg.lanes > 1 && !cfg.target.ice40()
-}
-
 /// Which shared reciprocal ROM (`u_recip_rom<rom>`) lane `k` reads, and through which of its
 /// [`recip_rom::PORTS`] (0: a, 1: b): the pairing, defined once.
 pub fn recip_read(k: u32) -> (u32, usize) {
@@ -58,7 +52,7 @@ pub fn recip_read(k: u32) -> (u32, usize) {
 
 /// The shared reciprocal ROMs: one per pair of lanes, one more for an odd last lane.
 pub fn recip_roms(cfg: &Config) -> u32 {
-    if shares_recip(cfg) {
+    if recip_rom::dual(cfg) {
         cfg.lanes.div_ceil(2)
     } else {
         0
@@ -193,7 +187,7 @@ fn own(cfg: &Config) -> u64 {
 
 /// Bits of one shared reciprocal ROM (0 when nothing is shared).
 fn shared_bits(cfg: &Config) -> u64 {
-    if shares_recip(cfg) {
+    if recip_rom::dual(cfg) {
         RecipRom.memories(cfg).iter().map(|m| m.bits).sum()
     } else {
         0
@@ -377,7 +371,7 @@ impl Unit for RmapLanes {
     }
 
     fn children(&self, cfg: &Config) -> Vec<&'static dyn Unit> {
-        if shares_recip(cfg) {
+        if recip_rom::dual(cfg) {
             vec![&RmapTop, &RecipRom]
         } else {
             vec![&RmapTop]
@@ -428,7 +422,7 @@ impl Unit for RmapLanes {
             rom_params: param_overrides(cfg, &RecipRom),
             ra: cfg.recip_addr_bits(),
             rw: cfg.recip_bits,
-            odd: shares_recip(cfg) && cfg.lanes % 2 == 1,
+            odd: recip_rom::dual(cfg) && cfg.lanes % 2 == 1,
         }
         .render()
     }
@@ -514,7 +508,7 @@ mod tests {
         for (l, roms) in [(2, 1), (3, 2), (8, 4)] {
             for t in [Target::Generic, Target::Ecp5] {
                 let cfg = lanes(l, false, false).for_target(t);
-                assert!(shares_recip(&cfg));
+                assert!(recip_rom::dual(&cfg));
                 assert_eq!(recip_roms(&cfg), roms);
                 let m = RmapLanes.memories(&cfg);
                 let recip: Vec<&str> = m
@@ -534,7 +528,7 @@ mod tests {
             }
             // The iCE40's SB_RAM40_4K has one read port: each lane keeps its own ROM.
             let cfg = lanes(l, false, false).for_target(Target::Ice40);
-            assert!(!shares_recip(&cfg));
+            assert!(!recip_rom::dual(&cfg));
             assert_eq!(recip_roms(&cfg), 0);
             assert!(RmapTop
                 .memories(&cfg)
@@ -546,7 +540,7 @@ mod tests {
         assert_eq!(info.shared.len(), 2);
         assert_eq!(info.shared[1].readers, "u_lane2 port a, u_lane3 port b");
         // One lane, nothing to share.
-        assert!(!shares_recip(&Config::default()));
+        assert!(!recip_rom::dual(&Config::default()));
     }
 
     #[test]
