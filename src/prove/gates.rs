@@ -204,22 +204,7 @@ fn transpose64(a: &mut [u64; 64]) {
 /// The words of gx bit `b` for evaluation `pass` of a row: gradient `pass * 512 + w * 64 +
 /// lane` of the row has gx equal to its number.
 fn gx_pattern(b: u32, pass: u64) -> [u64; WORDS] {
-    const LANE: [u64; 6] = [
-        0xAAAA_AAAA_AAAA_AAAA,
-        0xCCCC_CCCC_CCCC_CCCC,
-        0xF0F0_F0F0_F0F0_F0F0,
-        0xFF00_FF00_FF00_FF00,
-        0xFFFF_0000_FFFF_0000,
-        0xFFFF_FFFF_0000_0000,
-    ];
-    std::array::from_fn(|w| {
-        let n = pass * LANES + 64 * w as u64;
-        if b < 6 {
-            LANE[b as usize]
-        } else {
-            0u64.wrapping_sub((n >> b) & 1)
-        }
-    })
+    aig::number_bit(b, pass * LANES)
 }
 
 /// Checks the gradients `range` of one row (`row` = the gradient index >> G: gy and gz
@@ -389,9 +374,8 @@ mod tests {
 
     #[test]
     fn undefined_literals_are_refused_outside_comments() {
-        let dir = std::env::temp_dir().join(format!("rmapgen-undef-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let f = dir.join("m.v");
+        let dir = tempfile::tempdir().unwrap();
+        let f = dir.path().join("m.v");
         std::fs::write(
             &f,
             "assign a = 4'hF; // 4'bx in a comment\nassign b = 8'd3;\n",
@@ -403,6 +387,5 @@ mod tests {
         assert!(e.contains("m.v:2") && e.contains("'b1x"), "{e}");
         std::fs::write(&f, "assign b = 1'bz;\n").unwrap();
         assert!(no_undefined_literal(&f).is_err());
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

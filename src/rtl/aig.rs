@@ -261,9 +261,9 @@ fn word<const W: usize>(vals: &[[u64; W]], l: Lit) -> [u64; W] {
     std::array::from_fn(|k| v[k] ^ m)
 }
 
-/// The word pattern of free input `j` in word `w` of block `block`: inputs are numbered
-/// block * 512 + w * 64 + lane, and free input j is bit j of that number.
-fn pattern(j: usize, w: usize, block: u64) -> u64 {
+/// The words of bit `b` of the input number, for the `W * 64` inputs numbered `first + w * 64
+/// + lane` (word w, bit lane): laying consecutive input numbers out one per bit.
+pub fn number_bit<const W: usize>(b: u32, first: u64) -> [u64; W] {
     const LANE: [u64; 6] = [
         0xAAAA_AAAA_AAAA_AAAA,
         0xCCCC_CCCC_CCCC_CCCC,
@@ -272,14 +272,14 @@ fn pattern(j: usize, w: usize, block: u64) -> u64 {
         0xFFFF_0000_FFFF_0000,
         0xFFFF_FFFF_0000_0000,
     ];
-    let bit = if j < 6 {
-        return LANE[j];
-    } else if j < BLOCK_BITS as usize {
-        (w >> (j - 6)) & 1
-    } else {
-        ((block >> (j - BLOCK_BITS as usize)) & 1) as usize
-    };
-    0u64.wrapping_sub(bit as u64)
+    debug_assert_eq!(first % 64, 0, "inputs start at a word");
+    std::array::from_fn(|w| {
+        if b < 6 {
+            LANE[b as usize]
+        } else {
+            0u64.wrapping_sub(((first + 64 * w as u64) >> b) & 1)
+        }
+    })
 }
 
 /// Runs `p` on every value of its free inputs; the first input number (block * 512 + lane)
@@ -305,7 +305,7 @@ fn sweep(p: &Program, free: usize) -> Option<u64> {
     for block in 0..blocks {
         p.eval(
             &mut vals,
-            |j| std::array::from_fn(|w| pattern(j, w, block)),
+            |j| number_bit(j as u32, block << BLOCK_BITS),
             &mut out,
         );
         let out = out[0];
