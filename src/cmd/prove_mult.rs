@@ -43,8 +43,9 @@ pub struct ProveMultArgs {
     #[arg(long, value_name = "N", requires = "matrix", value_parser = parse::whole::<usize>(1, 64))]
     pub jobs: Option<usize>,
     /// How each tree is proved: sat (Yosys sat -prove, one run per value of the split
-    /// factor), exhaustive (the cut miter evaluated on every input), or auto (exhaustive up to
-    /// 2^34 inputs, else sat).
+    /// factor), exhaustive (the cut miter evaluated on every input), algebra (the sum and the
+    /// specification shown equal as polynomials), or auto (exhaustive up to 2^34 inputs, else
+    /// algebra).
     #[arg(long, value_enum, default_value = "auto")]
     pub engine: EngineChoice,
     /// Only these trees, by stage and tree name (normalise.pa; repeat the flag or separate
@@ -167,6 +168,7 @@ fn prove(
     let staged = StagedDir::new(logs, policy)?;
     let dir = absolute(staged.path());
     staged.write_text(mult_proof::TRANSPARENT_FILE, mult_proof::TRANSPARENT)?;
+    staged.write_text(mult_proof::RIPPLE_FILE, mult_proof::RIPPLE_LCU)?;
     let mut wrappers = Vec::new();
     for j in &jobs {
         let f = format!("{}.v", j.wrapper_name());
@@ -215,6 +217,14 @@ fn prove(
                         format!("{}: {}", j.name(), shown_logs.join(&aag).display())
                     })?;
                 p.inputs += j.exhaustive_inputs();
+            }
+            if engines[i] == Engine::Algebra {
+                let f = j.json_file();
+                let path = shown_logs.join(&f);
+                let json = std::fs::read_to_string(&path)
+                    .with_context(|| format!("cannot read {}", path.display()))?;
+                results[i] = mult_proof::algebraic(j, &json)
+                    .with_context(|| format!("{}: {}", j.name(), path.display()))?;
             }
         }
     }
@@ -342,6 +352,12 @@ fn report(jobs: &[Job], results: &[mult_proof::TreeResult], p: &mut Proof) {
                 Engine::Exhaustive => {
                     format!("every input: {}", mult_proof::count(j.exhaustive_inputs()))
                 }
+                Engine::Algebra => format!(
+                    "as polynomials: {} case{}, at most {} terms",
+                    r.cases,
+                    if r.cases == 1 { "" } else { "s" },
+                    r.peak_terms
+                ),
             };
             p.stdout += &format!("prove-mult: {} = {}: proved ({how})\n", r.name, r.title);
         } else if let Some(case) = &r.failed {
@@ -355,6 +371,11 @@ fn report(jobs: &[Job], results: &[mult_proof::TreeResult], p: &mut Proof) {
                 } else {
                     format!(" at {case}")
                 }
+            );
+        } else if let Some(why) = &r.undecided {
+            p.stderr += &format!(
+                "prove-mult: {} = {}: not proved by the algebraic engine: {why}\n",
+                r.name, r.title
             );
         } else {
             p.stderr += &format!(

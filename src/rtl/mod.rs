@@ -5,10 +5,12 @@
 
 pub mod adder_tree;
 pub mod aig;
+pub mod algebra;
 pub mod fpga;
 pub mod infer;
 pub mod manifest;
 pub mod mult_proof;
+pub mod netlist;
 pub mod package;
 pub mod ports;
 pub mod tb;

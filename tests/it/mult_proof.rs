@@ -85,9 +85,13 @@ fn every_tree_is_proved_and_every_planted_fault_is_caught() {
     let tmp = tempdir();
     let good = tmp.path().join("good");
     generate(&good, FLAGS, 0);
-    // Both engines on the same design and the same faults: each must prove the design and
-    // catch every fault on its own.
-    for (engine, how) in [("sat", "SAT case"), ("exhaustive", "every input: ")] {
+    // The three engines on the same design and the same faults: each must prove the design
+    // and catch every fault on its own.
+    for (engine, how) in [
+        ("sat", "SAT case"),
+        ("exhaustive", "every input: "),
+        ("algebra", "as polynomials: "),
+    ] {
         proves_and_catches(tmp.path(), &good, engine, how);
     }
 }
@@ -144,8 +148,11 @@ fn proves_and_catches(tmp: &Path, good: &Path, engine: &str, how: &str) {
     }
 }
 
-/// `--matrix` generates grid rows and proves each (here the narrowest row, 5 trees, ~5 s);
-/// an unknown row is bad input (one line, exit 2) before anything is generated.
+/// `--matrix` generates grid rows and proves each (here the narrowest row, 5 trees, ~5 s,
+/// and lanes4, whose tree inputs at pipeline depth 0 are other names of a stage input port
+/// (`recip_q1` of `recip_data_i`) and of a mux's output (`ux_d`): the cut must reach every
+/// reader of the net); an unknown row is bad input (one line, exit 2) before anything is
+/// generated.
 #[test]
 fn the_matrix_proves_the_rows_named_and_refuses_an_unknown_row() {
     if !require("yosys") {
@@ -155,7 +162,14 @@ fn the_matrix_proves_the_rows_named_and_refuses_an_unknown_row() {
     let out = rmapgen()
         .arg("prove-mult")
         .arg(tmp.path().join("designs"))
-        .args(["--matrix", "--row", "narrowest", "--jobs", "1", "--logs"])
+        .args([
+            "--matrix",
+            "--row",
+            "narrowest,lanes4",
+            "--jobs",
+            "1",
+            "--logs",
+        ])
         .arg(tmp.path().join("logs"))
         .output()
         .expect("rmapgen runs");
@@ -167,7 +181,9 @@ fn the_matrix_proves_the_rows_named_and_refuses_an_unknown_row() {
     );
     assert!(text.contains("==== narrowest: "), "{text}");
     assert!(text.contains("all 5 trees proved"), "{text}");
-    assert!(text.contains("every row proved (1 row,"), "{text}");
+    assert!(text.contains("==== lanes4: "), "{text}");
+    assert!(text.contains("all 4 trees proved"), "{text}");
+    assert!(text.contains("every row proved (2 rows,"), "{text}");
     assert!(tmp.path().join("logs/narrowest/yosys.log").is_file());
 
     let bad = tmp.path().join("bad");
