@@ -33,9 +33,11 @@ pub const MAX_SLICE_SAMPLES: u32 = 8;
 /// Which renderer makes the image.
 ///
 /// The default is the ray caster, by measurement (docs/PERFORMANCE.md): shear-warp is
-/// several times faster, but its images are not as good (one sample per slice, bilinear in
-/// the slice, a warp; on the MRI head its model image is 30 dB PSNR from the ray caster's
-/// float image, with the slice pattern visible), so it is the fast preview.
+/// 20-60x faster, but its images are not as good (one sample per slice, one intermediate
+/// pixel per voxel, a warp: on the MRI head its model image is 29.0 dB PSNR from a fine ray
+/// float image, the ray caster's 40.5 dB), so it is the fast preview. Sampled finely enough
+/// to match (`slice_samples` 4, `supersample` 3: 41.3 dB) it does 36x the work and costs
+/// about as much as the ray caster.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum CasterKind {

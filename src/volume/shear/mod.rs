@@ -15,6 +15,19 @@
 //! Consecutive samples of a ray are one slice apart: the transfer function is corrected for
 //! that length (in smallest spacings), which depends on the view.
 //!
+//! **Finer sampling** (options, both 1 by default; docs/PERFORMANCE.md measures them):
+//! - `slice_samples` n: n samples per slice spacing, at c = m / n; a sample between slices k
+//!   and k + 1 is the linear interpolation along c of the two slices' bilinear value and
+//!   gradient at the same sheared position (trilinear, rounded once), and the runs are those
+//!   of the slabs between slices (cells of 8 voxels). The transfer function is corrected
+//!   for the shorter step. This removes the slice pattern on oblique surfaces.
+//! - `supersample` r: r intermediate pixels per voxel along a and b, the r samples of a cell
+//!   at fractions (u + e) / r of it (e the shift's fraction in intermediate pixels), and the
+//!   warp reads the finer image: the image's detail below a voxel (pixels are 0.46 voxels on
+//!   the MRI head at 256²) is then resampled from closer rays.
+//!
+//! The work grows as n r²; matching the ray caster's image takes about n = 4, r = 3.
+//!
 //! **Compositing.** Front to back, slice by slice, per intermediate pixel exactly as the ray
 //! caster per ray ([`crate::volume::cast`]): weight (1 - A) a, termination at `ert`, where A
 //! becomes 1 and later weights are exactly 0.

@@ -9,6 +9,8 @@
 //! rounded gradient is no longer than the longest of the four plus [`GRAD_MARGIN`]. A cell on
 //! which [`Tf::transparent_on`] holds for that range and magnitude holds no visible sample;
 //! a run is a maximal stretch of cells along a scanline that are not transparent.
+//! Samples between slices k and k + 1 interpolate the 8 voxels of a slab cell; their runs
+//! ([`Spans`] with depth 2, built on first use) take the range and gradient over all 8.
 //!
 //! With the runs, each axis keeps the volume's voxels (value and quantised gradient) in its
 //! slice order ([`Runs::voxels`]): a run's samples then read memory in sequence, as
