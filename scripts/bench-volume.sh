@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # make bench-volume: renders VolPack's example MRI head (Debian libvolpack1-dev, 128x128x84)
-# with rmapgen (both casters, shear-warp and ray; model shading, skipping on, --model-only,
-# RAYON_NUM_THREADS = 1 and 2) and
+# with rmapgen (both casters, shear-warp and ray, and shear-warp sampled finely enough to
+# match the ray caster's image, --slice-samples 4 --supersample 3, "shear-4x3"; model
+# shading, skipping on, --model-only, RAYON_NUM_THREADS = 1 and 2) and
 # with VolPack's classified shear-warp renderer (bench/volume/volpack_bench.c, single
 # threaded), same scene (bench/volume/brainsmall.toml: VolPack's example view, light,
 # material and classification), at 256x256 and 512x512, in one run. Prints both median
@@ -22,13 +23,20 @@ ${CC:-cc} -O2 -o "$BUILD/volpack_bench" bench/volume/volpack_bench.c -lvolpack -
 # VP_MAX_RAY_OPACITY.
 ARGS=(bench/volume/brainsmall.nhdr --scene bench/volume/brainsmall.toml --zoom 1.4 --ert 0.95)
 printf '%-8s %-8s %-11s %12s %12s %8s\n' image threads caster rmapgen_ms volpack_ms ratio
+# The renderer's arguments for each label.
+declare -A CASTER=(
+  [shear-warp]="--caster shear-warp"
+  [ray]="--caster ray"
+  [shear-4x3]="--caster shear-warp --slice-samples 4 --supersample 3"
+)
 for size in 256 512; do
   for threads in 1 2; do
-    for caster in shear-warp ray; do
+    for caster in shear-warp ray shear-4x3; do
       vp=$("$BUILD/volpack_bench" "$DEN" "$REPEAT" "$size" | awk '{print $3}')
       out="$BUILD/rmapgen-$caster-$size-$threads"
+      # shellcheck disable=SC2086 # the label's arguments are words
       RAYON_NUM_THREADS=$threads "$RMAPGEN" volume "${ARGS[@]}" --size "$size" --model-only \
-        --caster "$caster" --timing --repeat "$REPEAT" --out "$out" --force >/dev/null
+        ${CASTER[$caster]} --timing --repeat "$REPEAT" --out "$out" --force >/dev/null
       rm=$(sed -n '/"model_skipping_on"/,/}/s/.*"median_ms": \([0-9.e+-]*\).*/\1/p' "$out/timing.json")
       awk -v s="$size" -v t="$threads" -v c="$caster" -v r="$rm" -v v="$vp" \
         'BEGIN { printf "%-8s %-8s %-11s %12.2f %12.3f %7.1fx\n", s "x" s, t, c, r, v, r / v }'

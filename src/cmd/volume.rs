@@ -104,6 +104,14 @@ pub struct VolumeArgs {
     /// samples once per slice).
     #[arg(long, value_name = "S", default_value_t = options::DEFAULT_STEP, value_parser = super::parse::positive())]
     pub step: f64,
+    /// Shear-warp samples per slice spacing along a ray [1..=8]: more are interpolated
+    /// between the slices (trilinear), closer to the ray caster's image at more work.
+    #[arg(long, value_name = "N", default_value_t = options::DEFAULT_SLICE_SAMPLES, value_parser = super::parse::count::<u32>())]
+    pub slice_samples: u32,
+    /// Shear-warp intermediate pixels per voxel along each slice axis [1..=4]: a finer
+    /// intermediate image for the warp, at the square of the work.
+    #[arg(long, value_name = "R", default_value_t = options::DEFAULT_SUPERSAMPLE, value_parser = super::parse::count::<u32>())]
+    pub supersample: u32,
     /// Early ray termination: accumulated opacity at which a pixel counts as opaque (0, 1].
     #[arg(long, value_name = "A", default_value_t = options::DEFAULT_ERT, value_parser = super::parse::positive())]
     pub ert: f64,
@@ -499,6 +507,8 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
             .map(|u| triple::<f64>("--up", u))
             .transpose()?,
         caster: a.caster,
+        slice_samples: a.slice_samples,
+        supersample: a.supersample,
     };
     opts.validate()?;
     if a.timing && a.repeat == 0 {

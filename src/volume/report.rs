@@ -486,11 +486,20 @@ mod tests {
         };
         let s = scene();
         let same = AsModel(ModelShader::new(&cfg, &s));
-        let r = render(&p, &cfg, &s, o, Some(&same), false).unwrap();
-        assert_eq!(r.rtl_mismatches(), Some(0));
-        assert!(r.metrics.as_ref().unwrap().pixels > 48 * 48 / 4);
-        let other = render(&p, &cfg, &s, o, Some(&Fixed(3)), false).unwrap();
-        assert!(other.rtl_mismatches().unwrap() > 0);
+        // One sample per slice and voxel, and samples between slices on a finer
+        // intermediate image.
+        for (slice_samples, supersample) in [(1, 1), (2, 2)] {
+            let o = CastOptions {
+                slice_samples,
+                supersample,
+                ..o
+            };
+            let r = render(&p, &cfg, &s, o, Some(&same), false).unwrap();
+            assert_eq!(r.rtl_mismatches(), Some(0));
+            assert!(r.metrics.as_ref().unwrap().pixels > 48 * 48 / 4);
+            let other = render(&p, &cfg, &s, o, Some(&Fixed(3)), false).unwrap();
+            assert!(other.rtl_mismatches().unwrap() > 0);
+        }
     }
 
     #[test]

@@ -576,6 +576,28 @@ fn shear_warp_caster_skips_without_changing_the_files() {
 }
 
 #[test]
+fn bad_shear_warp_sampling_is_refused() {
+    let s = ["--synthetic", "--dims", "16,16,8", "--caster", "shear-warp"];
+    for (flag, v, needle) in [
+        (
+            "--slice-samples",
+            "0",
+            "slice samples 0 is out of range; allowed 1..=8",
+        ),
+        ("--slice-samples", "9", "slice samples 9 is out of range"),
+        (
+            "--supersample",
+            "0",
+            "supersample 0 is out of range; allowed 1..=4",
+        ),
+        ("--supersample", "5", "supersample 5 is out of range"),
+        ("--supersample", "-1", "--supersample"),
+    ] {
+        fails(&[&s[..], &[flag, v]].concat(), needle);
+    }
+}
+
+#[test]
 fn unknown_caster_is_refused() {
     fails(
         &["--synthetic", "--dims", "16,16,8", "--caster", "fan"],

@@ -285,6 +285,7 @@ mod tests {
                     zoom,
                     up,
                     caster: options::CasterKind::Ray,
+                    ..CastOptions::default()
                 };
                 let on = Caster::new(&p, &tf, view, o).unwrap().render(&model);
                 let off = Caster::new(&p, &tf, view, CastOptions { skip: false, ..o })

@@ -15,6 +15,19 @@
 //! Consecutive samples of a ray are one slice apart: the transfer function is corrected for
 //! that length (in smallest spacings), which depends on the view.
 //!
+//! **Finer sampling** (options, both 1 by default; docs/PERFORMANCE.md measures them):
+//! - `slice_samples` n: n samples per slice spacing, at c = m / n; a sample between slices k
+//!   and k + 1 is the linear interpolation along c of the two slices' bilinear value and
+//!   gradient at the same sheared position (trilinear, rounded once), and the runs are those
+//!   of the slabs between slices (cells of 8 voxels). The transfer function is corrected
+//!   for the shorter step. This removes the slice pattern on oblique surfaces.
+//! - `supersample` r: r intermediate pixels per voxel along a and b, the r samples of a cell
+//!   at fractions (u + e) / r of it (e the shift's fraction in intermediate pixels), and the
+//!   warp reads the finer image: the image's detail below a voxel (pixels are 0.46 voxels on
+//!   the MRI head at 256²) is then resampled from closer rays.
+//!
+//! The work grows as n r²; matching the ray caster's image takes about n = 4, r = 3.
+//!
 //! **Compositing.** Front to back, slice by slice, per intermediate pixel exactly as the ray
 //! caster per ray ([`crate::volume::cast`]): weight (1 - A) a, termination at `ert`, where A
 //! becomes 1 and later weights are exactly 0.
@@ -42,33 +55,41 @@ pub mod runs;
 
 use super::camera::{Camera, Framing};
 use super::cast::frame::{Frame, Stats};
-use super::cast::options::CastOptions;
+use super::cast::options::{CastOptions, MAX_SUPERSAMPLE};
 use super::cast::shader::Shader;
 use super::cast::MAX_BATCH_SAMPLES;
 use crate::scene::transfer::Tf;
 use anyhow::{bail, ensure, Result};
 use rayon::prelude::*;
-pub use runs::{Classified, Runs};
+pub use runs::{Classified, Runs, Spans, Voxel};
 
 /// Intermediate scanlines per parallel task: small enough that two threads share the work
 /// evenly, large enough that each task composites many samples.
 const SLAB_ROWS: usize = 4;
 
-/// Where one slice's samples lie in the intermediate image.
+/// Where one slice's samples lie in the intermediate image, and between which slices.
 #[derive(Clone, Copy, Debug)]
 struct Slice {
-    /// Intermediate pixel of cell 0 along a and b.
+    /// The layer of the runs and voxels: slice k (one sample per slice), or the slab
+    /// between slices k and k + 1 (samples between slices).
+    k: usize,
+    /// Weight of slice k + 1 (0: the sample lies on slice k, and only its voxels are read).
+    t: f32,
+    /// Intermediate pixel of cell 0's first sample along a and b.
     i0: usize,
     j0: usize,
-    /// Bilinear weights of the slice's samples (the fraction of the shear).
-    fa: f32,
-    fb: f32,
+    /// Bilinear weights of the slice's samples: the r samples of a cell along a (b) lie at
+    /// fractions `fa[0..r]` (`fb[0..r]`) of it (with r = 1, the fraction of the shear).
+    fa: [f32; MAX_SUPERSAMPLE as usize],
+    fb: [f32; MAX_SUPERSAMPLE as usize],
 }
 
 /// A shear-warp renderer for one classified volume, view and options.
 pub struct ShearWarp<'a> {
     cl: &'a Classified<'a>,
     runs: &'a Runs,
+    /// The runs of the layers the samples lie in: the slices', or the slabs' between them.
+    spans: &'a Spans,
     tf: Tf,
     camera: Camera,
     opts: CastOptions,
@@ -78,6 +99,10 @@ pub struct ShearWarp<'a> {
     stride: [usize; 3],
     /// Whether the rays run towards increasing slice index.
     forward: bool,
+    /// Samples per slice spacing.
+    per_slice: usize,
+    /// Intermediate pixels per voxel along a and b.
+    sup: usize,
     slices: Vec<Slice>,
     /// Intermediate image size (a, b).
     width: usize,
@@ -131,34 +156,77 @@ impl<'a> ShearWarp<'a> {
             Some(GeometryFault::ShearSign) => (-sa, -sb),
             _ => (sa, sb),
         };
-        // The slice whose shift slice k takes (k itself; the next one for a planted fault).
+        // The position along c whose shift a sample at position s takes (s itself; one
+        // slice further for a planted fault).
         #[cfg(not(test))]
-        let shifted = |k: usize| k;
+        let shifted = |s: f64| s;
         #[cfg(test)]
-        let shifted = |k: usize| match cl.plant_geometry {
-            Some(GeometryFault::SliceOffByOne) => k + 1,
-            _ => k,
+        let shifted = |s: f64| match cl.plant_geometry {
+            Some(GeometryFault::SliceOffByOne) => s + 1.0,
+            _ => s,
         };
+        // `n` samples per slice spacing: sample m lies at c = m / n, between slices k and
+        // k + 1 (the last sample on the last slice). With one, every sample lies on a slice.
+        let n = if nc >= 2 {
+            opts.slice_samples as usize
+        } else {
+            1
+        };
+        // `r` intermediate pixels per voxel along a and b: intermediate pixel p of a slice
+        // whose shift is h lies at p / r + h voxels.
+        let r = opts.supersample as usize;
+        let rf = r as f64;
         // shift(k) = k s - off lies in [-(nc - 1)|s|, 0], so every intermediate index is >= 0.
         let (oa, ob) = (
             (sa * (nc - 1) as f64).max(0.0),
             (sb * (nc - 1) as f64).max(0.0),
         );
-        let slices: Vec<Slice> = (0..nc)
-            .map(|k| {
-                let k = shifted(k) as f64;
-                let (ha, hb) = (k * sa - oa, k * sb - ob);
+        let slices: Vec<Slice> = (0..=(nc - 1) * n)
+            .map(|m| {
+                let (k, t) = if n == 1 {
+                    (m, 0.0)
+                } else {
+                    let k = (m / n).min(nc - 2);
+                    let t = (m as f64 / n as f64 - k as f64) as f32;
+                    #[cfg(test)]
+                    let t = match cl.plant_geometry {
+                        Some(GeometryFault::WeightBetweenSlices) if t != 0.0 => 1.0 - t,
+                        _ => t,
+                    };
+                    (k, t)
+                };
+                let at = shifted(m as f64 / n as f64);
+                // In intermediate pixels; the fraction e of the shift in pixels puts cell
+                // sample u at (u + e) / r of the cell.
+                let (ha, hb) = (rf * (at * sa - oa), rf * (at * sb - ob));
                 let (fa, fb) = (ha.floor(), hb.floor());
+                #[cfg(test)]
+                let phase = |e: f64| match cl.plant_geometry {
+                    Some(GeometryFault::SubpixelPhase) if r > 1 => 0.0,
+                    _ => e,
+                };
+                #[cfg(not(test))]
+                let phase = |e: f64| e;
+                let sub = |e: f64| {
+                    let e = phase(e);
+                    let mut w = [0f32; MAX_SUPERSAMPLE as usize];
+                    for (u, x) in w.iter_mut().enumerate().take(r) {
+                        *x = ((u as f64 + e) / rf) as f32;
+                    }
+                    w
+                };
                 Slice {
+                    k,
+                    t,
                     i0: (-fa) as usize,
                     j0: (-fb) as usize,
-                    fa: (ha - fa) as f32,
-                    fb: (hb - fb) as f32,
+                    fa: sub(ha - fa),
+                    fb: sub(hb - fb),
                 }
             })
             .collect();
-        let width = slices.iter().map(|s| s.i0).max().unwrap_or(0) + d[a] - 1;
-        let height = slices.iter().map(|s| s.j0).max().unwrap_or(0) + d[b] - 1;
+        let width = slices.iter().map(|s| s.i0).max().unwrap_or(0) + r * (d[a] - 1);
+        let height = slices.iter().map(|s| s.j0).max().unwrap_or(0) + r * (d[b] - 1);
         // The ray of a final pixel with voxel-unit origin o meets slice k at p_a = o_a + (k -
         // o_c) sa, the intermediate pixel p_a - shift_a(k) = o_a - o_c sa + oa for every k.
         let meet = |x: u32, y: u32| {
@@ -174,22 +242,32 @@ impl<'a> ShearWarp<'a> {
             p00.1,
             p10.1 - p00.1,
             p01.1 - p00.1,
-        ];
-        // Samples are one slice apart: |dv_c|^-1 world units along the (unit) ray.
-        let step = 1.0 / (dv[c].abs() * vol.unit());
+        ]
+        .map(|w| w * rf);
+        // Samples are 1 / n slices apart: (n |dv_c|)^-1 world units along the (unit) ray.
+        let step = 1.0 / (dv[c].abs() * vol.unit() * n as f64);
         let tf = cl.transfer.compile(step as f32, cl.prepared.grads.scale);
         let forward = dv[c] > 0.0;
         #[cfg(test)]
         let forward = forward != (cl.plant_geometry == Some(GeometryFault::ReversedOrder));
+        let runs = cl.runs(c)?;
+        let spans = if n == 1 {
+            &runs.slices
+        } else {
+            cl.slab_runs(c)?
+        };
         Ok(ShearWarp {
             cl,
-            runs: cl.runs(c)?,
+            runs,
+            spans,
             tf,
             camera,
             opts,
             axes: [c, a, b],
             stride: [d[a] * d[b], 1, d[a]],
             forward,
+            per_slice: n,
+            sup: r,
             slices,
             width,
             height,
@@ -215,7 +293,7 @@ impl<'a> ShearWarp<'a> {
     pub fn sample_step(&self) -> f64 {
         let s = self.cl.prepared.vol.spacing[self.axes[0]];
         let dv = -self.camera.view.to_array()[self.axes[0]] / s;
-        1.0 / (dv.abs() * self.cl.prepared.vol.unit())
+        1.0 / (dv.abs() * self.cl.prepared.vol.unit() * self.per_slice as f64)
     }
 
     /// Fraction of the slice cells that are transparent for the transfer function.
@@ -241,7 +319,7 @@ impl<'a> ShearWarp<'a> {
         let [sc, sa, sb] = self.stride;
         let (cells, lines) = (self.runs.cells, self.runs.lines);
         let full = [[0u32, cells as u32]];
-        let nc = self.slices.len();
+        let ns = self.slices.len();
         let pw = self.width + 2;
         let tf = &self.tf;
         let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
@@ -250,63 +328,89 @@ impl<'a> ShearWarp<'a> {
         // `link[p]` is 0 for a pixel still open, else a distance to jump towards the next
         // open pixel of its row (shortened as chains are followed).
         let mut link = vec![0u32; im.len()];
-        for step in 0..nc {
-            let k = if self.forward { step } else { nc - 1 - step };
-            let sl = self.slices[k];
-            let (fa, fb) = (sl.fa, sl.fb);
+        let r = self.sup;
+        for step in 0..ns {
+            let sl = self.slices[if self.forward { step } else { ns - 1 - step }];
+            let (k, t) = (sl.k, sl.t);
+            // A sample between slices reads the same cell of slice k + 1 too (trilinear).
+            let deep = t != 0.0;
             for j in rows.clone() {
-                let Some(cb) = j.checked_sub(sl.j0).filter(|&cb| cb < lines) else {
+                let Some(qb) = j.checked_sub(sl.j0).filter(|&qb| qb < r * lines) else {
                     continue;
                 };
-                st.samples += cells as u64;
-                let spans = if skip { self.runs.line(k, cb) } else { &full };
+                let (cb, fb) = (qb / r, sl.fb[qb % r]);
+                st.samples += (r * cells) as u64;
+                let spans = if skip { self.spans.line(k, cb) } else { &full };
                 let row = (j - rows.start) * pw + 1 + sl.i0;
                 // The row's right border pixel: never opaque, so every chain stops there.
                 let row_end = (j - rows.start) * pw + 1 + self.width;
                 let base = k * sc + cb * sb;
                 let mut visited = 0u64;
                 for &[first, end] in spans {
+                    // The run's intermediate pixels (r per cell).
+                    let (first, end) = (r * first as usize, r * end as usize);
                     visited += (end - first) as u64;
-                    let mut ca = first as usize;
-                    while ca < end as usize {
-                        let px = row + ca;
+                    let mut q = first;
+                    while q < end {
+                        let px = row + q;
                         if skip && link[px] != 0 {
                             // Follow the chain to the next open pixel (or the row's end).
-                            let mut q = px;
-                            while q < row_end && link[q] != 0 {
-                                q += link[q] as usize;
+                            let mut open = px;
+                            while open < row_end && link[open] != 0 {
+                                open += link[open] as usize;
                             }
-                            // Path compression: every pixel on the chain now points at q,
-                            // so a later run starting inside the stretch jumps at once.
-                            let mut r = px;
-                            while r < q {
-                                let next = r + link[r] as usize;
-                                link[r] = (q - r) as u32;
-                                r = next;
+                            // Path compression: every pixel on the chain now points at the
+                            // open one, so a later run starting inside the stretch jumps at
+                            // once.
+                            let mut x = px;
+                            while x < open {
+                                let next = x + link[x] as usize;
+                                link[x] = (open - x) as u32;
+                                x = next;
                             }
-                            let next = (ca + q - px).min(end as usize);
-                            st.terminated += (next - ca) as u64;
-                            ca = next;
+                            let next = (q + open - px).min(end);
+                            st.terminated += (next - q) as u64;
+                            q = next;
                             continue;
                         }
-                        ca += 1;
+                        // The pixel's cell and its sample's weight along a.
+                        let (ca, fa) = if r == 1 {
+                            (q, sl.fa[0])
+                        } else {
+                            (q / r, sl.fa[q % r])
+                        };
+                        q += 1;
                         let before = im[px][1];
                         st.evaluated += 1;
-                        let i = base + (ca - 1) * sa;
-                        let (q00, q10, q01, q11) =
-                            (vox[i], vox[i + sa], vox[i + sb], vox[i + sa + sb]);
-                        let v = lerp(lerp(q00.v, q10.v, fa), lerp(q01.v, q11.v, fa), fb);
+                        let i = base + ca * sa;
+                        let cell = |i: usize| (vox[i], vox[i + sa], vox[i + sb], vox[i + sa + sb]);
+                        let value = |(q00, q10, q01, q11): (Voxel, Voxel, Voxel, Voxel)| {
+                            lerp(lerp(q00.v, q10.v, fa), lerp(q01.v, q11.v, fa), fb)
+                        };
+                        let grad = |(q00, q10, q01, q11): (Voxel, Voxel, Voxel, Voxel), x| {
+                            lerp(
+                                lerp(q00.g[x] as f32, q10.g[x] as f32, fa),
+                                lerp(q01.g[x] as f32, q11.g[x] as f32, fa),
+                                fb,
+                            )
+                        };
+                        let near = cell(i);
+                        let far = if deep { cell(i + sc) } else { near };
+                        let v = if deep {
+                            lerp(value(near), value(far), t)
+                        } else {
+                            value(near)
+                        };
                         let o = tf.value_opacity(v);
                         if skip && o == 0.0 {
                             continue;
                         }
-                        let (g00, g10, g01, g11) = (q00.g, q10.g, q01.g, q11.g);
                         let g = [0, 1, 2].map(|x| {
-                            super::cast::march::round_half_away(lerp(
-                                lerp(g00[x] as f32, g10[x] as f32, fa),
-                                lerp(g01[x] as f32, g11[x] as f32, fa),
-                                fb,
-                            ))
+                            super::cast::march::round_half_away(if deep {
+                                lerp(grad(near, x), grad(far, x), t)
+                            } else {
+                                grad(near, x)
+                            })
                         });
                         // The ramp only lowers the opacity: the value test above skips
                         // nothing visible.
@@ -321,7 +425,7 @@ impl<'a> ShearWarp<'a> {
                         }
                         let after = before + w;
                         if after > 0.0 {
-                            bbox.add(sl.i0 + ca - 1, j);
+                            bbox.add(sl.i0 + q - 1, j);
                         }
                         if after >= ert {
                             im[px][1] = 1.0;
@@ -331,7 +435,7 @@ impl<'a> ShearWarp<'a> {
                         }
                     }
                 }
-                st.empty_skipped += cells as u64 - visited;
+                st.empty_skipped += (r * cells) as u64 - visited;
             }
         }
         bbox
@@ -547,6 +651,10 @@ pub(crate) enum GeometryFault {
     SliceOffByOne,
     /// Slices composited back to front.
     ReversedOrder,
+    /// A sample between slices weighted towards the wrong slice (1 - t for t).
+    WeightBetweenSlices,
+    /// A finer intermediate image's samples placed without the shift's sub-pixel fraction.
+    SubpixelPhase,
 }
 
 /// The bounding box of the non-transparent pixels of an intermediate image (inclusive
@@ -624,6 +732,12 @@ mod tests {
         assert_eq!(on.alpha, off.alpha, "{what}");
         assert_eq!(on.stats.samples, off.stats.samples, "{what}");
         assert_eq!(off.stats.evaluated, off.stats.samples, "{what}");
+        let st = on.stats;
+        assert_eq!(
+            st.empty_skipped + st.terminated + st.evaluated,
+            st.samples,
+            "{what}"
+        );
         on
     }
 
@@ -670,14 +784,22 @@ mod tests {
             vol.axes = ax;
             let p = Prepared::new(&vol, 12, 8);
             let cl = Classified::new(&p, &tf).unwrap();
-            for view in views {
+            // One sample per slice and voxel; samples between slices (the slabs' runs) on a
+            // finer intermediate image.
+            for (view, (slice_samples, supersample)) in
+                views.into_iter().flat_map(|v| [(v, (1, 1)), (v, (3, 2))])
+            {
                 let o = CastOptions {
                     zoom,
                     up,
                     ert,
+                    slice_samples,
+                    supersample,
                     ..opts(40, true)
                 };
-                let what = format!("view {view:?} spacing {spacing:?} tf {tf:?}");
+                let what = format!(
+                    "view {view:?} spacing {spacing:?} tf {tf:?} {slice_samples}/{supersample}"
+                );
                 let on = same_on_and_off(&cl, view, o, &what);
                 assert!(on.stats.skipped_fraction() > 0.3, "{what} {:?}", on.stats);
                 assert!(on.stats.shaded > 100, "{what} {:?}", on.stats);
@@ -706,7 +828,19 @@ mod tests {
         };
         let views = [[0.2, 0.3, 1.0], [-1.0, 0.5, 0.1], [0.1, -1.0, 0.4]];
         let cl = Classified::new(&p, &tf).unwrap();
+        // Samples between slices use the slabs' runs: the same checks for them.
+        let between = CastOptions {
+            slice_samples: 2,
+            supersample: 2,
+            ..o
+        };
         for view in views {
+            let b = same_on_and_off(&cl, view, between, &format!("{view:?} between"));
+            assert!(
+                b.stats.shaded > 1000 && b.stats.empty_skipped > 0,
+                "{:?}",
+                b.stats
+            );
             let on = same_on_and_off(&cl, view, o, &format!("{view:?}"));
             assert!(
                 on.stats.shaded > 1000 && on.stats.empty_skipped > 0,
@@ -732,13 +866,15 @@ mod tests {
         // image, so the comparison above would catch it.
         let model = ModelShader::new(&Config::default(), &Scene::standard());
         for view in views {
-            let mut wrong = Classified::new(&p, &tf).unwrap();
-            wrong.plant_wrong_skip = Some(11);
-            let bad = ShearWarp::new(&wrong, view, o).unwrap().render(&model);
-            let off = ShearWarp::new(&cl, view, CastOptions { skip: false, ..o })
-                .unwrap()
-                .render(&model);
-            assert_ne!(bad.value, off.value, "{view:?}");
+            for o in [o, between] {
+                let mut wrong = Classified::new(&p, &tf).unwrap();
+                wrong.plant_wrong_skip = Some(11);
+                let bad = ShearWarp::new(&wrong, view, o).unwrap().render(&model);
+                let off = ShearWarp::new(&cl, view, CastOptions { skip: false, ..o })
+                    .unwrap()
+                    .render(&model);
+                assert_ne!(bad.value, off.value, "{view:?} {o:?}");
+            }
         }
     }
 
@@ -752,18 +888,20 @@ mod tests {
         let cl = Classified::new(&p, &classified_tf()).unwrap();
         let model = ModelShader::new(&Config::default(), &Scene::standard());
         let mut buf = Frame::default();
-        for (view, size) in [
-            ([-0.5, -0.7, 0.5], 64),
-            ([0.9, 0.1, 0.2], 40),
-            ([0.0, 0.0, 1.0], 40),
-            ([-0.5, -0.7, 0.5], 48),
+        for (view, size, supersample) in [
+            ([-0.5, -0.7, 0.5], 64, 1),
+            ([0.9, 0.1, 0.2], 40, 3),
+            ([0.0, 0.0, 1.0], 40, 1),
+            ([-0.5, -0.7, 0.5], 48, 2),
         ] {
-            let sw = ShearWarp::new(&cl, view, opts(size, true)).unwrap();
+            let o = CastOptions {
+                supersample,
+                ..opts(size, true)
+            };
+            let sw = ShearWarp::new(&cl, view, o).unwrap();
             sw.render_into(&model, &mut buf);
             let fresh = Classified::new(&p, &classified_tf()).unwrap();
-            let once = ShearWarp::new(&fresh, view, opts(size, true))
-                .unwrap()
-                .render(&model);
+            let once = ShearWarp::new(&fresh, view, o).unwrap().render(&model);
             assert!(once.alpha.iter().any(|&a| a > 0.0), "{view:?}");
             assert_eq!(buf, once, "{view:?} {size}");
         }
@@ -780,10 +918,17 @@ mod tests {
             interp_bits: 0,
             ..Config::default()
         };
-        for cfg in [Config::default(), small] {
+        // The default design with one sample per slice and voxel; the small one with samples
+        // between slices on a finer intermediate image.
+        for (cfg, slice_samples, supersample) in [(Config::default(), 1, 1), (small, 2, 2)] {
             let p = Prepared::new(&vol, cfg.grad_bits, 8);
             let cl = Classified::new(&p, &classified_tf()).unwrap();
-            let sw = ShearWarp::new(&cl, [-0.4, -0.8, 0.45], opts(40, true)).unwrap();
+            let o = CastOptions {
+                slice_samples,
+                supersample,
+                ..opts(40, true)
+            };
+            let sw = ShearWarp::new(&cl, [-0.4, -0.8, 0.45], o).unwrap();
             let model = ModelShader::new(&cfg, &Scene::standard());
             let fused = sw.render(&model);
             let s = sw.collect().unwrap();
@@ -816,7 +961,12 @@ mod tests {
     /// (slices against half-voxel steps, bilinear against trilinear, a warp), so the images
     /// differ a little, but a wrong shear, slice or order differs by more. Returns the
     /// failures, one line each.
-    fn geometry_failures(fault: Option<GeometryFault>) -> Vec<String> {
+    fn geometry_failures(fault: Option<GeometryFault>, sampling: (u32, u32)) -> Vec<String> {
+        geometry(fault, sampling).0
+    }
+
+    /// [`geometry_failures`] and the mean |difference| on each view.
+    fn geometry(fault: Option<GeometryFault>, (n, r): (u32, u32)) -> (Vec<String>, Vec<f64>) {
         let vol = synthetic::engine_block([64, 64, 32], [1.0, 1.0, 1.2]).unwrap();
         let cfg = Config::default();
         let p = Prepared::new(&vol, cfg.grad_bits, 8);
@@ -825,6 +975,7 @@ mod tests {
         cl.plant_geometry = fault;
         let model = ModelShader::new(&cfg, &Scene::standard());
         let mut failures = Vec::new();
+        let mut means = Vec::new();
         for (view, up) in [
             ([-0.5, -0.7, 0.5], None),
             ([0.6, 0.2, -0.75], Some([0.0, 1.0, 0.0])),
@@ -832,6 +983,8 @@ mod tests {
         ] {
             let o = CastOptions {
                 up,
+                slice_samples: n,
+                supersample: r,
                 ..opts(96, true)
             };
             let sw = ShearWarp::new(&cl, view, o).unwrap().render(&model);
@@ -852,13 +1005,14 @@ mod tests {
                 .filter(|(&x, &y)| (x > 0.5) != (y > 0.5))
                 .count();
             assert!(covered > 96 * 96 / 5, "{view:?} {covered}");
+            means.push(mean);
             if disagree * 50 >= covered || mean >= GEOMETRY_MEAN {
                 failures.push(format!(
                     "{view:?}: {disagree} of {covered} covered pixels disagree, mean |difference| {mean:.2}"
                 ));
             }
         }
-        failures
+        (failures, means)
     }
 
     /// The largest mean |difference| to the ray caster's image (8-bit values over its
@@ -867,7 +1021,43 @@ mod tests {
 
     #[test]
     fn the_image_matches_the_ray_casters() {
-        assert_eq!(geometry_failures(None), Vec::<String>::new());
+        assert_eq!(geometry_failures(None, (1, 1)), Vec::<String>::new());
+    }
+
+    /// The largest ratio of the mean |difference| to the ray caster's image with 4 samples
+    /// per slice spacing and 2 intermediate pixels per voxel to the one with 1 and 1 (it is
+    /// 0.27 to 0.34 on the three views; a planted sampling fault gives 0.6 or more on some).
+    const FINER: f64 = 0.5;
+
+    /// Samples between slices and a finer intermediate image bring the image closer to the
+    /// ray caster's on every view (the resampling error shrinks); a sampling that moved the
+    /// samples (a wrong weight between slices, a wrong sub-pixel position) would not.
+    #[test]
+    fn finer_sampling_comes_closer_to_the_ray_casters() {
+        let (f, coarse) = geometry(None, (1, 1));
+        assert!(f.is_empty(), "{f:?}");
+        let (f, fine) = geometry(None, (4, 2));
+        assert!(f.is_empty(), "{f:?}");
+        eprintln!("coarse {coarse:?} fine {fine:?}");
+        for (c, x) in coarse.iter().zip(&fine) {
+            assert!(x < &(FINER * c), "coarse {coarse:?}, fine {fine:?}");
+        }
+    }
+
+    #[test]
+    fn a_planted_sampling_fault_is_caught() {
+        let (_, coarse) = geometry(None, (1, 1));
+        for fault in [
+            GeometryFault::WeightBetweenSlices,
+            GeometryFault::SubpixelPhase,
+        ] {
+            let (f, fine) = geometry(Some(fault), (4, 2));
+            eprintln!("{fault:?}: {f:?} coarse {coarse:?} fine {fine:?}");
+            assert!(
+                !f.is_empty() || coarse.iter().zip(&fine).any(|(c, x)| x >= &(FINER * c)),
+                "{fault:?} passes"
+            );
+        }
     }
 
     #[test]
@@ -877,9 +1067,14 @@ mod tests {
             GeometryFault::SliceOffByOne,
             GeometryFault::ReversedOrder,
         ] {
-            let f = geometry_failures(Some(fault));
-            eprintln!("{fault:?}: {f:?}");
-            assert!(!f.is_empty(), "{fault:?} passes the geometry test");
+            for sampling in [(1, 1), (2, 2)] {
+                let f = geometry_failures(Some(fault), sampling);
+                eprintln!("{fault:?} {sampling:?}: {f:?}");
+                assert!(
+                    !f.is_empty(),
+                    "{fault:?} {sampling:?} passes the geometry test"
+                );
+            }
         }
     }
 }
