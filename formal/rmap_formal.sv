@@ -1,6 +1,7 @@
 // Formal harness of the handshake top (rmapgen generate --handshake --axis): SymbiYosys proves
-// its assertions by k-induction (formal/run_formal.py writes the .sby, sets the parameters
-// from the generated rmap_top.v and connects the probes p_* to the top's internal signals).
+// its assertions by k-induction, one run per assertion group (CHK, below); formal/run_formal.py
+// writes the .sby, sets the parameters from the generated rmap_top.v and connects the probes
+// p_* to the top's internal signals.
 //
 // Samples are tagged: sample n (the n-th accepted, from 0 after reset) carries side_i = n mod
 // 2^SD, which the top passes to side_o with its result. The harness keeps its own model of the
@@ -148,8 +149,9 @@ module rmap_formal #(
 
   // The inductive invariants, stated stage by stage: each relates stage k only to stage k - 1
   // (or to the model's counters), so that the induction step is many small local facts rather
-  // than one count over the whole pipeline (that global form did not finish in 15 minutes of
-  // z3 or 10 of yices at 23 stages). u_side_delay's line is loaded from side_i = in_q at every
+  // than one count over the whole pipeline (that global form, a running count of the valid
+  // stages from the queue back, did not finish in 15 minutes of z3 or 10 of yices at 23
+  // stages; with the groups below it takes about a minute). u_side_delay's line is loaded from side_i = in_q at every
   // enabled edge, bubble or not, so stage k's tag is in_q as it was when stage k was loaded:
   // for a valid stage its sample's tag, for a bubble the tag of the next sample accepted after
   // it. Hence, writing d[k] = in_q - tag[k] (the samples accepted since stage k was loaded):

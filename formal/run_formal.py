@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """Proves the flow control and the map double buffer of a handshake top with SymbiYosys
-(k-induction, smtbmc with z3), on a design that `rmapgen generate --handshake --axis` wrote;
+(k-induction, smtbmc with yices, one run per assertion group of the harness), on a design that `rmapgen generate --handshake --axis` wrote;
 with --plant, on a copy of the design with a planted fault, and then it passes only if the
 proof FAILS, naming the assertion the fault breaks (every check must be able to fail).
 
-    run_formal.py DESIGN_DIR [--build DIR] [--depth K] [--plant NAME ... | --all-plants]
+    run_formal.py DESIGN_DIR [--build DIR] [--depth K] [--solver yices|z3]
+                  [--plant NAME ... | --all-plants]
 
 The harness is formal/rmap_formal.sv (its header lists the properties). This script reads the
 generated rmap_top.v for the harness's parameters (widths, SIDE_DELAY, BUF_DELAY, side_i width)
@@ -67,7 +68,15 @@ PLANTS = {
     "wr-same": (".wr_buf_i  (~front_d),", ".wr_buf_i  (front_d),", "a_wr_buf"),
     "front-stuck": ("      front_q <= front_d;", "      front_q <= front_q;",
                     ("a_wr_buf", "a_rd_buf")),
-    "phantom": ("assign push    = en && out_valid;", "assign push    = en;", "a_fly"),
+    "phantom": ("assign push    = en && out_valid;", "assign push    = en;", ("a_fly", "a_order")),
+    # When the head takes the skid entry it takes the tag at the pipeline's end instead (the
+    # next sample's, or a bubble's): only the order sees it.
+    "skid-tag": ("side_q <= skid_valid_q ? skid_side_q : side_in;", "side_q <= side_in;",
+                 "a_order"),
+    # The head takes a result at every edge with the pipeline stalled, the first edge after
+    # reset included, when nothing is in flight.
+    "valid-stall": ("valid_q <= skid_valid_q || push;", "valid_q <= skid_valid_q || push || !en_q;",
+                    "a_fly"),
     "latency-short": (re.compile(r'^(  "latency": )(\d+),$', re.M),
                       lambda m: f"{m.group(1)}{int(m.group(2)) - 1},", "a_live", "manifest.json"),
     "en-swap": ("assign en      = en_q;", "assign en      = en_q && !swap_i;", "a_live"),
@@ -227,19 +236,20 @@ def sby_run(design, build, p, stages, mode, depth, solver):
     return status, failed, secs
 
 
-def prove(design, build, depth, bmc, solver):
+def prove(design, build, depth, bmc, solver, one_query=False):
     """With `bmc`, a bounded search for a counterexample from reset over the pipeline's length
     plus 8 clocks, properties only (a planted fault must give a real trace, not only a failed
     induction step): (status, failed assertions, seconds, parameters, []). Else the proof:
     k-induction of depth `depth`, one run per assertion group (CHK = g), PASS when every group
-    passes; the last item lists (group, status, seconds)."""
+    passes (with `one_query`, one run of every assertion at once, CHK = 0: for comparison); the
+    last item lists (group, status, seconds)."""
     p, stages = params(design / "rmap_top.v")
     if bmc:
         p["INV"], p["CHK"] = 0, 0
         return (*sby_run(design, build, p, stages, "bmc", p["L"] + 8, solver), p, [])
     p["INV"] = 1
     status, failed, secs, runs = "PASS", [], 0.0, []
-    for g in groups():
+    for g in [0] if one_query else groups():
         p["CHK"] = g
         st, f, t = sby_run(design, build / f"group{g}", p, stages, "prove", depth, solver)
         print(f"run_formal: group {g}: {st}, {t:.1f} s ({build / f'group{g}' / 'sby.log'})",
@@ -283,6 +293,8 @@ def main():
     ap.add_argument("--depth", type=int, default=1, help="induction depth (sby depth)")
     ap.add_argument("--solver", choices=sorted(ENGINES), default="yices",
                     help="smtbmc's SMT solver (default yices)")
+    ap.add_argument("--one-query", action="store_true",
+                    help="prove every assertion in one induction instead of by groups (slower)")
     ap.add_argument("--plant", action="append", default=[], choices=sorted(PLANTS))
     ap.add_argument("--all-plants", action="store_true",
                     help="every plant, then check that each property is broken by three or more")
@@ -296,12 +308,13 @@ def main():
     for name in a.plant or [None]:
         d = design if name is None else plant(design, build, name)
         run_dir = build / (name or "proof")
-        status, failed, secs, p, _ = prove(d, run_dir, a.depth, name is not None, a.solver)
+        status, failed, secs, p, _ = prove(d, run_dir, a.depth, name is not None, a.solver,
+                                         a.one_query)
         where = f"{run_dir / 'sby.log'}" if name else f"{run_dir}/group*/sby.log"
         if name is None:
             good = status == "PASS"
             what = (f"proof: {status} by k-induction ({ENGINES[a.solver]}, depth {a.depth}, "
-                    f"{len(groups())} groups) on L={p['L']}"
+                    f"{1 if a.one_query else len(groups())} groups) on L={p['L']}"
                     f" SD={p['SD']}" + (f"; failed: {', '.join(failed)}" if failed else ""))
         else:
             want = PLANTS[name][2]
