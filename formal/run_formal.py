@@ -240,13 +240,14 @@ def sby_run(design, build, p, stages, mode, depth, solver):
     return status, failed, secs
 
 
-def prove(design, build, depth, bmc, solver, one_query=False):
+def prove(design, build, depth, bmc, solver, one_query=False, stop=False):
     """With `bmc`, a bounded search for a counterexample from reset over the pipeline's length
     plus 8 clocks, properties only (a planted fault must give a real trace, not only a failed
     induction step): (status, failed assertions, seconds, parameters, []). Else the proof:
     k-induction of depth `depth`, one run per assertion group (CHK = g), PASS when every group
-    passes (with `one_query`, one run of every assertion at once, CHK = 0: for comparison); the
-    last item lists (group, status, seconds)."""
+    passes (with `one_query`, one run of every assertion at once, CHK = 0: for comparison;
+    with `stop`, no group after the first that does not pass); the last item lists (group,
+    status, seconds)."""
     p, stages = params(design / "rmap_top.v")
     if bmc:
         p["INV"], p["CHK"] = 0, 0
@@ -263,6 +264,8 @@ def prove(design, build, depth, bmc, solver, one_query=False):
         failed += f
         if st != "PASS":
             status = st
+            if stop:
+                break
     return status, sorted(set(failed)), secs, p, runs
 
 
@@ -299,6 +302,9 @@ def main():
                     help="smtbmc's SMT solver (default yices)")
     ap.add_argument("--one-query", action="store_true",
                     help="prove every assertion in one induction instead of by groups (slower)")
+    ap.add_argument("--proof-plant", action="append", default=[], choices=sorted(PLANTS),
+                    help="after the runs, the grouped proof of a copy with this plant must NOT pass "
+                    "(the groups' assumption is not vacuous)")
     ap.add_argument("--plant", action="append", default=[], choices=sorted(PLANTS))
     ap.add_argument("--all-plants", action="store_true",
                     help="every plant, then check that each property is broken by three or more")
@@ -329,6 +335,18 @@ def main():
                     f"{', '.join(failed) or 'nothing'}"
                     f" ({'caught' if good else 'expected ' + ' or '.join(want) + ' to fail'})")
         print(f"run_formal: {what}, {secs:.1f} s ({where})", flush=True)
+        ok, bad = (ok + 1, bad) if good else (ok, bad + 1)
+    # The grouped proof must fail on a planted fault too: were the groups' past-time assumption
+    # unsatisfiable, every group would pass vacuously on any design.
+    for name in a.proof_plant:
+        d = plant(design, build, name)
+        run_dir = build / f"proof-{name}"
+        status, failed, secs, p, runs = prove(d, run_dir, a.depth, False, a.solver, stop=True)
+        good = status != "PASS"
+        print(f"run_formal: proof of plant {name}: {status}"
+              + (f" in group {runs[-1][0]}, failed {', '.join(failed) or 'induction'}" if good
+                 else " (expected the proof to fail)")
+              + f", {secs:.1f} s ({run_dir}/group*/sby.log)", flush=True)
         ok, bad = (ok + 1, bad) if good else (ok, bad + 1)
     # Every property of the harness must be broken by at least three of the plants (the
     # assertions that failed at each plant's first failing step), when all of them ran.
