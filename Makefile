@@ -210,21 +210,26 @@ prove: build
 	echo "make prove: $$(( $$(date +%s) - start )) s wall on $(PROVE_SHARDS) shards"; \
 	exit $$status
 
-# ---- Multipliers (rmapgen prove-mult, src/rtl/mult_proof.rs): Yosys sat proves that every
-# adder tree of a generated design equals the product its plan states (a * b + c) on every
-# input: the default design ($(OUT), 5 trees, ~40 s) and the narrowest design with every tree
-# stage ($(MULT_OUT), 11 trees, ~7 s). The planted faults are in the cargo tests
-# (tests/it/mult_proof.rs). Logs in $(MULT_BUILD)/<design>.
+# ---- Multipliers (rmapgen prove-mult, src/rtl/mult_proof.rs): every adder tree of a
+# generated design equals the product its plan states (a * b + c) on every input (engine
+# auto: every input evaluated up to 2^34, else shown equal as polynomials): the default
+# design ($(OUT), 5 trees) and the narrowest design with every tree stage ($(MULT_OUT), 11
+# trees), seconds each. formal-mult-grid proves every row of the parameter grid with the
+# algebraic engine (benchmark-style, not in make test: ~7 min on one core). The planted
+# faults are in the cargo tests (tests/it/mult_proof.rs). Logs in $(MULT_BUILD)/<design>.
 MULT_OUT   ?= build/rtl_mult
 MULT_BUILD ?= build/prove-mult
 MULT_FLAGS ?= --grad-bits 8 --red-bits 6 --recip-bits 5 --frac-bits 4 --index-bits 2 --interp-bits 1 --map-bits 6 --color --pipeline-depth 0
 
-.PHONY: formal-mult
+.PHONY: formal-mult formal-mult-grid
 
 formal-mult: build
 	$(RMAPGEN) generate --out $(MULT_OUT) $(MULT_FLAGS)
 	YOSYS=$(YOSYS) $(RMAPGEN) prove-mult $(OUT) --logs $(MULT_BUILD)/$(notdir $(OUT))
 	YOSYS=$(YOSYS) $(RMAPGEN) prove-mult $(MULT_OUT) --logs $(MULT_BUILD)/$(notdir $(MULT_OUT))
+
+formal-mult-grid: build
+	YOSYS=$(YOSYS) $(RMAPGEN) prove-mult build/matrix --matrix --engine algebra --logs $(MULT_BUILD)/grid
 
 # ---- FPGA (src/rtl/fpga.rs): Yosys synth_ice40 and nextpnr-ice40 on the default design built
 # for the iCE40 (--target ice40; rtl_out/ is the portable --target generic): post-route Fmax,
