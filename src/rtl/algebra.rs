@@ -7,7 +7,8 @@
 //! al. and Kaufmann, Biere and Kauers): every Boolean function f of n bits has exactly one
 //! multilinear polynomial P over the integers modulo 2^m with P(x) = f(x) on {0,1}^n (the
 //! Möbius transform is invertible over any ring). Start from
-//! `D = sum 2^i got_i - sum 2^i spec_i (mod 2^m)` over the output bits, then replace the
+//! `D = sum 2^i got_i - spec (mod 2^m)`, `spec` another word's bits or a polynomial given
+//! outright (`prove-mult` gives the specification's: [`equals_polynomial`]), then replace the
 //! latest node by its gate's polynomial (AND: ab, XOR: a + b - 2ab, MUX: a + s(b - a), a
 //! complement 1 - x, every x^2 reduced to x), node by node in reverse order, until only
 //! inputs are left. The two words agree on every input exactly when what is left is the
@@ -15,8 +16,10 @@
 //! variables 1, all others 0, where D equals that monomial's (non-zero) coefficient.
 //!
 //! Adders keep the polynomial small: a full adder's sum plus twice its carry is exactly a +
-//! b + c, so the sums of a tree rewrite into linear forms. A term limit bounds the memory;
-//! a circuit that exceeds it is reported, not guessed.
+//! b + c, so the sums of a tree rewrite into linear forms, provided a half adder's sum is
+//! rewritten as `a + b - 2 carry` with its carry's node (XOR rewriting) and terms that
+//! vanish (a carry times its own sum) are dropped as they appear. A term limit bounds the
+//! memory; a circuit that exceeds it is reported, not guessed.
 
 use super::netlist::{Circuit, Lit, Node};
 use anyhow::{bail, Result};
@@ -32,21 +35,28 @@ type Mono = Vec<u32>;
 struct Poly {
     terms: BTreeMap<Mono, u64>,
     mask: u64,
-    /// For each variable, the node it can never be 1 with, or 0: `x & y` and `x ^ y` of
-    /// the same operands (a half adder's carry and sum). A monomial holding both is the zero
-    /// function, so it is dropped at once; rewriting would remove it only once both nodes
-    /// and everything between them and their operands were substituted, and in the
-    /// carry-save rows of a multiplier Yosys infers such terms pile up first (past 2
-    /// million terms on an inferred 9 x 9 constant product without this rule).
-    exclusive: Vec<u32>,
+    /// For each variable, nodes it can never be 1 with. A monomial holding such a pair is
+    /// the zero function, so it is dropped at once; rewriting would remove it only once both
+    /// nodes and everything between them and their operands were substituted, and in the
+    /// carry-save rows and carry chains of a multiplier Yosys infers such terms pile up
+    /// first (past 2 million terms on an inferred 9 x 9 constant product without this rule).
+    /// The pairs: `x & y` and `x ^ y` of the same operands (a half adder's carry and sum),
+    /// and an AND node with whatever one of its (uncomplemented) operands excludes (a
+    /// ripple carry's `p & c_in` with the generate `g` of the same `p`).
+    exclusive: Vec<Vec<u32>>,
 }
+
+/// Exclusions kept per node: the nearest ones. Fewer only drops fewer vanishing terms
+/// early; it never changes a verdict.
+const MAX_EXCLUSIVE: usize = 8;
 
 impl Poly {
     fn vanishes(&self, m: &[u32]) -> bool {
         m.iter().any(|&v| {
-            let x = self.exclusive.get(v as usize).copied().unwrap_or(0);
-            // Largest first: a binary search with the order reversed.
-            x != 0 && m.binary_search_by(|y| x.cmp(y)).is_ok()
+            self.exclusive.get(v as usize).is_some_and(|xs| {
+                // Largest first: a binary search with the order reversed.
+                xs.iter().any(|x| m.binary_search_by(|y| x.cmp(y)).is_ok())
+            })
         })
     }
 
@@ -198,23 +208,94 @@ pub struct Stats {
 /// Whether output words `got` and `spec` of `c` (bits least significant first; bits at and
 /// above `m` ignored) agree modulo 2^m on every input. `m` is at most 64.
 pub fn equal_mod(c: &Circuit, got: usize, spec: usize, m: u32) -> Result<(Verdict, Stats)> {
+    rewrite(c, got, Spec::Word(spec), m)
+}
+
+/// Whether output word `got` of `c` equals the polynomial `spec` over the circuit's inputs
+/// (monomials of input variables `1..=inputs`, with their coefficients) modulo 2^m on every
+/// input. This is how a word-level specification (`a * b + c`) is given without gates: the
+/// gates of an inferred product are what made the polynomial blow up (the carry-save rows of
+/// Yosys's `$macc` map), and the specification's own polynomial is known outright.
+pub fn equals_polynomial(
+    c: &Circuit,
+    got: usize,
+    spec: &[Term],
+    m: u32,
+) -> Result<(Verdict, Stats)> {
+    rewrite(c, got, Spec::Polynomial(spec), m)
+}
+
+/// A half adder's carry node, with its two operand literals.
+type Carry = (u32, Lit, Lit);
+
+/// A term of a polynomial: its variables (in any order, each at most once) and coefficient.
+pub type Term = (Vec<u32>, u64);
+
+/// What `got` is compared with.
+enum Spec<'a> {
+    Word(usize),
+    Polynomial(&'a [Term]),
+}
+
+fn rewrite(c: &Circuit, got: usize, spec: Spec, m: u32) -> Result<(Verdict, Stats)> {
     if m == 0 || m > 64 {
         bail!("the algebraic engine compares 1 to 64 bits, not {m}");
     }
     let mask = if m == 64 { u64::MAX } else { (1u64 << m) - 1 };
     let base = c.inputs.len() as u32 + 1;
-    let mut exclusive = vec![0u32; (base as usize) + c.nodes.len()];
-    let mut ands: std::collections::HashMap<(Lit, Lit), u32> = Default::default();
+    // For each XOR node, an AND node of the same two variables, either complemented: the
+    // half adder it belongs to (Yosys's ripple carries are ORs, so the carry a sum bit
+    // reads is often the complement of a node).
+    // Of several, the one complemented alike nearest to the XOR: another AND of the same
+    // operands elsewhere in the netlist would bring an unrelated node into the polynomial.
+    let mut ands: std::collections::HashMap<(u32, u32), Vec<Carry>> = Default::default();
     for (k, n) in c.nodes.iter().enumerate() {
         if let Node::And(a, b) = *n {
-            ands.insert((a.min(b), a.max(b)), base + k as u32);
+            ands.entry((a / 2, b / 2))
+                .or_default()
+                .push((base + k as u32, a, b));
         }
     }
+    let mut carry_of = vec![None; c.nodes.len()];
+    let mut exclusive = vec![Vec::new(); (base as usize) + c.nodes.len()];
     for (k, n) in c.nodes.iter().enumerate() {
         if let Node::Xor(a, b) = *n {
-            if let Some(&g) = ands.get(&(a.min(b), a.max(b))) {
-                exclusive[g as usize] = base + k as u32;
-                exclusive[(base + k as u32) as usize] = g;
+            let x = base + k as u32;
+            let best = ands.get(&(a / 2, b / 2)).and_then(|v| {
+                v.iter()
+                    .min_by_key(|(g, la, lb)| ((la ^ lb) & 1, g.abs_diff(x)))
+                    .copied()
+            });
+            if let Some((g, la, lb)) = best {
+                carry_of[k] = Some((g, la, lb));
+                // `la & lb` and `la ^ lb` are never both 1, and the node is `la ^ lb` when
+                // both literals are complemented alike (else it is its complement).
+                if la & 1 == lb & 1 {
+                    exclusive[g as usize].push(x);
+                    exclusive[x as usize].push(g);
+                }
+            }
+        }
+    }
+    // An AND node is 1 only where its operands are, so it excludes what they exclude.
+    for (k, n) in c.nodes.iter().enumerate() {
+        if let Node::And(a, b) = *n {
+            let x = base + k as u32;
+            let mut inherited: Vec<u32> = [a, b]
+                .iter()
+                .filter(|&&l| l & 1 == 0)
+                .flat_map(|&l| exclusive[(l / 2) as usize].clone())
+                .filter(|&y| y != x)
+                .collect();
+            inherited.sort_unstable_by_key(|&y| std::cmp::Reverse(y));
+            let own = &mut exclusive[x as usize];
+            for y in inherited {
+                if own.len() >= MAX_EXCLUSIVE {
+                    break;
+                }
+                if !own.contains(&y) {
+                    own.push(y);
+                }
             }
         }
     }
@@ -223,7 +304,22 @@ pub fn equal_mod(c: &Circuit, got: usize, spec: usize, m: u32) -> Result<(Verdic
         mask,
         exclusive,
     };
-    for (k, sign) in [(got, 1u64), (spec, u64::MAX)] {
+    let mut words = vec![(got, 1u64)];
+    match spec {
+        Spec::Word(w) => words.push((w, u64::MAX)),
+        Spec::Polynomial(terms) => {
+            for (vars, coeff) in terms {
+                if let Some(v) = vars.iter().find(|&&v| v == 0 || v > c.inputs.len() as u32) {
+                    bail!("the specification names variable {v}, not an input of the circuit");
+                }
+                let mut mono = vars.clone();
+                mono.sort_unstable_by(|a, b| b.cmp(a));
+                mono.dedup();
+                p.add(mono, coeff.wrapping_neg());
+            }
+        }
+    }
+    for (k, sign) in words {
         for (i, &l) in c.outputs[k].iter().enumerate().take(m as usize) {
             p.add_lit(l, sign.wrapping_mul(1u64 << i));
         }
@@ -251,7 +347,28 @@ pub fn equal_mod(c: &Circuit, got: usize, spec: usize, m: u32) -> Result<(Verdic
             break;
         }
         let node = c.node(v).expect("a variable above the inputs is a node");
-        let g = node_poly(node);
+        let g = match carry_of[(v - base) as usize] {
+            // A half adder's sum is la + lb - 2 * carry, its carry's own node standing for
+            // la * lb (or the complement, 1 - la - lb + 2 * carry, when the node is the
+            // complement of the sum). That keeps the rewriting linear through the adders of
+            // a correct multiplier, where each carry then cancels against the next
+            // column's sum (XOR rewriting, after Kaufmann, Biere and Kauers). Either form
+            // is exact on {0,1}; with la * lb instead, every row multiplied its operands out
+            // and the polynomials of inferred products grew past the term limit. The
+            // carry, if it is a later node, is the largest variable left and is
+            // substituted next.
+            Some((carry, la, lb)) => {
+                let (pa, pb) = (lit_poly(la), lit_poly(lb));
+                let t: Small = vec![(vec![carry], 1)];
+                if la & 1 == lb & 1 {
+                    lin(&[(&pa, 1), (&pb, 1), (&t, 2u64.wrapping_neg())])
+                } else {
+                    let one: Small = vec![(vec![], 1)];
+                    lin(&[(&one, 1), (&pa, u64::MAX), (&pb, u64::MAX), (&t, 2)])
+                }
+            }
+            None => node_poly(node),
+        };
         let with_v = p.terms.split_off(&vec![v]);
         for (m, coeff) in with_v {
             let rest = &m[1..];
@@ -382,6 +499,57 @@ mod tests {
         }
     }
 
+    /// `a * b` (vars 1..=4 and 5..=7 of [`products`]) as a polynomial.
+    fn product_polynomial() -> Vec<Term> {
+        let mut t = Vec::new();
+        for i in 0..4u32 {
+            for j in 0..3u32 {
+                t.push((vec![i + 1, 5 + j], 1u64 << (i + j)));
+            }
+        }
+        t
+    }
+
+    #[test]
+    fn a_product_equals_its_polynomial_and_a_dropped_carry_does_not() {
+        // Word 1 of `products` is the one with the fault: compare it with the polynomial.
+        let (v, _) = equals_polynomial(&products(None), 1, &product_polynomial(), 7).unwrap();
+        assert_eq!(v, Verdict::Equal);
+        let mut caught = 0;
+        for bit in 0..6 {
+            let c = products(Some(bit));
+            let (v, _) = equals_polynomial(&c, 1, &product_polynomial(), 7).unwrap();
+            let truth = |f: &[bool]| {
+                let (a, b) = (word(&f[..4]), word(&f[4..]));
+                (a * b) & 127
+            };
+            match v {
+                Verdict::Equal => assert!((0..128u32).all(|x| {
+                    let f: Vec<bool> = (0..7).map(|i| (x >> i) & 1 == 1).collect();
+                    word(&c.eval(&f)[1]) == truth(&f)
+                })),
+                Verdict::Differ { input, difference } => {
+                    let got = word(&c.eval(&input)[1]);
+                    assert_eq!(
+                        got.wrapping_sub(truth(&input)) & 127,
+                        difference,
+                        "carry {bit}"
+                    );
+                    caught += 1;
+                }
+            }
+        }
+        // The others are carries that cannot be 1 there (shown harmless by evaluation above).
+        assert!(caught >= 3, "only {caught} dropped carries caught");
+        // A wrong specification is caught too: one coefficient off.
+        let mut wrong = product_polynomial();
+        wrong[5].1 += 1;
+        let (v, _) = equals_polynomial(&products(None), 0, &wrong, 7).unwrap();
+        assert!(matches!(v, Verdict::Differ { .. }));
+        // A variable that is not an input is refused, not treated as a node.
+        assert!(equals_polynomial(&products(None), 0, &[(vec![8], 1)], 7).is_err());
+    }
+
     /// Random circuits of every node kind: the verdict agrees with evaluation on all 2^6
     /// inputs, and a counterexample really differs by the difference reported.
     #[test]
@@ -401,10 +569,18 @@ mod tests {
                     pool[rng.below(pool.len() as u64) as usize] ^ rng.bits(1) as Lit
                 };
                 let (x, y, z) = (pick(&mut rng), pick(&mut rng), pick(&mut rng));
-                let l = match rng.below(3) {
+                let l = match rng.below(4) {
                     0 => c.and(x, y),
                     1 => c.xor(x, y),
-                    _ => c.mux(x, y, z),
+                    2 => c.mux(x, y, z),
+                    _ => {
+                        // A half adder, its AND's operands complemented alike or not (the
+                        // XOR rewriting's and the exclusion's cases): both nodes kept.
+                        let n = rng.bits(2) as Lit;
+                        let carry = c.and(x ^ (n & 1), y ^ (n >> 1));
+                        pool.push(carry);
+                        c.xor(x, y)
+                    }
                 };
                 pool.push(l);
             }

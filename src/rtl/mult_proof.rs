@@ -443,46 +443,88 @@ fn assignment_text(sigs: &[(String, u128)]) -> String {
         .join(", ")
 }
 
+/// The specification `sum of a * b << shift, plus c` as a polynomial over the free input
+/// bits `free` of a case's circuit (variable k + 1 is `free[k]`), the other bits being the
+/// constants `fixed` gives them: each word is `sum 2^i x_i`, and the products are multiplied
+/// out, coefficients modulo 2^64 (the engine reduces them modulo 2^m <= 2^64); with its
+/// largest value in the case under the premises (an upper bound: exact but for a signal in
+/// two products). It is the
+/// same [`TreeSpec`] the miter's Verilog `spec` is written from ([`wrapper`]), stated as
+/// arithmetic, not gates.
+fn spec_polynomial(
+    t: &TreeSpec,
+    free: &[(String, u32)],
+    fixed: &impl Fn(&str, usize) -> Option<bool>,
+) -> Result<(Vec<algebra::Term>, u128)> {
+    // A word's bits that are not the constant 0: (its variable, or None for a constant
+    // 1, and the bit's position).
+    let word = |name: &str, width: u32| -> Result<Vec<(Option<u32>, u32)>> {
+        let mut out = Vec::new();
+        for i in 0..width {
+            match fixed(name, i as usize) {
+                Some(false) => {}
+                Some(true) => out.push((None, i)),
+                None => match free.iter().position(|(p, b)| p == name && *b == i) {
+                    Some(k) => out.push((Some(k as u32 + 1), i)),
+                    None => bail!("input bit {name}[{i}] is neither free nor fixed in the netlist"),
+                },
+            }
+        }
+        Ok(out)
+    };
+    // 2^e modulo 2^64.
+    let pow = |e: u32| if e < 64 { 1u64 << e } else { 0 };
+    // A word's largest value here under the premises: every bit that is not the constant 0
+    // set, or the premise's bound if that is less.
+    let top = |name: &str, w: &[(Option<u32>, u32)]| {
+        let all = w.iter().map(|&(_, i)| 1u128 << i).sum::<u128>();
+        t.at_most
+            .iter()
+            .filter(|(s, _)| s.name == name)
+            .fold(all, |m, &(_, b)| m.min(b))
+    };
+    let (mut terms, mut max) = (Vec::new(), t.constant);
+    for p in &t.products {
+        let a = word(&p.a.name, p.a.width)?;
+        match &p.b {
+            Factor::Sig(sig) => {
+                let b = word(&sig.name, sig.width)?;
+                max += (top(&p.a.name, &a) * top(&sig.name, &b)) << p.shift;
+                for &(x, i) in &a {
+                    for &(y, j) in &b {
+                        terms.push((x.into_iter().chain(y).collect(), pow(i + j + p.shift)));
+                    }
+                }
+            }
+            Factor::Const(k) => {
+                max += (top(&p.a.name, &a) * k) << p.shift;
+                for &(x, i) in &a {
+                    terms.push((
+                        x.into_iter().collect(),
+                        (*k as u64).wrapping_mul(pow(i + p.shift)),
+                    ));
+                }
+            }
+        }
+    }
+    terms.push((Vec::new(), t.constant as u64));
+    Ok((terms, max))
+}
+
 /// The algebraic engine's result for `job`, from the gate netlist Yosys wrote
-/// ([`Job::json_file`]). For each case the miter's `got` and `spec` words are shown equal
-/// modulo 2^m as polynomials over the free input bits (docs/VERIFICATION.md, "The
-/// algebraic engine", gives why that is the miter's `ok` on every input):
-/// - m is the bit length of the specification's largest value under the premises, so
-///   equal modulo 2^m is equal, once `got` is shown below 2^m (its bits from m up are the
-///   constant 0 in the netlist, checked here); when they are not, m is the words' whole
-///   width;
+/// ([`Job::json_file`]). For each case the miter's `got` word is shown equal to the
+/// specification modulo 2^m as polynomials over the free input bits, the specification's
+/// polynomial computed from the [`TreeSpec`] ([`spec_polynomial`]) rather than rewritten
+/// from the miter's gates (docs/VERIFICATION.md, "The algebraic engine", gives why that is
+/// the miter's `ok` on every input):
+/// - m, per case, is the least with both words below 2^m: at least the bit length of the
+///   specification's largest value in the case, and above the sum's highest bit that is
+///   not the constant 0 in the case's circuit; so equal modulo 2^m is equal;
 /// - an input bounded by a premise (`x <= bound`) has its bits at and above the bound's
 ///   length fixed at 0: an input with one of them set breaks the premise.
 pub fn algebraic(job: &Job, json: &str) -> Result<TreeResult> {
     let t = &job.spec;
     let net = Netlist::parse(json, &job.wrapper_name())?;
-    let m = bits(t.max());
-    let undecided = |why: String, cases: usize| TreeResult {
-        name: job.name(),
-        title: t.title.clone(),
-        engine: Engine::Algebra,
-        cases,
-        proved: 0,
-        failed: None,
-        undecided: Some(why),
-        peak_terms: 0,
-    };
-    // Compared modulo 2^m: the specification's bit length when the sum's bits from there up
-    // are the constant 0 (then both words are below 2^m under the premises), else the whole
-    // width of the miter's words (then equal modulo 2^m is equal outright).
-    let width = net.width("got")?;
-    let above_zero = (m as usize..width)
-        .map(|i| net.is_const("got", i, false))
-        .collect::<Result<Vec<bool>>>()?
-        .into_iter()
-        .all(|z| z);
-    let m = if above_zero { m } else { width as u32 };
-    if m > 64 {
-        return Ok(undecided(
-            format!("its words have {m} bits, over the engine's 64"),
-            1,
-        ));
-    }
     let cases = job.cases();
     let ports = net.input_ports();
     for case in &cases {
@@ -509,8 +551,23 @@ pub fn algebraic(job: &Job, json: &str) -> Result<TreeResult> {
                     .any(|(s, b)| s == p && i as u32 >= *b)
                     .then_some(false)
             };
-            let c = net.simplify(&["got", "spec"], fixed)?;
-            let (v, stats) = algebra::equal_mod(&c, 0, 1, m)?;
+            let c = net.simplify(&["got"], fixed)?;
+            let (spec, max) = spec_polynomial(t, &c.inputs, &fixed)?;
+            // Compared modulo 2^m, m the least with both words below 2^m in this case: the
+            // specification's largest value here has m bits at most, and the sum's bits
+            // from m up are the constant 0 in this case's circuit. Then equal modulo 2^m is
+            // equal. The least m matters: a sum narrower than the miter's word (a0's 17
+            // bits of 19) is a truncated adder, whose dropped carries only cancel modulo
+            // 2^17, after the polynomial passed 2 million terms modulo 2^19.
+            let top = c.outputs[0]
+                .iter()
+                .rposition(|&l| l != 0)
+                .map_or(0, |i| i + 1);
+            let m = bits(max).max(top as u32);
+            if m > 64 {
+                bail!("its words have {m} bits, over the engine's 64");
+            }
+            let (v, stats) = algebra::equals_polynomial(&c, 0, &spec, m)?;
             Ok((v, stats, c.inputs))
         })
         .collect();
