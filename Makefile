@@ -55,7 +55,7 @@ roms: build
 # AXI4-Stream top under cocotb (axis-test: makes the venv first), the default design placed
 # and routed (fpga-check: block RAMs and the Fmax target, ~20 s) and the same on an ECP5
 # (fpga-check-ecp5, ~1-2 min), the formal proofs of the handshake top with their planted faults
-# (formal, narrowest and default design, ~4 min), the multiplier proofs (formal-mult, ~1 min) and the default design's
+# (formal, narrowest and default design, ~4 min), the multiplier proofs (formal-mult: the default design and every grid row, ~1.5 min) and the default design's
 # synth_ice40 netlist simulated with the top testbench (gate-sim, ~2 min). The venv comes
 # before the cargo tests, whose ECP5 flow tests need its YoWASP tools.
 test: tools venv cargo-test lint synth sim-all sim-handshake axis-test formal formal-mult fpga-check fpga-check-ecp5 gate-sim
@@ -211,26 +211,21 @@ prove: build
 	exit $$status
 
 # ---- Multipliers (rmapgen prove-mult, src/rtl/mult_proof.rs): every adder tree of a
-# generated design equals the product its plan states (a * b + c) on every input (engine
-# auto: every input evaluated up to 2^34, else shown equal as polynomials): the default
-# design ($(OUT), 5 trees) and the narrowest design with every tree stage ($(MULT_OUT), 11
-# trees), seconds each. formal-mult-grid runs the algebraic engine over every row of the
-# parameter grid (benchmark-style, not in make test): 35 of 36 rows proved in ~8 min on one
-# core; widest_infer's inferred interpolate sums are not (docs/VERIFICATION.md). The planted
-# faults are in the cargo tests (tests/it/mult_proof.rs). Logs in $(MULT_BUILD)/<design>.
-MULT_OUT   ?= build/rtl_mult
+# generated design equals the product its plan states (a * b + c) on every input. The
+# default design ($(OUT), 5 trees) under engine auto (every input evaluated, ~10 s), then
+# every row of the parameter grid (src/grid.rs, 36 rows, 249 trees, generated into
+# $(MULT_GRID)) under the algebraic engine (sum and specification shown equal as
+# polynomials): ~1 min on 2 cores, each row's report printed whole, exit 1 naming a row that
+# fails. The planted faults are in the cargo tests (tests/it/mult_proof.rs). Logs in
+# $(MULT_BUILD)/<design>.
 MULT_BUILD ?= build/prove-mult
-MULT_FLAGS ?= --grad-bits 8 --red-bits 6 --recip-bits 5 --frac-bits 4 --index-bits 2 --interp-bits 1 --map-bits 6 --color --pipeline-depth 0
+MULT_GRID  ?= build/mult-grid
 
-.PHONY: formal-mult formal-mult-grid
+.PHONY: formal-mult
 
 formal-mult: build
-	$(RMAPGEN) generate --out $(MULT_OUT) $(MULT_FLAGS)
 	YOSYS=$(YOSYS) $(RMAPGEN) prove-mult $(OUT) --logs $(MULT_BUILD)/$(notdir $(OUT))
-	YOSYS=$(YOSYS) $(RMAPGEN) prove-mult $(MULT_OUT) --logs $(MULT_BUILD)/$(notdir $(MULT_OUT))
-
-formal-mult-grid: build
-	YOSYS=$(YOSYS) $(RMAPGEN) prove-mult build/matrix --matrix --engine algebra --logs $(MULT_BUILD)/grid
+	YOSYS=$(YOSYS) $(RMAPGEN) prove-mult $(MULT_GRID) --matrix --engine algebra --logs $(MULT_BUILD)/grid
 
 # ---- FPGA (src/rtl/fpga.rs): Yosys synth_ice40 and nextpnr-ice40 on the default design built
 # for the iCE40 (--target ice40; rtl_out/ is the portable --target generic): post-route Fmax,

@@ -66,9 +66,9 @@ enum Command {
     /// Synthesise a generated design with Yosys as a check: no latch, the memories inferred;
     /// prints its cells, memory bits and block RAMs (exit 1 if Yosys fails on it).
     Synth(cmd::synth::SynthArgs),
-    /// Prove with Yosys (sat) that every adder tree of a generated design equals the plain
-    /// product its plan builds (`a * b + c`) on every input; exit 1 naming each tree
-    /// that is not.
+    /// Prove that every adder tree of a generated design equals the plain product its plan
+    /// builds (`a * b + c`) on every input, from Yosys's netlist of the tree (every input
+    /// evaluated, polynomials, or Yosys `sat`); exit 1 naming each tree that is not.
     ProveMult(cmd::prove_mult::ProveMultArgs),
     /// Lint a generated design with Verilator --lint-only -Wall (exit 1 on any warning).
     Lint(cmd::lint::LintArgs),
