@@ -322,19 +322,29 @@ fn sweep(p: &Program, free: usize) -> Option<u64> {
 /// A failing input: each signal's value.
 pub type Assignment = Vec<(String, u128)>;
 
+/// Refuses a case that sets a signal the miter does not have as an input (`is_input`): the
+/// engines would otherwise prove the miter with that signal left free or unset, not the case.
+pub fn cases_name_inputs(
+    cases: &[Vec<(String, u128)>],
+    is_input: impl Fn(&str) -> bool,
+) -> Result<()> {
+    for case in cases {
+        for (s, _) in case {
+            if !is_input(s) {
+                bail!("the case signal {s} is not an input of the miter");
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Evaluates `aig` on every input: for each case (values of some signals, the rest
 /// enumerated). Returns the first failing input (cases in order, then input order), or None
 /// when `ok` is 1 everywhere. Signals named in a case must be inputs of the graph.
 pub fn exhaustive(aig: &Aig, cases: &[Vec<(String, u128)>]) -> Result<Option<Assignment>> {
     aig.single_output()?;
     let used = aig.used();
-    for case in cases {
-        for (s, _) in case {
-            if !aig.inputs.iter().any(|(n, _)| n == s) {
-                bail!("the case signal {s} is not an input of the miter");
-            }
-        }
-    }
+    cases_name_inputs(cases, |s| aig.inputs.iter().any(|(n, _)| n == s))?;
     let failure = cases
         .par_iter()
         .map(|case| {

@@ -527,13 +527,7 @@ pub fn algebraic(job: &Job, json: &str) -> Result<TreeResult> {
     let net = Netlist::parse(json, &job.wrapper_name())?;
     let cases = job.cases();
     let ports = net.input_ports();
-    for case in &cases {
-        for (s, _) in case {
-            if !ports.iter().any(|(p, _)| p == s) {
-                bail!("the case signal {s} is not an input of the miter");
-            }
-        }
-    }
+    aig::cases_name_inputs(&cases, |s| ports.iter().any(|(p, _)| p == s))?;
     let bound_bits: Vec<(String, u32)> = t
         .at_most
         .iter()
