@@ -388,6 +388,14 @@ pub fn exhaustive(aig: &Aig, cases: &[Vec<(String, u128)>]) -> Result<Option<Ass
 mod tests {
     use super::*;
 
+    #[test]
+    fn a_case_naming_a_signal_the_miter_lacks_is_refused() {
+        let cases = vec![vec![("w".to_string(), 3)], vec![("wc".to_string(), 1)]];
+        let err = cases_name_inputs(&cases, |s| s == "w").unwrap_err();
+        assert!(err.to_string().contains("case signal wc"), "{err}");
+        cases_name_inputs(&cases, |s| s == "w" || s == "wc").unwrap();
+    }
+
     /// `ok = x XOR y`, built by hand: false at x = y.
     fn xor_aig() -> (String, String) {
         // ok = x XOR y over two inputs: 1 = x (var 1), 2 = y (var 2);
