@@ -34,6 +34,9 @@ enum Command {
     Vectors(cmd::vectors::VectorsArgs),
     /// Ray cast a volume (raw, NRRD or the synthetic engine block) shaded by the model and the float reference.
     Volume(cmd::volume::VolumeArgs),
+    /// Measure one image against another (PNG, same size and kind): largest, mean and RMS
+    /// error in LSBs, PSNR and where the worst sample is.
+    Compare(cmd::compare::CompareArgs),
     /// Run the model over every gradient (--exhaustive) or a sample sweeping every magnitude,
     /// and report the worst angular and intensity errors per magnitude class.
     Stress(cmd::stress::StressArgs),
@@ -99,6 +102,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Fpga(a) => done(cmd::fpga::run(&a)),
         Command::Fit(a) => done(cmd::fit::run(&a)),
         Command::Volume(a) => done(cmd::volume::run(&a)),
+        Command::Compare(a) => done(cmd::compare::run(&a)),
         Command::Sim(a) => cmd::sim::run(&a),
         Command::Synth(a) => cmd::synth::run(&a),
         Command::ProveMult(a) => cmd::prove_mult::run(&a),

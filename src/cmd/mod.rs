@@ -1,6 +1,7 @@
 //! One file per subcommand; each owns its clap arguments and its `run`.
 
 pub mod bench;
+pub mod compare;
 pub mod config_args;
 pub mod fit;
 pub mod force;

@@ -823,6 +823,11 @@ fn readme_limits_table_quotes_the_constants() {
         format!("`1..={}`", rmapgen::cmd::fit::MAX_SYNTH_LIMIT),
         format!("`{}` voxels", rmapgen::volume::MAX_VOXELS),
         format!(
+            "`{}` pixels a side, `{}` decoded",
+            rmapgen::cmd::compare::MAX_SIDE,
+            rmapgen::volume::human_bytes(rmapgen::cmd::compare::MAX_ALLOC).replace(".0", "")
+        ),
+        format!(
             "`{}`",
             rmapgen::volume::human_bytes(rmapgen::volume::load::MAX_READ_BYTES).replace(".0", "")
         ),

@@ -4,6 +4,7 @@ mod alloc;
 mod bench;
 mod cmd_render;
 mod cmd_sim;
+mod compare;
 mod ecp5;
 mod errors;
 mod fast;
