@@ -245,9 +245,9 @@ fn rewrite(c: &Circuit, got: usize, spec: Spec, m: u32) -> Result<(Verdict, Stat
     let base = c.inputs.len() as u32 + 1;
     // For each XOR node, an AND node of the same two variables, either complemented: the
     // half adder it belongs to (Yosys's ripple carries are ORs, so the carry a sum bit
-    // reads is often the complement of a node).
-    // Of several, the one complemented alike nearest to the XOR: another AND of the same
-    // operands elsewhere in the netlist would bring an unrelated node into the polynomial.
+    // reads is often the complement of a node). Of several, the one complemented alike
+    // nearest to the XOR: another AND of the same operands elsewhere in the netlist would
+    // bring an unrelated node into the polynomial.
     let mut ands: std::collections::HashMap<(u32, u32), Vec<Carry>> = Default::default();
     for (k, n) in c.nodes.iter().enumerate() {
         if let Node::And(a, b) = *n {

@@ -448,9 +448,8 @@ fn assignment_text(sigs: &[(String, u128)]) -> String {
 /// constants `fixed` gives them: each word is `sum 2^i x_i`, and the products are multiplied
 /// out, coefficients modulo 2^64 (the engine reduces them modulo 2^m <= 2^64); with its
 /// largest value in the case under the premises (an upper bound: exact but for a signal in
-/// two products). It is the
-/// same [`TreeSpec`] the miter's Verilog `spec` is written from ([`wrapper`]), stated as
-/// arithmetic, not gates.
+/// two products). It is the same [`TreeSpec`] the miter's Verilog `spec` is written from
+/// ([`wrapper`]), stated as arithmetic, not gates.
 fn spec_polynomial(
     t: &TreeSpec,
     free: &[(String, u32)],

@@ -9,6 +9,17 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
+/// `rmapgen compare --json image reference`, parsed.
+fn json(image: &Path, reference: &Path) -> serde_json::Value {
+    let out = run(&["compare", "--json", s(image), s(reference)]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
 #[test]
 fn the_figures_are_those_of_the_planted_differences() {
     let tmp = tempdir();
@@ -42,8 +53,7 @@ fn the_figures_are_those_of_the_planted_differences() {
         assert!(text.contains(want), "{want:?} in {text}");
     }
 
-    let out = run(&["compare", "--json", s(&a), s(&b)]);
-    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let j = json(&a, &b);
     assert_eq!(j["max_abs_error"], 3);
     assert_eq!(j["worst_pixel"], serde_json::json!([4, 2, 0]));
     assert_eq!(j["abs_error_histogram"], serde_json::json!([198, 1, 0, 1]));
@@ -60,8 +70,7 @@ fn sixteen_bit_and_rgba_images_use_their_own_peak_and_channels() {
     let (a, b) = (tmp.path().join("a16.png"), tmp.path().join("b16.png"));
     g16(0).save(&a).unwrap();
     g16(300).save(&b).unwrap();
-    let out = run(&["compare", "--json", s(&a), s(&b)]);
-    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let j = json(&a, &b);
     assert_eq!(j["kind"], "gray16");
     assert_eq!(j["peak"], 65535);
     assert_eq!(j["max_abs_error"], 300);
@@ -75,8 +84,7 @@ fn sixteen_bit_and_rgba_images_use_their_own_peak_and_channels() {
     let (c, d) = (tmp.path().join("c.png"), tmp.path().join("d.png"));
     rgba(250).save(&c).unwrap();
     rgba(255).save(&d).unwrap();
-    let out = run(&["compare", "--json", s(&c), s(&d)]);
-    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let j = json(&c, &d);
     assert_eq!(j["kind"], "rgba8");
     assert_eq!(j["pixels"], 24);
     assert_eq!(j["worst_pixel"], serde_json::json!([1, 0, 3]));
