@@ -35,7 +35,8 @@ tools:
 
 # rmapgen against VolPack (classified shear-warp) on VolPack's MRI head, 256^2 and 512^2, 1 and
 # 2 threads, in one run (scripts/bench-volume.sh; installs libvolpack1-dev when missing). A
-# benchmark, not part of make test; figures in docs/PERFORMANCE.md.
+# benchmark, not part of make test; figures in docs/PERFORMANCE.md. REPEAT=N frames per
+# figure, CASTERS="shear-warp ray shear-4x3" (a subset) to time only some casters.
 .PHONY: bench-volume
 bench-volume: build
 	@WITH_VOLPACK=1 scripts/install-tools.sh

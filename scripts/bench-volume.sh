@@ -10,6 +10,8 @@
 # and its load (docs/PERFORMANCE.md).
 set -euo pipefail
 REPEAT=${REPEAT:-9}
+# CASTERS: the rmapgen casters to run, a subset of the labels below (all three by default).
+CASTERS=${CASTERS:-shear-warp ray shear-4x3}
 BUILD=${BUILD:-build/bench-volume}
 RMAPGEN=${RMAPGEN:-target/release/rmapgen}
 DEN=/usr/share/doc/libvolpack1-dev/examples/brainsmall.den
@@ -31,7 +33,8 @@ declare -A CASTER=(
 )
 for size in 256 512; do
   for threads in 1 2; do
-    for caster in shear-warp ray shear-4x3; do
+    for caster in $CASTERS; do
+      [ -n "${CASTER[$caster]:-}" ] || { echo "bench-volume: unknown caster $caster (CASTERS)" >&2; exit 2; }
       vp=$("$BUILD/volpack_bench" "$DEN" "$REPEAT" "$size" | awk '{print $3}')
       out="$BUILD/rmapgen-$caster-$size-$threads"
       # shellcheck disable=SC2086 # the label's arguments are words

@@ -322,7 +322,6 @@ impl<'a> ShearWarp<'a> {
         let ns = self.slices.len();
         let pw = self.width + 2;
         let tf = &self.tf;
-        let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
         let mut bbox = Bbox::EMPTY;
         // Early ray termination without visiting opaque pixels (VolPack's pixel skip links):
         // `link[p]` is 0 for a pixel still open, else a distance to jump towards the next
@@ -383,35 +382,30 @@ impl<'a> ShearWarp<'a> {
                         let before = im[px][1];
                         st.evaluated += 1;
                         let i = base + ca * sa;
-                        let cell = |i: usize| (vox[i], vox[i + sa], vox[i + sb], vox[i + sa + sb]);
-                        let value = |(q00, q10, q01, q11): (Voxel, Voxel, Voxel, Voxel)| {
-                            lerp(lerp(q00.v, q10.v, fa), lerp(q01.v, q11.v, fa), fb)
-                        };
-                        let grad = |(q00, q10, q01, q11): (Voxel, Voxel, Voxel, Voxel), x| {
-                            lerp(
-                                lerp(q00.g[x] as f32, q10.g[x] as f32, fa),
-                                lerp(q01.g[x] as f32, q11.g[x] as f32, fa),
-                                fb,
-                            )
-                        };
-                        let near = cell(i);
-                        let far = if deep { cell(i + sc) } else { near };
+                        // The value first: a transparent sample reads no gradient.
                         let v = if deep {
-                            lerp(value(near), value(far), t)
+                            lerp(
+                                cell_value(vox, i, sa, sb, fa, fb),
+                                cell_value(vox, i + sc, sa, sb, fa, fb),
+                                t,
+                            )
                         } else {
-                            value(near)
+                            cell_value(vox, i, sa, sb, fa, fb)
                         };
                         let o = tf.value_opacity(v);
                         if skip && o == 0.0 {
                             continue;
                         }
-                        let g = [0, 1, 2].map(|x| {
-                            super::cast::march::round_half_away(if deep {
-                                lerp(grad(near, x), grad(far, x), t)
-                            } else {
-                                grad(near, x)
-                            })
-                        });
+                        let gf = if deep {
+                            let (n, f) = (
+                                cell_gradient(vox, i, sa, sb, fa, fb),
+                                cell_gradient(vox, i + sc, sa, sb, fa, fb),
+                            );
+                            [0, 1, 2].map(|x| lerp(n[x], f[x], t))
+                        } else {
+                            cell_gradient(vox, i, sa, sb, fa, fb)
+                        };
+                        let g = gf.map(super::cast::march::round_half_away);
                         // The ramp only lowers the opacity: the value test above skips
                         // nothing visible.
                         let alpha = tf.correct(tf.with_gradient(o, g));
@@ -618,26 +612,61 @@ impl<'a> ShearWarp<'a> {
                 ar[..x0].fill(0.0);
                 vr[x1..].fill(0.0);
                 ar[x1..].fill(0.0);
-                let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
-                for x in x0..x1 {
+                let rows = vr[x0..x1].iter_mut().zip(&mut ar[x0..x1]);
+                for (x, (v, a)) in (x0..x1).zip(rows) {
                     let xf = x as f64;
                     // Padded positions.
                     let (pi, pj) = (i0 + m[1] * xf + 1.0, j0 + m[4] * xf + 1.0);
                     if pi <= bi.0 + 1.0 || pj <= bj.0 + 1.0 || pi >= bi.1 + 1.0 || pj >= bj.1 + 1.0
                     {
-                        vr[x] = 0.0;
-                        ar[x] = 0.0;
+                        (*v, *a) = (0.0, 0.0);
                         continue;
                     }
                     let (i, j) = (pi as u32 as usize, pj as u32 as usize);
                     let (ti, tj) = ((pi - i as f64) as f32, (pj - j as f64) as f32);
                     let q = j * pw + i;
-                    let (p00, p10, p01, p11) = (im[q], im[q + 1], im[q + pw], im[q + pw + 1]);
-                    vr[x] = lerp(lerp(p00[0], p10[0], ti), lerp(p01[0], p11[0], ti), tj);
-                    ar[x] = lerp(lerp(p00[1], p10[1], ti), lerp(p01[1], p11[1], ti), tj);
+                    let (r0, r1) = (&im[q..q + 2], &im[q + pw..q + pw + 2]);
+                    let at = |c: usize| {
+                        lerp(
+                            lerp(r0[0][c], r0[1][c], ti),
+                            lerp(r1[0][c], r1[1][c], ti),
+                            tj,
+                        )
+                    };
+                    (*v, *a) = (at(0), at(1));
                 }
             });
     }
+}
+
+#[inline(always)]
+fn lerp(a: f32, b: f32, t: f32) -> f32 {
+    a + (b - a) * t
+}
+
+/// The bilinear interpolation (weights `fa` along a, then `fb` along b) of the values of the
+/// slice cell whose first voxel is `vox[i]` (strides `sa`, `sb`).
+///
+/// Scalar reads on purpose: the four voxels built as a tuple were copied through the stack
+/// and read back with wider loads, a store-forwarding stall on every sample that cost the
+/// compositing about a quarter of its time (docs/PERFORMANCE.md).
+#[inline(always)]
+fn cell_value(vox: &[Voxel], i: usize, sa: usize, sb: usize, fa: f32, fb: f32) -> f32 {
+    let (q00, q10, q01, q11) = (vox[i].v, vox[i + sa].v, vox[i + sb].v, vox[i + sa + sb].v);
+    lerp(lerp(q00, q10, fa), lerp(q01, q11, fa), fb)
+}
+
+/// [`cell_value`] of the quantised gradients, per component (before rounding).
+#[inline(always)]
+fn cell_gradient(vox: &[Voxel], i: usize, sa: usize, sb: usize, fa: f32, fb: f32) -> [f32; 3] {
+    let (q00, q10, q01, q11) = (vox[i].g, vox[i + sa].g, vox[i + sb].g, vox[i + sa + sb].g);
+    [0, 1, 2].map(|x| {
+        lerp(
+            lerp(q00[x] as f32, q10[x] as f32, fa),
+            lerp(q01[x] as f32, q11[x] as f32, fa),
+            fb,
+        )
+    })
 }
 
 /// A planted geometry fault (tests only): each must make the geometry test against the ray
