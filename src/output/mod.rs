@@ -283,8 +283,19 @@ impl CreatedParents {
         let mut made = CreatedParents { dirs: Vec::new() };
         for d in missing.into_iter().rev() {
             let token = signals::register(Undo::RemoveIfEmpty(d.clone()));
-            std::fs::create_dir(&d)?;
-            made.dirs.push((d, token));
+            match std::fs::create_dir(&d) {
+                Ok(()) => made.dirs.push((d, token)),
+                // Made since the check by another thread or process (`prove-mult --matrix`
+                // starts its rows' logs side by side under one new parent): not ours, so
+                // it is neither removed on failure nor an error.
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && d.is_dir() => {
+                    token.release()
+                }
+                Err(e) => {
+                    token.release();
+                    return Err(e);
+                }
+            }
         }
         Ok(made)
     }
@@ -344,4 +355,55 @@ fn stamp_or_mark(p: &Path) -> bool {
 fn process_alive(pid: &str) -> bool {
     // Where /proc is missing, assume alive: never remove what might still be in use.
     !Path::new("/proc/self").exists() || Path::new("/proc").join(pid).exists()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::Barrier;
+
+    /// Outputs written side by side under one new parent (`prove-mult --matrix` proves rows
+    /// on several threads, each into `logs/<row>`): every one must start, whichever thread
+    /// makes the shared parent. Each round starts 8 threads at once on a fresh parent two
+    /// levels deep, so the check-then-create window is hit.
+    #[test]
+    fn siblings_started_at_once_under_a_new_parent_all_start() {
+        let tmp = tempfile::tempdir().unwrap();
+        let policy = Policy::new(false);
+        for round in 0..40 {
+            let parent = tmp.path().join(format!("r{round}")).join("logs");
+            let barrier = Barrier::new(8);
+            let results: Vec<Result<StagedDir>> = std::thread::scope(|s| {
+                let handles: Vec<_> = (0..8)
+                    .map(|i| {
+                        let (parent, barrier, policy) = (&parent, &barrier, &policy);
+                        s.spawn(move || {
+                            barrier.wait();
+                            StagedDir::new(&parent.join(format!("row{i}")), policy)
+                        })
+                    })
+                    .collect();
+                handles.into_iter().map(|h| h.join().unwrap()).collect()
+            });
+            for (i, r) in results.into_iter().enumerate() {
+                let dir = r.unwrap_or_else(|e| panic!("round {round}, row{i}: {e:#}"));
+                dir.commit().unwrap();
+            }
+            for i in 0..8 {
+                assert!(parent.join(format!("row{i}")).is_dir());
+            }
+        }
+    }
+
+    /// A parent that exists as a file is still an error (only a directory made meanwhile is
+    /// accepted), and nothing is left behind.
+    #[test]
+    fn a_parent_that_is_a_file_is_refused() {
+        let tmp = tempfile::tempdir().unwrap();
+        let file = tmp.path().join("logs");
+        std::fs::write(&file, b"mine").unwrap();
+        let r = StagedDir::new(&file.join("row"), &Policy::new(false));
+        assert!(r.is_err());
+        assert_eq!(std::fs::read(&file).unwrap(), b"mine");
+    }
 }
