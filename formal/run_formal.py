@@ -347,12 +347,13 @@ def main():
         """The proof of the design (name None), or the bounded search on a plant's copy."""
         d = design if name is None else plant(design, build, name)
         run_dir = build / (name or "proof")
-        # The proof's groups go to the pool themselves; a plant is one run on it.
         return run_dir, prove(d, run_dir, a.depth, name is not None, a.solver, pool, a.one_query)
 
-    names = a.plant or [None]
-    for name, (run_dir, (status, failed, secs, p, _)) in zip(
-            names, ordered(pool, run, names) if a.plant else [run(None)]):
+    # Each plant is one run on the pool. The proof runs in this thread and puts its groups on
+    # the pool: run from a worker, it would wait for workers that it occupies (for ever with
+    # --jobs 1).
+    results = ordered(pool, run, a.plant) if a.plant else [run(None)]
+    for name, (run_dir, (status, failed, secs, p, _)) in zip(a.plant or [None], results):
         where = f"{run_dir / 'sby.log'}" if name else f"{run_dir}/group*/sby.log"
         if name is None:
             good = status == "PASS"
