@@ -45,10 +45,43 @@ void* rp_top_new() {
 
 void rp_top_free(void* h) { delete static_cast<Top*>(h); }
 
+// Host writes into the back map buffer, one per clock with no sample: w[3k..3k+3] is the
+// k-th write's axis, address and data. Returns the number of writes applied.
+size_t rp_top_write(void* h, const uint32_t* w, size_t n) {
+    auto* d = static_cast<Top*>(h);
+    auto& t = d->top;
+    t.valid_i = 0;
+    t.swap_i = 0;
+    for (size_t k = 0; k < n; ++k) {
+        t.wr_en_i = 1;
+        t.wr_axis_i = w[3 * k];
+        t.wr_addr_i = w[3 * k + 1];
+        t.wr_data_i = w[3 * k + 2];
+        tick(d);
+    }
+    t.wr_en_i = 0;
+    tick(d);
+    return n;
+}
+
+// Exchanges the front and back map buffers: swap_i high for one clock with no sample (the
+// pipeline is empty: rp_top_run returns only when every result has left).
+void rp_top_swap(void* h) {
+    auto* d = static_cast<Top*>(h);
+    auto& t = d->top;
+    t.valid_i = 0;
+    t.wr_en_i = 0;
+    t.swap_i = 1;
+    tick(d);
+    t.swap_i = 0;
+    tick(d);
+}
+
 // Applies n samples back to back (in[6k..6k+6]: gx gy gz as G-bit fields, then r g b, used
 // with colour) and flushes. out[5k..5k+5] receives the k-th result: zero, i, r, g, b (the
-// colour 0 without colour). Returns 0, or -1 if the pipeline lost or added a sample.
-int rp_top_run(void* h, const uint32_t* in, size_t n, uint32_t* out) {
+// colour 0 without colour). Returns the number of results collected (n), or -1 if the
+// pipeline lost or added a sample.
+long rp_top_run(void* h, const uint32_t* in, size_t n, uint32_t* out) {
     auto* d = static_cast<Top*>(h);
     auto& t = d->top;
     size_t nin = 0, nout = 0;
@@ -91,6 +124,6 @@ int rp_top_run(void* h, const uint32_t* in, size_t n, uint32_t* out) {
     }
     // One clock more: a sample beyond n would show here.
     if (t.valid_o) return -1;
-    return 0;
+    return static_cast<long>(nout);
 }
 }

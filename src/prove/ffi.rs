@@ -61,7 +61,9 @@ type New = unsafe extern "C" fn() -> *mut c_void;
 type Lanes = unsafe extern "C" fn() -> usize;
 type Free = unsafe extern "C" fn(*mut c_void);
 type FrontRun = unsafe extern "C" fn(*mut c_void, *const u16, usize, *mut u8, *mut u64) -> c_int;
-type TopRun = unsafe extern "C" fn(*mut c_void, *const u32, usize, *mut u32) -> c_int;
+type TopRun = unsafe extern "C" fn(*mut c_void, *const u32, usize, *mut u32) -> std::ffi::c_long;
+type TopWrite = unsafe extern "C" fn(*mut c_void, *const u32, usize) -> usize;
+type TopSwap = unsafe extern "C" fn(*mut c_void);
 
 /// The Verilated front (tb/prove_front.cpp): zero detect and sort & shift side by side.
 pub struct Front {
@@ -122,6 +124,8 @@ impl Drop for Front {
 pub struct Top {
     model: *mut c_void,
     run: TopRun,
+    write: TopWrite,
+    swap: TopSwap,
     free: Free,
 }
 
@@ -135,26 +139,51 @@ impl Top {
         unsafe {
             let new: New = std::mem::transmute::<*mut c_void, New>(lib.symbol("rp_top_new")?);
             let run = std::mem::transmute::<*mut c_void, TopRun>(lib.symbol("rp_top_run")?);
+            let write = std::mem::transmute::<*mut c_void, TopWrite>(lib.symbol("rp_top_write")?);
+            let swap = std::mem::transmute::<*mut c_void, TopSwap>(lib.symbol("rp_top_swap")?);
             let free = std::mem::transmute::<*mut c_void, Free>(lib.symbol("rp_top_free")?);
             Ok(Top {
                 model: new(),
                 run,
+                write,
+                swap,
                 free,
             })
         }
     }
 
     /// Applies `input` ([`TOP_IN`] fields per sample) one per clock; `out` receives
-    /// [`TOP_OUT`] fields per result, in order.
-    pub fn run(&mut self, input: &[u32], out: &mut [u32]) -> Result<()> {
+    /// [`TOP_OUT`] fields per result, in order. Returns the number of results the
+    /// simulation delivered (all of them: anything else is an error).
+    pub fn run(&mut self, input: &[u32], out: &mut [u32]) -> Result<u64> {
         let n = input.len() / TOP_IN;
         assert!(input.len() == TOP_IN * n && out.len() >= TOP_OUT * n);
         // SAFETY: the buffers hold n samples each, as rp_top_run reads and writes.
         let r = unsafe { (self.run)(self.model, input.as_ptr(), n, out.as_mut_ptr()) };
-        if r != 0 {
+        if r < 0 || r as usize != n {
             bail!("the Verilated top lost or added a sample among {n}");
         }
+        Ok(r as u64)
+    }
+
+    /// Host writes into the back map buffer, one per clock.
+    pub fn write(&mut self, writes: &[crate::map_stream::Write]) -> Result<()> {
+        let flat: Vec<u32> = writes
+            .iter()
+            .flat_map(|w| [w.axis, w.addr, w.data])
+            .collect();
+        // SAFETY: flat holds 3 words per write, as rp_top_write reads.
+        let n = unsafe { (self.write)(self.model, flat.as_ptr(), writes.len()) };
+        if n != writes.len() {
+            bail!("the Verilated top took {n} of {} host writes", writes.len());
+        }
         Ok(())
+    }
+
+    /// Exchanges the front and back map buffers (the pipeline is empty between runs).
+    pub fn swap(&mut self) {
+        // SAFETY: a model from rp_top_new.
+        unsafe { (self.swap)(self.model) }
     }
 }
 

@@ -126,6 +126,7 @@ pub fn check(
             gin.copy_within(3 * (n - 1)..3 * n, 3 * k);
         }
         front.run(&gin[..3 * padded], &mut zero[..padded], &mut ss[..padded])?;
+        failures.checked += n as u64;
         for k in 0..n {
             if zero[k] == want_zero[k] && ss[k] == want_ss[k] {
                 continue;

@@ -262,6 +262,7 @@ fn check_row(
                     continue;
                 }
                 let idx = first + gx;
+                fails.checked += 1;
                 let gr = gradient(cfg, idx).map(|v| dec_grad(cfg, v));
                 let z = zero_detect::eval(gr);
                 let s = sort_shift::eval(cfg, gr);
@@ -323,6 +324,7 @@ pub fn check(
             })
             .collect();
         for (n, f) in results {
+            failures.checked += f.checked;
             failures.count += f.count - f.kept.len() as u64;
             for m in f.kept {
                 failures.add(m);

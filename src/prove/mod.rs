@@ -25,6 +25,7 @@ pub mod states;
 pub mod structure;
 pub mod top;
 
+use crate::config::Config;
 use crate::design_dir::DesignDir;
 use crate::model::{MapSet, Model};
 use anyhow::{bail, ensure, Context, Result};
@@ -86,9 +87,12 @@ impl Shard {
     }
 }
 
-/// What went wrong in a part: every failure counted, the first [`KEEP_FAILURES`] kept.
+/// What a part found: the inputs it checked (each driven through the simulation or the
+/// gates and compared with the model: counted where that happens, never from loop bounds),
+/// and what went wrong, every failure counted, the first [`KEEP_FAILURES`] kept.
 #[derive(Default)]
 pub struct Failures {
+    pub checked: u64,
     pub count: u64,
     pub kept: Vec<String>,
 }
@@ -136,7 +140,13 @@ pub struct Options {
 
 /// Checks that `rmapgen prove` takes this design.
 pub fn check_design(d: &DesignDir, direct: bool) -> Result<()> {
-    let g = d.config.grad_bits;
+    check_limits(&d.config, direct)
+}
+
+/// Checks that `rmapgen prove` takes a design of configuration `cfg` (the bounds of every
+/// allocation and loop of a run or a merge).
+pub fn check_limits(cfg: &Config, direct: bool) -> Result<()> {
+    let g = cfg.grad_bits;
     if direct {
         ensure!(
             g <= MAX_DIRECT_BITS,
@@ -148,11 +158,158 @@ pub fn check_design(d: &DesignDir, direct: bool) -> Result<()> {
             "rmapgen prove covers 2^(3 grad_bits) gradients; grad_bits = {g} is above {MAX_GRAD_BITS}"
         );
         ensure!(
-            d.config.red_bits <= states::MAX_RED_BITS,
+            cfg.red_bits <= states::MAX_RED_BITS,
             "rmapgen prove keeps one bit per sort & shift state (24 x 2^(3 red_bits - 1)); red_bits = {} is above {}",
-            d.config.red_bits,
+            cfg.red_bits,
             states::MAX_RED_BITS
         );
+    }
+    Ok(())
+}
+
+/// The number of inputs of part `name` of a run of a configuration whose gradient has
+/// `grad_bits` bits and whose sort & shift has `states` states: the one formula a run
+/// reports and a merge requires.
+fn part_total(name: &str, grad_bits: u32, states: u64) -> u64 {
+    let gradients = 1u64 << (3 * grad_bits);
+    let passes = PASSES.len() as u64;
+    match name {
+        "structure" | "zero" => 1,
+        "front" => gradients,
+        "direct" => passes * gradients,
+        "states" => passes * states,
+        _ => unreachable!("a part of FACTORED or DIRECT"),
+    }
+}
+
+/// Every part of a run of `cfg` (factored or `--direct`) with its number of inputs.
+pub fn totals(cfg: &Config, direct: bool) -> Result<Vec<(&'static str, u64)>> {
+    let names: &[&'static str] = if direct { &DIRECT } else { &FACTORED };
+    let states = if direct { 0 } else { state_count(cfg)? };
+    Ok(names
+        .iter()
+        .map(|&n| (n, part_total(n, cfg.grad_bits, states)))
+        .collect())
+}
+
+/// The sort & shift states of `cfg` and their set, each visited once, in order.
+fn state_set(cfg: &Config) -> Result<(u64, states::StateSet)> {
+    let mut count = 0u64;
+    let set = states::enumerate(cfg, |ord, _| {
+        ensure!(
+            ord == count,
+            "state enumeration: state {ord} where {count} was due"
+        );
+        count += 1;
+        Ok(())
+    })?;
+    ensure!(
+        set.len() == count,
+        "state enumeration: {count} states visited, {} in the set",
+        set.len()
+    );
+    Ok((count, set))
+}
+
+fn state_count(cfg: &Config) -> Result<u64> {
+    Ok(state_set(cfg)?.0)
+}
+
+/// What the harness does to the map buffers before a pass of the top.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Step {
+    /// Exchange the front and back buffers (`swap_i`).
+    Swap,
+    /// Write every entry of the design's second map into the back buffer through the host
+    /// port (`wr_en_i`, in [`crate::map_stream::writes`] order).
+    WriteSecond,
+}
+
+/// One pass of the top's samples over one map buffer: the steps before it, and the map the
+/// front buffer must then hold (0: the scene's, the initial contents of both buffers; 1:
+/// the second map).
+#[derive(Clone, Copy, Debug)]
+pub struct Pass {
+    pub label: &'static str,
+    pub before: &'static [Step],
+    pub expect: u64,
+}
+
+/// The passes of the top, in order: each buffer as loaded at reset, and each buffer written
+/// through the host port. The second pass writes into buffer 0 while buffer 1 is read
+/// (writes must reach only the back buffer); the fourth writes buffer 1. So every entry of
+/// both buffers' init contents, the write port into either buffer and the swap are observed
+/// at the outputs (docs/VERIFICATION.md, "Both map buffers").
+pub const PASSES: [Pass; 4] = [
+    Pass {
+        label: "buffer 0 as loaded",
+        before: &[],
+        expect: 0,
+    },
+    Pass {
+        label: "buffer 1 as loaded",
+        before: &[Step::Swap, Step::WriteSecond],
+        expect: 0,
+    },
+    Pass {
+        label: "buffer 0 written",
+        before: &[Step::Swap],
+        expect: 1,
+    },
+    Pass {
+        label: "buffer 1 written",
+        before: &[Step::WriteSecond, Step::Swap],
+        expect: 1,
+    },
+];
+
+/// Runs the [`PASSES`] of a part of the top whose samples are `each` per pass (ordinal
+/// `pass * each + k` for sample k of a pass), those in `range`; `samples(visit)` visits a
+/// pass's samples in order with their index k. Every pass's steps run in every shard, so
+/// that the buffers hold what the pass expects.
+#[allow(clippy::too_many_arguments)]
+fn passes(
+    top: &mut ffi::Top,
+    model: &Model,
+    maps: &MapSet,
+    part: &'static str,
+    each: u64,
+    range: std::ops::Range<u64>,
+    fails: &mut Failures,
+    progress: &Progress,
+    mut samples: impl FnMut(&mut dyn FnMut(u64, [i32; 3]) -> Result<()>) -> Result<()>,
+) -> Result<()> {
+    let second = crate::map_stream::writes(&model.cfg, maps.buffer(1));
+    for (p, pass) in PASSES.iter().enumerate() {
+        for step in pass.before {
+            match step {
+                Step::Swap => top.swap(),
+                Step::WriteSecond => top.write(&second)?,
+            }
+        }
+        let base = p as u64 * each;
+        let mine = range.start.max(base)..range.end.min(base + each);
+        if mine.is_empty() {
+            continue;
+        }
+        let mut batch = top::Batch::new(top, model, maps.buffer(pass.expect), part, mine.start);
+        batch.pass(pass.label);
+        samples(&mut |k, g| {
+            let ord = base + k;
+            if mine.contains(&ord) {
+                batch.push(ord, g, fails, progress)?;
+            }
+            Ok(())
+        })?;
+        if batch.next() != mine.end {
+            fails.add(format!(
+                "{part} ({}): samples {}..{} were never driven",
+                pass.label,
+                batch.next(),
+                mine.end
+            ));
+        }
+        batch.flush(fails, progress)?;
     }
     Ok(())
 }
@@ -177,11 +334,14 @@ pub fn run(d: &DesignDir, build: &Path, opts: &Options, progress: &Progress) -> 
     }
     let wanted = |name: &str| opts.parts.is_empty() || opts.parts.iter().any(|p| p == name);
     let start = Instant::now();
+    // What is proven is the files as they are now: hashed before the run and again after it,
+    // so that a file changed meanwhile cannot be certified.
+    let file_names = report::read_files(d);
+    let files = report::hash_files(d, &file_names)?;
     let cfg = &d.config;
     let model = Model::new(cfg);
     let maps = MapSet::from_dir(cfg, d.path())
         .with_context(|| format!("the maps of {}", d.path().display()))?;
-    let maps = maps.buffer(0);
     let total = 1u64 << (3 * cfg.grad_bits);
     let mut parts = Vec::new();
 
@@ -206,42 +366,56 @@ pub fn run(d: &DesignDir, build: &Path, opts: &Options, progress: &Progress) -> 
     };
     let mut top = top_lib.as_ref().map(ffi::Top::new).transpose()?;
     if let (true, Some(top)) = (opts.direct, top.as_mut()) {
-        let range = opts.shard.range(total);
+        let all = part_total("direct", cfg.grad_bits, 0);
+        let range = opts.shard.range(all);
         let mut fails = Failures::default();
-        let mut batch = top::Batch::new(top, &model, maps, "direct");
-        for idx in range.clone() {
-            let g = front::gradient(cfg, idx).map(|v| crate::vectors::inputs::dec_grad(cfg, v));
-            batch.push(idx, g, &mut fails, progress)?;
-        }
-        batch.flush(&mut fails, progress)?;
-        parts.push(Part::new("direct", range, total, fails).since(t));
+        passes(
+            top,
+            &model,
+            &maps,
+            "direct",
+            total,
+            range.clone(),
+            &mut fails,
+            progress,
+            |visit| {
+                for idx in 0..total {
+                    let g =
+                        front::gradient(cfg, idx).map(|v| crate::vectors::inputs::dec_grad(cfg, v));
+                    visit(idx, g)?;
+                }
+                Ok(())
+            },
+        )?;
+        parts.push(Part::new("direct", range, all, fails).since(t));
     }
     if !opts.direct {
         // The states' enumeration also gives the set the front checks every state against.
-        let mut count = 0;
-        let set = states::enumerate(cfg, |_, _| {
-            count += 1;
-            Ok(())
-        })?;
+        let (count, set) = state_set(cfg)?;
         if let (true, Some(top)) = (wanted("states"), top.as_mut()) {
-            let range = opts.shard.range(count);
+            let all = part_total("states", cfg.grad_bits, count);
+            let range = opts.shard.range(all);
             let mut fails = Failures::default();
-            let mut batch = top::Batch::new(top, &model, maps, "states");
-            states::enumerate(cfg, |ord, g| {
-                if range.contains(&ord) {
-                    batch.push(ord, g, &mut fails, progress)?;
-                }
-                Ok(())
-            })?;
-            batch.flush(&mut fails, progress)?;
-            parts.push(Part::new("states", range, count, fails).since(t));
+            passes(
+                top,
+                &model,
+                &maps,
+                "states",
+                count,
+                range.clone(),
+                &mut fails,
+                progress,
+                |visit| states::enumerate(cfg, &mut *visit).map(|_| ()),
+            )?;
+            parts.push(Part::new("states", range, all, fails).since(t));
         }
         if let (true, Some(top)) = (wanted("zero"), top.as_mut()) {
             let t = report::now();
             let range = opts.shard.range(1);
             let mut fails = Failures::default();
             if !range.is_empty() {
-                let mut batch = top::Batch::new(top, &model, maps, "zero");
+                let front = maps.buffer(PASSES[PASSES.len() - 1].expect);
+                let mut batch = top::Batch::new(top, &model, front, "zero", 0);
                 batch.push(0, [0, 0, 0], &mut fails, progress)?;
                 batch.flush(&mut fails, progress)?;
             }
@@ -249,7 +423,8 @@ pub fn run(d: &DesignDir, build: &Path, opts: &Options, progress: &Progress) -> 
         }
         if wanted("front") {
             let t = report::now();
-            let range = opts.shard.range(total);
+            let all = part_total("front", cfg.grad_bits, count);
+            let range = opts.shard.range(all);
             let mut fails = Failures::default();
             match opts.front_engine {
                 FrontEngine::Gates => {
@@ -262,9 +437,16 @@ pub fn run(d: &DesignDir, build: &Path, opts: &Options, progress: &Progress) -> 
                     front::check(&mut fr, cfg, &set, range.clone(), &mut fails, progress)?;
                 }
             }
-            let part = Part::new("front", range, total, fails).since(t);
+            let part = Part::new("front", range, all, fails).since(t);
             parts.push(part.engine(opts.front_engine.name()));
         }
     }
-    Report::new(d, opts, parts, start.elapsed().as_secs_f64())
+    let after = report::hash_files(d, &file_names)?;
+    if let Some((b, _)) = files.iter().zip(&after).find(|(b, a)| b.sha256 != a.sha256) {
+        bail!(
+            "{} changed while it was being proven; prove the design again",
+            d.path().join(&b.name).display()
+        );
+    }
+    Report::new(d, opts, files, parts, start.elapsed().as_secs_f64())
 }

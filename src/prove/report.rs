@@ -1,19 +1,20 @@
 //! The report of one shard of `rmapgen prove` (JSON, `--report FILE`) and the merge of a
 //! run's shard reports into one verdict (`rmapgen prove --merge`).
 //!
-//! A report names the design by a digest of its manifest, Verilog and memory files, so the
-//! merge refuses shards of different designs; and each part's range, so it refuses a run
-//! with a shard missing, repeated or from another split.
+//! A report names what was proven: the configuration and the SHA-256 of every file the
+//! proof read (each marked as generated or edited, against the design's `.rmapgen-files`);
+//! and each part's range and the inputs it checked. So the merge refuses shards of different
+//! designs or files, a part or shard missing or repeated, totals the configuration does not
+//! give and parts that checked less than they claim.
 
 use super::{Failures, Options, Shard};
 use crate::design_dir::DesignDir;
 use anyhow::{bail, ensure, Context, Result};
 use serde::{Deserialize, Serialize};
-use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
 /// The report format's name, which the merge checks.
-pub const FORMAT: &str = "rmapgen-prove-1";
+pub const FORMAT: &str = "rmapgen-prove-2";
 
 /// One part of the proof in one shard: inputs `first..end` of `total`.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -22,6 +23,10 @@ pub struct Part {
     pub first: u64,
     pub end: u64,
     pub total: u64,
+    /// Inputs the part checked: driven through the simulation or the gates and compared
+    /// with the model, counted where that happened. A part whose count differs from its
+    /// range failed.
+    pub ran: u64,
     pub failures: u64,
     pub examples: Vec<String>,
     /// Wall-clock seconds the part took (its builds included).
@@ -36,12 +41,22 @@ pub struct Part {
 }
 
 impl Part {
-    pub fn new(name: &str, range: std::ops::Range<u64>, total: u64, f: Failures) -> Part {
+    /// The part over `range` of its `total` inputs; it fails unless it checked exactly the
+    /// inputs of its range.
+    pub fn new(name: &str, range: std::ops::Range<u64>, total: u64, mut f: Failures) -> Part {
+        let claimed = range.end - range.start;
+        if f.checked != claimed {
+            f.add(format!(
+                "{name}: checked {} inputs, not the {claimed} of its range [{}..{})",
+                f.checked, range.start, range.end
+            ));
+        }
         Part {
             name: name.into(),
             first: range.start,
             end: range.end,
             total,
+            ran: f.checked,
             failures: f.count,
             examples: f.kept,
             seconds: 0.0,
@@ -82,14 +97,27 @@ fn cpu_seconds() -> f64 {
     (ticks(11) + ticks(12)) / 100.0
 }
 
+/// One file of the design that the proof read (the simulation, the netlist or the model),
+/// with its SHA-256 when the run started and whether it is as `rmapgen generate` wrote it
+/// (its digest in the design's `.rmapgen-files`).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, Eq)]
+pub struct FileHash {
+    pub name: String,
+    pub sha256: String,
+    /// False: edited since it was generated (or not listed in `.rmapgen-files`).
+    pub as_generated: bool,
+}
+
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Report {
     pub format: String,
     /// The design directory as given.
     pub design: String,
-    pub config: String,
-    /// SHA-256 of the design's manifest, Verilog and memory files.
-    pub digest: String,
+    /// The configuration proven, from the design's manifest.
+    pub config: crate::config::Config,
+    pub config_summary: String,
+    /// Every file the proof read, by name, with its SHA-256: what was proven.
+    pub files: Vec<FileHash>,
     pub mode: String,
     pub shard: Shard,
     pub parts: Vec<Part>,
@@ -97,38 +125,71 @@ pub struct Report {
     pub passed: bool,
 }
 
-/// The files a design's behaviour depends on: its manifest, its Verilog (the manifest's
-/// modules) and every .hex file beside them (the memories' init files).
-fn digest(d: &DesignDir) -> Result<String> {
+/// The files of design `d` that a proof reads: the manifest, the Verilog (the manifest's
+/// modules: the simulation, the netlist and the gates), every `$readmemh` file of the top
+/// (the simulation's memories) and the map files the model reads (both buffers), sorted.
+pub fn read_files(d: &DesignDir) -> Vec<String> {
+    let cfg = &d.config;
     let mut names: Vec<String> = d.file_names().to_vec();
     names.push(crate::rtl::manifest::FILE.to_string());
-    for e in std::fs::read_dir(d.path())? {
-        let name = e?.file_name().to_string_lossy().into_owned();
-        if name.ends_with(".hex") {
-            names.push(name);
+    names.extend(
+        crate::rtl::tb::top_files(cfg)
+            .into_iter()
+            .map(|f| f.default),
+    );
+    for buf in 0..2 {
+        for axis in crate::model::map_set::AXES {
+            names.push(crate::model::map_set::map_file(cfg, buf, axis));
         }
     }
     names.sort();
     names.dedup();
-    let mut h = Sha256::new();
-    for n in &names {
-        let bytes = std::fs::read(d.path().join(n))
-            .with_context(|| format!("cannot read {}", d.path().join(n).display()))?;
-        h.update(n.as_bytes());
-        h.update((bytes.len() as u64).to_le_bytes());
-        h.update(&bytes);
-    }
-    Ok(format!("{:x}", h.finalize()))
+    names
+}
+
+/// The SHA-256 of every file in `names` of design `d`, each marked as generated or edited
+/// against the design's `.rmapgen-files`.
+pub fn hash_files(d: &DesignDir, names: &[String]) -> Result<Vec<FileHash>> {
+    let stamp = crate::output::stamp::read(d.path()).unwrap_or_default();
+    names
+        .iter()
+        .map(|n| {
+            let sha256 = crate::output::stamp::digest(&d.path().join(n))?;
+            let as_generated = stamp.get(n) == Some(&sha256);
+            Ok(FileHash {
+                name: n.clone(),
+                sha256,
+                as_generated,
+            })
+        })
+        .collect()
+}
+
+/// The files of `files` that differ from what rmapgen generated, for messages.
+pub fn edited(files: &[FileHash]) -> Vec<&str> {
+    files
+        .iter()
+        .filter(|f| !f.as_generated)
+        .map(|f| f.name.as_str())
+        .collect()
 }
 
 impl Report {
-    pub fn new(d: &DesignDir, opts: &Options, parts: Vec<Part>, seconds: f64) -> Result<Report> {
+    /// The report of a run of `d` that read `files` (hashed when it started).
+    pub fn new(
+        d: &DesignDir,
+        opts: &Options,
+        files: Vec<FileHash>,
+        parts: Vec<Part>,
+        seconds: f64,
+    ) -> Result<Report> {
         let passed = parts.iter().all(|p| p.failures == 0);
         Ok(Report {
             format: FORMAT.into(),
             design: d.path().display().to_string(),
-            config: d.config.summary(),
-            digest: digest(d)?,
+            config: d.config.clone(),
+            config_summary: d.config.summary(),
+            files,
             mode: if opts.direct { "direct" } else { "factored" }.into(),
             shard: opts.shard,
             parts,
@@ -137,20 +198,11 @@ impl Report {
         })
     }
 
-    /// The gradients this report's parts cover between them (front or direct).
-    pub fn gradients(&self) -> u64 {
-        self.parts
-            .iter()
-            .filter(|p| p.name == "front" || p.name == "direct")
-            .map(|p| p.end - p.first)
-            .sum()
-    }
-
     /// Lines for the terminal: one per part, then the failures kept.
     pub fn summary(&self) -> String {
         let mut s = format!(
             "prove {} ({}, shard {}/{}, {}):\n",
-            self.design, self.config, self.shard.index, self.shard.count, self.mode
+            self.design, self.config_summary, self.shard.index, self.shard.count, self.mode
         );
         for p in &self.parts {
             let name = if p.engine.is_empty() {
@@ -177,6 +229,19 @@ impl Report {
                 s += &format!("    {e}\n");
             }
         }
+        let edited = edited(&self.files);
+        s += &format!(
+            "  files             {} read, SHA-256 in the report; {}\n",
+            self.files.len(),
+            if edited.is_empty() {
+                "all as generated (.rmapgen-files)".to_string()
+            } else {
+                format!(
+                    "edited since generated (not as in .rmapgen-files): {}",
+                    edited.join(", ")
+                )
+            }
+        );
         s += &format!(
             "{} in {:.1} s\n",
             if self.passed { "PASSED" } else { "FAILED" },
@@ -198,24 +263,56 @@ pub struct Merged {
     pub text: String,
 }
 
-/// Combines the reports of every shard of one run. Bad input (unreadable, another design,
-/// a shard missing or repeated, ranges that do not tile) is an error; a failed part is a
+/// The most report files `--merge` reads (as many as [`super::MAX_SHARDS`]), and the largest
+/// report it reads (a report is a few kilobytes: its parts and at most
+/// [`super::KEEP_FAILURES`] messages each).
+const MAX_REPORT_BYTES: u64 = 4 << 20;
+
+/// Combines the reports of every shard of one run. The reports must together cover every
+/// part of the run's mode exactly once, shard by shard, for one configuration and the same
+/// files (by SHA-256): each shard given once, each with every part, each part's ranges tiling
+/// its total, each total the one the configuration gives, each part having checked every
+/// input of its range. Anything else is bad input (an error, one line); a failed part is a
 /// verdict.
 pub fn merge(files: &[PathBuf]) -> Result<Merged> {
     ensure!(!files.is_empty(), "give the shard reports to merge");
+    ensure!(
+        files.len() as u64 <= super::MAX_SHARDS,
+        "{} reports given; a run has at most {} shards",
+        files.len(),
+        super::MAX_SHARDS
+    );
     let reports: Vec<Report> = files.iter().map(|f| read(f)).collect::<Result<_>>()?;
     let first = &reports[0];
     let n = first.shard.count;
     for (r, f) in reports.iter().zip(files) {
-        if r.digest != first.digest || r.mode != first.mode {
+        if r.config != first.config || r.mode != first.mode {
             bail!(
-                "{} is a report of another design or mode than {} ({} {}, not {} {})",
+                "{} is a report of another configuration or mode than {} ({} {}, not {} {})",
                 f.display(),
                 files[0].display(),
-                r.config,
+                r.config_summary,
                 r.mode,
-                first.config,
+                first.config_summary,
                 first.mode
+            );
+        }
+        if r.files != first.files {
+            let differ: Vec<&str> = r
+                .files
+                .iter()
+                .filter(|x| !first.files.contains(x))
+                .map(|x| x.name.as_str())
+                .collect();
+            bail!(
+                "{} proved other files than {} (they differ in {})",
+                f.display(),
+                files[0].display(),
+                if differ.is_empty() {
+                    "the list of files".to_string()
+                } else {
+                    differ.join(", ")
+                }
             );
         }
         if r.shard.count != n {
@@ -227,6 +324,7 @@ pub fn merge(files: &[PathBuf]) -> Result<Merged> {
             );
         }
     }
+    // n is at most MAX_SHARDS (read checks it), and as many reports were read.
     let mut seen = vec![false; n as usize];
     for (r, f) in reports.iter().zip(files) {
         let k = r.shard.index as usize - 1;
@@ -238,31 +336,85 @@ pub fn merge(files: &[PathBuf]) -> Result<Merged> {
     if let Some(k) = seen.iter().position(|s| !s) {
         bail!("shard {}/{n} is missing", k + 1);
     }
-    // Every part's ranges, over the shards, must tile 0..total.
-    let mut names: Vec<&str> = first.parts.iter().map(|p| p.name.as_str()).collect();
-    names.sort();
+    let direct = match first.mode.as_str() {
+        "direct" => true,
+        "factored" => false,
+        m => bail!(
+            "{}: mode {m:?} is neither factored nor direct",
+            files[0].display()
+        ),
+    };
+    let cfg = &first.config;
+    cfg.validate()
+        .with_context(|| format!("{}: config", files[0].display()))?;
+    super::check_limits(cfg, direct).with_context(|| format!("{}: config", files[0].display()))?;
+    let totals = super::totals(cfg, direct)?;
+    // Every report has exactly the run's parts, each once.
+    for (r, f) in reports.iter().zip(files) {
+        let mut names: Vec<&str> = r.parts.iter().map(|p| p.name.as_str()).collect();
+        names.sort();
+        let mut want: Vec<&str> = totals.iter().map(|t| t.0).collect();
+        want.sort();
+        if names != want {
+            let missing: Vec<&str> = want
+                .iter()
+                .filter(|w| !names.contains(w))
+                .copied()
+                .collect();
+            bail!(
+                "{} (shard {}/{n}) has the parts [{}], not those of a {} run [{}]{}",
+                f.display(),
+                r.shard.index,
+                names.join(", "),
+                first.mode,
+                want.join(", "),
+                if missing.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        ": {} missing (a --part run does not merge)",
+                        missing.join(", ")
+                    )
+                }
+            );
+        }
+    }
     let mut text = format!(
         "prove {} ({}, {} shards, {}):\n",
-        first.design, first.config, n, first.mode
+        first.design, first.config_summary, n, first.mode
     );
     let mut passed = true;
-    for name in names {
-        let mut ranges: Vec<&Part> = reports
+    for &(name, total) in &totals {
+        let mut ranges: Vec<(&Part, u64)> = reports
             .iter()
             .map(|r| {
-                r.parts
+                let p = r
+                    .parts
                     .iter()
                     .find(|p| p.name == name)
-                    .with_context(|| format!("shard {}/{n} has no part {name}", r.shard.index))
+                    .expect("checked above");
+                (p, r.shard.index)
             })
-            .collect::<Result<_>>()?;
-        ranges.sort_by_key(|p| (p.first, p.end));
-        let total = ranges[0].total;
+            .collect();
+        ranges.sort_by_key(|(p, _)| (p.first, p.end));
         let mut at = 0;
-        for p in &ranges {
+        for (p, k) in &ranges {
             ensure!(
-                p.total == total && p.first == at,
-                "part {name}: the shards' ranges do not tile 0..{total} (a gap or overlap at {at})"
+                p.total == total,
+                "part {name} of shard {k}/{n} claims {} inputs; the configuration gives {total}",
+                p.total
+            );
+            ensure!(
+                p.first == at && p.end >= p.first,
+                "part {name}: the shards' ranges do not tile 0..{total} (a gap or overlap at {at}, shard {k}/{n})"
+            );
+            ensure!(
+                p.ran == p.end - p.first,
+                "part {name} of shard {k}/{n} checked {} inputs of its {} ([{}..{}))",
+                p.ran,
+                p.end - p.first,
+                p.first,
+                p.end
             );
             at = p.end;
         }
@@ -270,12 +422,12 @@ pub fn merge(files: &[PathBuf]) -> Result<Merged> {
             at == total,
             "part {name}: the shards stop at {at} of {total}"
         );
-        let failures: u64 = ranges.iter().map(|p| p.failures).sum();
+        let failures: u64 = ranges.iter().map(|(p, _)| p.failures).sum();
         passed &= failures == 0;
         // The engines the shards used for the part (shards may differ: each proves its range).
         let mut engines: Vec<&str> = ranges
             .iter()
-            .map(|p| p.engine.as_str())
+            .map(|(p, _)| p.engine.as_str())
             .filter(|e| !e.is_empty())
             .collect();
         engines.sort();
@@ -293,39 +445,62 @@ pub fn merge(files: &[PathBuf]) -> Result<Merged> {
                 format!("{failures} FAILED")
             }
         );
-        for p in ranges.iter().filter(|p| p.failures > 0) {
+        for (p, _) in ranges.iter().filter(|(p, _)| p.failures > 0) {
             for e in &p.examples {
                 text += &format!("    {e}\n");
             }
         }
     }
+    let edited = edited(&first.files);
+    text += &format!(
+        "  files             {} proven by SHA-256{}\n",
+        first.files.len(),
+        if edited.is_empty() {
+            ", all as generated".to_string()
+        } else {
+            format!("; edited since generated: {}", edited.join(", "))
+        }
+    );
     let seconds: f64 = reports.iter().map(|r| r.seconds).sum();
     text += &format!(
-        "{}: {} gradients, {:.0} s of shard time\n",
+        "{}: {} ({} gradients), {:.0} s of shard time\n",
         if passed { "PROVEN" } else { "FAILED" },
-        reports.iter().map(Report::gradients).sum::<u64>(),
+        first.config_summary,
+        1u64 << (3 * cfg.grad_bits),
         seconds
     );
     Ok(Merged { passed, text })
 }
 
 fn read(f: &Path) -> Result<Report> {
+    let len = std::fs::metadata(f)
+        .with_context(|| format!("cannot read {}", f.display()))?
+        .len();
+    ensure!(
+        len <= MAX_REPORT_BYTES,
+        "{} is {len} bytes, not a report of rmapgen prove (at most {MAX_REPORT_BYTES})",
+        f.display()
+    );
     let text =
         std::fs::read_to_string(f).with_context(|| format!("cannot read {}", f.display()))?;
-    let r: Report = serde_json::from_str(&text)
+    let v: serde_json::Value = serde_json::from_str(&text)
         .with_context(|| format!("{} is not a report of rmapgen prove", f.display()))?;
     ensure!(
-        r.format == FORMAT,
-        "{} is a report of format {:?}, not {FORMAT}",
+        v["format"].as_str() == Some(FORMAT),
+        "{} is not a report of rmapgen prove in format {FORMAT} (its format is {}; prove the design again with this rmapgen)",
         f.display(),
-        r.format
+        v["format"]
     );
+    let r: Report = serde_json::from_value(v)
+        .with_context(|| format!("{} is not a report of rmapgen prove", f.display()))?;
     ensure!(
-        r.shard.count >= 1 && (1..=r.shard.count).contains(&r.shard.index),
-        "{}: shard {}/{} is not a shard",
+        (1..=super::MAX_SHARDS).contains(&r.shard.count)
+            && (1..=r.shard.count).contains(&r.shard.index),
+        "{}: shard {}/{} is not a shard (N in 1..={})",
         f.display(),
         r.shard.index,
-        r.shard.count
+        r.shard.count,
+        super::MAX_SHARDS
     );
     Ok(r)
 }

@@ -22,29 +22,39 @@ fn colour(model: &Model, ordinal: u64) -> [u32; 3] {
     [0; 3].map(|_| r.bits(model.cfg.map_bits) as u32)
 }
 
-/// Gradients queued for the top, run and checked a chunk at a time.
+/// Gradients queued for the top, run and checked a chunk at a time. The samples must come
+/// in order of their ordinals, none left out: a gap is a failure of the part, so that a
+/// part can never claim samples it did not drive ([`Failures::checked`] counts those it did).
 pub struct Batch<'a> {
     top: &'a mut ffi::Top,
     model: &'a Model,
     maps: &'a Maps,
     part: &'static str,
+    /// The map-buffer pass the samples belong to, for messages (empty: none).
+    pass: &'static str,
+    /// The ordinal the next sample must have.
+    next: u64,
     input: Vec<u32>,
     ordinals: Vec<u64>,
     out: Vec<u32>,
 }
 
 impl<'a> Batch<'a> {
+    /// A batch whose first sample is ordinal `first`.
     pub fn new(
         top: &'a mut ffi::Top,
         model: &'a Model,
         maps: &'a Maps,
         part: &'static str,
+        first: u64,
     ) -> Self {
         Batch {
             top,
             model,
             maps,
             part,
+            pass: "",
+            next: first,
             input: Vec::with_capacity(TOP_IN * CHUNK),
             ordinals: Vec::with_capacity(CHUNK),
             out: vec![0; TOP_OUT * CHUNK],
@@ -59,6 +69,13 @@ impl<'a> Batch<'a> {
         failures: &mut Failures,
         progress: &Progress,
     ) -> Result<()> {
+        if ordinal != self.next {
+            failures.add(format!(
+                "{}: samples {}..{ordinal} were never driven",
+                self.part, self.next
+            ));
+        }
+        self.next = ordinal + 1;
         let cfg = &self.model.cfg;
         self.input.extend(g.map(|v| enc_grad(cfg, v) as u32));
         self.input.extend(colour(self.model, ordinal));
@@ -69,13 +86,24 @@ impl<'a> Batch<'a> {
         Ok(())
     }
 
+    /// Names the map-buffer pass in failure messages.
+    pub fn pass(&mut self, label: &'static str) {
+        self.pass = label;
+    }
+
+    /// The ordinal the next sample would have: one past the last pushed.
+    pub fn next(&self) -> u64 {
+        self.next
+    }
+
     pub fn flush(&mut self, failures: &mut Failures, progress: &Progress) -> Result<()> {
         let n = self.ordinals.len();
         if n == 0 {
             return Ok(());
         }
         let cfg = &self.model.cfg;
-        self.top.run(&self.input, &mut self.out[..TOP_OUT * n])?;
+        let ran = self.top.run(&self.input, &mut self.out[..TOP_OUT * n])?;
+        failures.checked += ran;
         for k in 0..n {
             let i = &self.input[TOP_IN * k..TOP_IN * k + TOP_IN];
             let g = [i[0], i[1], i[2]].map(|v| dec_grad(cfg, v as u64));
@@ -89,8 +117,13 @@ impl<'a> Batch<'a> {
                 } else {
                     String::new()
                 };
+                let pass = if self.pass.is_empty() {
+                    String::new()
+                } else {
+                    format!(" ({})", self.pass)
+                };
                 failures.add(format!(
-                    "{}: sample {} gradient {g:?}{colour}: expected zero={} i={:#x}{}, got zero={} i={:#x}{}",
+                    "{}{pass}: sample {} gradient {g:?}{colour}: expected zero={} i={:#x}{}, got zero={} i={:#x}{}",
                     self.part,
                     self.ordinals[k],
                     want.zero as u8,

@@ -114,7 +114,12 @@ fn a_small_design_is_proven_in_two_shards_and_every_part_catches_a_planted_fault
     let o = helpers::run(&["prove", "--merge", s(&r1), s(&r2)]);
     let t = text(&o);
     assert_eq!(o.status.code(), Some(0), "{t}");
-    assert!(t.contains("PROVEN: 16777216 gradients"), "{t}");
+    assert!(
+        t.contains("(16777216 gradients)") && t.starts_with("prove "),
+        "{t}"
+    );
+    assert!(t.contains("PROVEN: G8 "), "{t}");
+    assert!(t.contains("all as generated"), "{t}");
     for part in ["structure", "states", "zero", "front"] {
         assert!(t.contains(&format!("  {part} ")), "{part} in {t}");
     }
@@ -149,11 +154,19 @@ fn a_small_design_is_proven_in_two_shards_and_every_part_catches_a_planted_fault
     assert_fails(
         &o,
         "states",
-        &["states: sample", "gradient [", "expected zero=0 i="],
+        &[
+            "states (buffer 0 as loaded): sample",
+            "gradient [",
+            "expected zero=0 i=",
+        ],
     );
     // ... and the same through --direct.
     let o = prove(&d, &build, &["--direct", "--part", "direct"]);
-    assert_fails(&o, "direct", &["direct: sample", "gradient ["]);
+    assert_fails(
+        &o,
+        "direct",
+        &["direct (buffer 0 as loaded): sample", "gradient ["],
+    );
 
     // Sort & shift's leading-zero count off by one for x magnitudes 8..15.
     let d = tmp.path().join("shift");
@@ -290,7 +303,7 @@ fn every_g8_grid_row_is_proven_with_every_gradient_through_its_top() {
                     assert_eq!(o.status.code(), Some(0), "{}: {t}", r.name);
                     assert!(
                         t.lines().any(|l| l.trim_start().starts_with("direct ")
-                            && l.contains(" 16777216 of       16777216 ")),
+                            && l.contains(" 67108864 of       67108864 ")),
                         "{}: {t}",
                         r.name
                     );
@@ -339,4 +352,174 @@ fn bad_input_is_one_line_and_exit_2() {
         &helpers::run(&["prove", "--merge", s(&junk)]),
         "not a report of rmapgen prove",
     );
+}
+
+/// The reproduction of issue 31: bit 8 of every reciprocal ROM entry flipped (the file's
+/// format kept). The states part failed to drive the top at all in the release build (a
+/// miscompiled count, docs/VERIFICATION.md "The false proof") and passed; now every part
+/// counts the samples it checked, and this fails in `states`, naming the pass, the sample
+/// and the gradient, and the report names the edited file.
+#[test]
+fn a_flipped_rom_bit_fails_the_factored_proof_and_the_edited_file_is_named() {
+    if !tools() {
+        return;
+    }
+    let tmp = helpers::tempdir();
+    let dir = tmp.path().join("d");
+    hdl::generate(&dir, &["--grad-bits", "8", "--red-bits", "6"], 0);
+    let p = dir.join("recip_rom.hex");
+    let text = std::fs::read_to_string(&p).unwrap();
+    let flipped: Vec<String> = text
+        .lines()
+        .map(|l| {
+            if l.starts_with("//") {
+                return l.to_string();
+            }
+            let v = u64::from_str_radix(l, 16).unwrap() ^ (1 << 8);
+            format!("{v:0w$x}", w = l.len())
+        })
+        .collect();
+    std::fs::write(&p, flipped.join("\n") + "\n").unwrap();
+    let build = tmp.path().join("build");
+    let report = tmp.path().join("r.json");
+    let o = prove(&dir, &build, &["--report", s(&report)]);
+    assert_fails(
+        &o,
+        "states",
+        &[
+            "states (buffer 0 as loaded): sample ",
+            " gradient [",
+            "edited since generated (not as in .rmapgen-files): recip_rom.hex",
+        ],
+    );
+    // Every part says what it checked: the states part drove all its samples.
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    for part in r["parts"].as_array().unwrap() {
+        let range = part["end"].as_u64().unwrap() - part["first"].as_u64().unwrap();
+        assert_eq!(part["ran"].as_u64(), Some(range), "{part}");
+        assert!(range > 0, "{part}");
+    }
+    let files = r["files"].as_array().unwrap();
+    let rom = files.iter().find(|f| f["name"] == "recip_rom.hex").unwrap();
+    assert_eq!(rom["as_generated"], false);
+    assert_eq!(rom["sha256"].as_str().unwrap().len(), 64);
+    assert!(files.iter().any(|f| f["name"] == "rmap_top.v"));
+}
+
+/// One entry changed in each class of memory file the top reads (the reciprocal ROM, the
+/// compensation ROM, each map bank in its buffer-0 and buffer-1 halves) or the model reads
+/// (the scene's logical map): the factored proof fails on each, in the pass that reads it.
+#[test]
+fn a_single_changed_entry_of_every_memory_class_fails_the_states() {
+    if !tools() {
+        return;
+    }
+    let tmp = helpers::tempdir();
+    let dir = tmp.path().join("d");
+    hdl::generate(&dir, &["--grad-bits", "8", "--red-bits", "6"], 0);
+    let build = tmp.path().join("build");
+    // (file, entry, the pass that must see it). A bank holds 1,024 entries: address
+    // {buf, axis, s_max, s_u, i_u >> 1, s_v, i_v >> 1}, 512 a buffer; entry 100 is axis 0.
+    let cases = [
+        ("recip_rom.hex", 7, "buffer 0 as loaded"),
+        ("atan_rom.hex", 40, "buffer 0 as loaded"),
+        ("map_bank_00.hex", 100, "buffer 0 as loaded"),
+        ("map_bank_01.hex", 100, "buffer 0 as loaded"),
+        ("map_bank_10.hex", 100, "buffer 0 as loaded"),
+        ("map_bank_11.hex", 612, "buffer 1 as loaded"),
+        ("map_x.hex", 300, "buffer 0 as loaded"),
+    ];
+    for (file, entry, pass) in cases {
+        let d = tmp.path().join(file.replace('.', "_"));
+        copy_dir(&dir, &d);
+        corrupt_entry(&d, file, entry);
+        let o = prove(&d, &build, &["--part", "states"]);
+        assert_fails(&o, "states", &[&format!("states ({pass}): sample "), file]);
+    }
+}
+
+/// `--merge` certifies only a whole run: every part of every shard once, for one
+/// configuration and the same files, totals the configuration gives, every input of a
+/// part's range checked. Each forgery here is one line and exit 2.
+#[test]
+fn merge_refuses_reports_that_do_not_cover_the_run() {
+    if !tools() {
+        return;
+    }
+    let tmp = helpers::tempdir();
+    let dir = tmp.path().join("d");
+    hdl::generate(&dir, &hdl::strs(&hdl::narrowest_flags()), 0);
+    let build = tmp.path().join("build");
+    let (r1, r2) = (tmp.path().join("1.json"), tmp.path().join("2.json"));
+    for (k, r) in [("1/2", &r1), ("2/2", &r2)] {
+        let o = prove(&dir, &build, &["--shard", k, "--report", s(r)]);
+        assert_eq!(o.status.code(), Some(0), "shard {k} passes: {}", text(&o));
+    }
+    let read = |p: &Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+    };
+    let forge = |name: &str, edit: &dyn Fn(&mut serde_json::Value)| {
+        let mut v = read(&r1);
+        edit(&mut v);
+        let p = tmp.path().join(name);
+        std::fs::write(&p, v.to_string()).unwrap();
+        p
+    };
+    let whole =
+        |v: &mut serde_json::Value| v["shard"] = serde_json::json!({"index": 1, "count": 1});
+    let only_structure = forge("structure.json", &|v| {
+        whole(v);
+        v["parts"]
+            .as_array_mut()
+            .unwrap()
+            .retain(|p| p["name"] == "structure");
+    });
+    let no_parts = forge("none.json", &|v| {
+        whole(v);
+        v["parts"] = serde_json::json!([]);
+    });
+    let front10 = forge("front10.json", &|v| {
+        for p in v["parts"].as_array_mut().unwrap() {
+            if p["name"] == "front" {
+                p["total"] = 10.into();
+            }
+        }
+    });
+    let huge = forge("huge.json", &|v| {
+        v["shard"] = serde_json::json!({"index": 1, "count": 1u64 << 62});
+    });
+    let short = forge("short.json", &|v| {
+        for p in v["parts"].as_array_mut().unwrap() {
+            if p["name"] == "states" {
+                p["ran"] = (p["ran"].as_u64().unwrap() - 1).into();
+            }
+        }
+    });
+    let other_file = forge("file.json", &|v| {
+        v["files"][0]["sha256"] = "0".repeat(64).into();
+    });
+    let other_config = forge("config.json", &|v| {
+        v["config"]["map_bits"] = 7.into();
+    });
+    let old = forge("old.json", &|v| v["format"] = "rmapgen-prove-1".into());
+    for (files, want) in [
+        (vec![&only_structure], "front, states, zero missing"),
+        (vec![&no_parts], "has the parts []"),
+        (
+            vec![&front10, &r2],
+            "claims 10 inputs; the configuration gives",
+        ),
+        (vec![&huge], "is not a shard"),
+        (vec![&short, &r2], "checked"),
+        (vec![&other_file, &r2], "proved other files"),
+        (vec![&other_config, &r2], "another configuration"),
+        (vec![&old, &r2], "its format is \"rmapgen-prove-1\""),
+        (vec![&r1, &r1], "given twice"),
+        (vec![&r2], "shard 1/2 is missing"),
+    ] {
+        let mut a = vec!["prove", "--merge"];
+        a.extend(files.iter().map(|p| s(p)));
+        helpers::assert_error(&helpers::run(&a), want);
+    }
 }
