@@ -71,7 +71,7 @@ roms: build
 # build as well would compile everything a second time for the same code (98 s of the
 # 1,028 s make test took here before the checks ran side by side).
 TEST_JOBS   ?= 2
-TEST_CHECKS  = gate-sim formal formal-mult sim-all sim-handshake fpga-check-ecp5 fpga-check axis-test synth lint
+TEST_CHECKS  = mutants-sample gate-sim formal formal-mult sim-all sim-handshake fpga-check-ecp5 fpga-check axis-test synth lint
 TEST_BIN     = RMAPGEN=target/debug/rmapgen BUILD_CMD="$(CARGO) test --no-run"
 
 test: tools venv
@@ -229,6 +229,41 @@ prove: build
 	$(RMAPGEN) prove --merge $$(seq -f "$(PROVE_BUILD)/shard-%g-of-$(PROVE_SHARDS).json" 1 $(PROVE_SHARDS)) || status=1; \
 	echo "make prove: $$(( $$(date +%s) - start )) s wall on $(PROVE_SHARDS) shards"; \
 	exit $$status
+
+# ---- Mutation testing (rmapgen mutants, src/mutants/; docs/VERIFICATION.md "Every verdict
+# can fail"): mutants of a G = 8 design drawn by Yosys's `mutate` pass and single changed
+# entries of every memory file, each judged by the ground truth (`prove --direct`: every
+# gradient through the top on both map buffers) and by the checks; exit 1 if the factored
+# proof passes a mutant whose outputs differ. They run the release binary, the build users
+# run: the false proof of issue 31 was in the release build only.
+# mutants-sample (in make test): MUTANTS_SAMPLE Verilog mutants and one per memory file, the
+# ground truth only on those prove passes, ~8 min on 2 cores. mutants: the campaign, every
+# mutant judged by direct, prove, sim and sim --gate (a benchmark-style run, hours; figures in
+# docs/VERIFICATION.md). MUTANTS_SEED picks another draw.
+MUTANTS_BIN     := target/release/rmapgen
+MUTANTS_DESIGN  ?= build/mutants-design
+MUTANTS_FLAGS   ?= --grad-bits 8 --red-bits 6
+MUTANTS_SEED    ?= 1
+MUTANTS_SAMPLE  ?= 40
+MUTANTS_COUNT   ?= 200
+MUTANTS_JOBS    ?= 2
+MUTANTS_METHODS ?= prove,sim,gate
+
+.PHONY: mutants mutants-sample mutants-design
+
+mutants-design:
+	$(CARGO) build --release
+	$(MUTANTS_BIN) generate --out $(MUTANTS_DESIGN) $(MUTANTS_FLAGS)
+
+mutants-sample: mutants-design
+	$(MUTANTS_BIN) mutants $(MUTANTS_DESIGN) --quick --count $(MUTANTS_SAMPLE) --memories 1 \
+	  --seed $(MUTANTS_SEED) --jobs $(MUTANTS_JOBS) --build build/mutants-sample \
+	  --report build/mutants-sample.json
+
+mutants: mutants-design
+	$(MUTANTS_BIN) mutants $(MUTANTS_DESIGN) --count $(MUTANTS_COUNT) --memories 4 \
+	  --method $(MUTANTS_METHODS) --seed $(MUTANTS_SEED) --jobs $(MUTANTS_JOBS) \
+	  --build build/mutants --report build/mutants.json
 
 # ---- Multipliers (rmapgen prove-mult, src/rtl/mult_proof.rs): every adder tree of a
 # generated design equals the product its plan states (a * b + c) on every input. The

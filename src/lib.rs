@@ -13,6 +13,7 @@ pub mod grid;
 pub mod hexfile;
 pub mod map_stream;
 pub mod model;
+pub mod mutants;
 pub mod output;
 pub mod prove;
 pub mod reference;

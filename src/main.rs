@@ -82,6 +82,11 @@ enum Command {
     ///
     /// --shard K/N runs one of N parts, --merge combines their reports into one verdict.
     Prove(cmd::prove::ProveArgs),
+    /// Mutation testing of the checks: draw mutants of a design (Yosys's `mutate` on its
+    /// netlist, single entries of its memory files), judge each by the ground truth
+    /// (`prove --direct`) and by the checks; exit 1 if the factored proof passes a mutant
+    /// whose outputs differ.
+    Mutants(cmd::mutants::MutantsArgs),
 }
 
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
@@ -108,6 +113,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::ProveMult(a) => cmd::prove_mult::run(&a),
         Command::Lint(a) => cmd::lint::run(&a),
         Command::Prove(a) => cmd::prove::run(&a),
+        Command::Mutants(a) => cmd::mutants::run(&a),
     }
 }
 

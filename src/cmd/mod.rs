@@ -10,6 +10,7 @@ pub mod generate;
 pub mod lint;
 pub mod map_args;
 pub mod maps;
+pub mod mutants;
 pub mod parse;
 pub mod prove;
 pub mod prove_mult;

@@ -10,6 +10,11 @@
 use std::path::PathBuf;
 use std::sync::{Mutex, MutexGuard, Once};
 
+extern "C" {
+    fn kill(pid: i32, sig: i32) -> i32;
+}
+const SIGKILL: i32 = 9;
+
 /// What to undo for one registered path.
 #[derive(Debug, Clone)]
 pub enum Undo {
@@ -20,9 +25,17 @@ pub enum Undo {
     /// A previous output moved aside while the new one takes its place: move it back to
     /// `to` if nothing is there yet, else remove it.
     Restore { from: PathBuf, to: PathBuf },
+    /// A child process started in a process group of its own (its id the group's): kill
+    /// the group, so no tool it started outlives rmapgen.
+    KillGroup(u32),
 }
 
 impl Undo {
+    /// Does it now (a child past its time limit is killed the way an interrupt kills it).
+    pub fn run_now(&self) {
+        self.run()
+    }
+
     fn run(&self) {
         match self {
             Undo::Remove(p) => {
@@ -35,6 +48,13 @@ impl Undo {
             }
             Undo::RemoveIfEmpty(p) => {
                 std::fs::remove_dir(p).ok();
+            }
+            Undo::KillGroup(pgid) => {
+                // SAFETY: kill(2) with a negative pid signals the process group; no memory
+                // is touched.
+                unsafe {
+                    kill(-(*pgid as i32), SIGKILL);
+                }
             }
             Undo::Restore { from, to } => {
                 if std::fs::symlink_metadata(to).is_err() {

@@ -342,6 +342,10 @@ pub fn check(d: &DesignDir, build: &Path) -> Result<Part> {
     // enable: a constant, or the same net for all (the pipeline's clock enable), so none
     // holds a sample while the others move.
     let mut enables: std::collections::BTreeMap<String, Vec<String>> = Default::default();
+    // ... and on one clock edge: the same clock net, the same polarity (a register clocked
+    // on the other edge, or on an inverted or other clock, moves half a clock apart from
+    // the rest: a stage skipped that a full-rate stream of similar samples can hide).
+    let mut clocks: std::collections::BTreeMap<String, Vec<String>> = Default::default();
     for (ci, c) in m.cells.iter().enumerate() {
         // An asynchronous read is combinational; its data register is a register here.
         let clocked_read = c.kind.starts_with("$memrd")
@@ -361,7 +365,43 @@ pub fn check(d: &DesignDir, build: &Path) -> Result<Part> {
         } else {
             format!("{en:?}")
         };
+        let polarity = |p: &str| {
+            c.params.get(p).map_or("1", |v| {
+                if v.trim_start_matches('0').is_empty() {
+                    "0"
+                } else {
+                    "1"
+                }
+            })
+        };
+        let name = if name == "constant" {
+            name
+        } else {
+            format!("{name} polarity {}", polarity("EN_POLARITY"))
+        };
         enables.entry(name).or_default().push(c.name.clone());
+        let clk = c
+            .inputs
+            .iter()
+            .find(|(p, _)| p == "CLK")
+            .map(|(_, b)| format!("{b:?}"))
+            .unwrap_or_else(|| "none".into());
+        clocks
+            .entry(format!("{clk} polarity {}", polarity("CLK_POLARITY")))
+            .or_default()
+            .push(c.name.clone());
+    }
+    if clocks.len() > 1 {
+        let (odd, cells) = clocks
+            .iter()
+            .min_by_key(|(_, c)| c.len())
+            .expect("more than one");
+        fails.add(format!(
+            "structure: the registers the samples reach move on {} different clock edges; {} on {odd} ({} of them) apart from the rest",
+            clocks.len(),
+            cells[0],
+            cells.len()
+        ));
     }
     let moving: Vec<_> = enables.iter().collect();
     if moving.len() > 1 {

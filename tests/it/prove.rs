@@ -232,6 +232,21 @@ fn a_small_design_is_proven_in_two_shards_and_every_part_catches_a_planted_fault
     let o = prove(&d, &build, &["--part", "front", "--front-engine", "gates"]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
 
+    // The reciprocal ROM's read register clocked on the falling edge: that path is half a
+    // clock short, so each sample reads its neighbour's reciprocal, which consecutive states
+    // (most share their max) hide from the states part. Found by `rmapgen mutants` (Yosys
+    // inverted the register's clock); the structure now requires one clock edge.
+    let d = tmp.path().join("negedge");
+    plant(
+        &dir,
+        &d,
+        "recip_rom.v",
+        "always @(posedge clk_i)",
+        "always @(negedge clk_i)",
+    );
+    let o = prove(&d, &build, &["--part", "structure"]);
+    assert_fails(&o, "structure", &["different clock edges", "polarity 0"]);
+
     // An undefined literal in the front: the gates would take it as "any value", so the
     // gate engine refuses the design (bad input), naming the line.
     let d = tmp.path().join("undef");
@@ -343,6 +358,12 @@ fn bad_input_is_one_line_and_exit_2() {
     helpers::assert_error(
         &prove(&dir, &build, &["--direct"]),
         "grad_bits = 16 is above 9",
+    );
+    assert!(!build.exists(), "nothing written");
+    // rmapgen mutants judges by prove --direct, so it takes the same designs.
+    helpers::assert_error(
+        &helpers::run(&["mutants", s(&dir), "--build", s(&build)]),
+        "the ground truth of rmapgen mutants is prove --direct",
     );
     assert!(!build.exists(), "nothing written");
     // A file that is not a report.

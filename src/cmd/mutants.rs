@@ -1,0 +1,253 @@
+//! `rmapgen mutants`: mutation testing of rmapgen's own checks on a design
+//! ([`crate::mutants`]). Exit 0 when no non-equivalent mutant passed the factored proof, 1
+//! when one did (a soundness bug), 2 for bad input or a broken flow (the null mutant failed).
+
+use super::force::ForceArg;
+use crate::design_dir::DesignDir;
+use crate::mutants::{self, Change, Method, Mutant, Outcome, Plan};
+use crate::output::{absolute, StagedDir, StagedFile};
+use anyhow::{bail, Result};
+use clap::Args;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+#[derive(Args, Debug)]
+pub struct MutantsArgs {
+    /// The generated design directory (grad_bits <= 9: the ground truth drives every
+    /// gradient through the top).
+    #[arg(value_name = "DIR")]
+    pub dir: PathBuf,
+    /// Verilog mutants to draw with Yosys's `mutate -list` [0..=10000].
+    #[arg(long, default_value_t = 60, value_name = "N")]
+    pub count: usize,
+    /// The seed of Yosys's draw and of the memory mutants.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Memory mutants per memory file (one entry, one bit) [0..=1000].
+    #[arg(long, default_value_t = 1, value_name = "K")]
+    pub memories: usize,
+    /// Checks to judge every mutant by besides the ground truth (`prove --direct`): prove,
+    /// sim, gate (repeat or separate with commas).
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "prove")]
+    pub method: Vec<Method>,
+    /// Judge only these mutants of the draw (their numbers, as printed: `m29` or `29`; the
+    /// null mutant always runs).
+    #[arg(long, value_name = "ID", value_delimiter = ',', value_parser = parse_id)]
+    pub only: Vec<usize>,
+    /// Run the ground truth only on the mutants the factored proof passes (enough to show it
+    /// sound: the bounded sample of `make test`).
+    #[arg(long)]
+    pub quick: bool,
+    /// Mutants judged side by side.
+    #[arg(long, default_value_t = 1, value_name = "J")]
+    pub jobs: usize,
+    /// Seconds one check of one mutant may take before it is killed (a timeout kills).
+    #[arg(long, default_value_t = 900, value_name = "SECONDS")]
+    pub timeout: u64,
+    /// Random top vectors of `sim`'s C++ stream.
+    #[arg(long, default_value_t = 100_000, value_name = "N")]
+    pub sim_stream: u64,
+    /// Every mutant's design, builds and logs go to BUILD/<design name>/m<id> (replaced whole).
+    #[arg(long, default_value = "build/mutants", value_name = "BUILD")]
+    pub build: PathBuf,
+    /// Write every mutant's verdicts and the tallies as JSON to FILE.
+    #[arg(long, value_name = "FILE")]
+    pub report: Option<PathBuf>,
+    #[command(flatten)]
+    pub force: ForceArg,
+}
+
+fn is_report(bytes: &[u8]) -> bool {
+    serde_json::from_slice::<serde_json::Value>(bytes)
+        .is_ok_and(|v| v["format"].as_str() == Some("rmapgen-mutants-1"))
+}
+
+pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
+    let design = DesignDir::open(&a.dir)?;
+    if let Err(e) = crate::prove::check_design(&design, true) {
+        bail!("the ground truth of rmapgen mutants is prove --direct: {e}");
+    }
+    if a.jobs == 0 || a.jobs > 64 {
+        bail!("--jobs {}: give 1..=64", a.jobs);
+    }
+    if a.timeout == 0 {
+        bail!("--timeout 0: give a number of seconds");
+    }
+    if a.method.contains(&Method::Direct) {
+        bail!("--method direct: the ground truth runs on every mutant already");
+    }
+    let policy = a.force.policy(&[Some(design.path())]);
+    let out = match &a.report {
+        Some(p) => Some(StagedFile::new(p, &policy, is_report)?),
+        None => None,
+    };
+    let staged = StagedDir::new(&mutants::work_dir(&a.build, &design), &policy)?;
+    let work = absolute(staged.path());
+
+    let mut changes = vec![Change::Null];
+    changes.extend(mutants::draw_verilog(
+        &design,
+        a.count,
+        a.seed,
+        &work.join("draw"),
+    )?);
+    changes.extend(mutants::draw_memories(&design, a.memories, a.seed)?);
+    let n = changes.len();
+    if let Some(id) = a.only.iter().find(|&&id| id >= n) {
+        bail!("--only m{id}: the draw has m0..m{}", n - 1);
+    }
+    let list: Vec<Mutant> = changes
+        .into_iter()
+        .enumerate()
+        .map(|(id, change)| Mutant { id, change })
+        .filter(|m| m.id == 0 || a.only.is_empty() || a.only.contains(&m.id))
+        .collect();
+    let plan = Plan {
+        methods: a.method.clone(),
+        quick: a.quick,
+        timeout: Duration::from_secs(a.timeout),
+        sim_stream: a.sim_stream,
+    };
+    println!(
+        "mutants of {} ({}): the null mutant, {} Verilog (Yosys mutate, seed {}), {} memory; ground truth prove --direct{}; {} at a time",
+        design.path().display(),
+        design.config.summary(),
+        list.iter().filter(|m| matches!(m.change, Change::Verilog { .. })).count(),
+        a.seed,
+        list.iter().filter(|m| matches!(m.change, Change::Memory { .. })).count(),
+        if a.quick { " on the mutants prove passes" } else { "" },
+        a.jobs
+    );
+    let t0 = Instant::now();
+    let next = AtomicUsize::new(0);
+    let results: Mutex<Vec<Result<Outcome>>> = Mutex::new(Vec::new());
+    // The null mutant first, alone: if the flow changes the design, nothing else means much.
+    let null = mutants::judge(&design, &list[0], &plan, &work)?;
+    print_outcome(&null, n);
+    let broken: Vec<String> = null
+        .verdicts
+        .iter()
+        .filter(|(_, v)| v.kills())
+        .map(|(m, v)| format!("{} {v:?}", m.name()))
+        .collect();
+    if !broken.is_empty() {
+        let work = staged.commit()?;
+        bail!(
+            "the null mutant (the design through Yosys, no mutation) does not pass: {}; logs in {}",
+            broken.join(", "),
+            work.join("m0").display()
+        );
+    }
+    next.store(1, Ordering::SeqCst);
+    std::thread::scope(|s| {
+        for _ in 0..a.jobs {
+            s.spawn(|| loop {
+                let k = next.fetch_add(1, Ordering::SeqCst);
+                let Some(m) = list.get(k) else { break };
+                let r = mutants::judge(&design, m, &plan, &work);
+                if let Ok(o) = &r {
+                    print_outcome(o, n);
+                }
+                results.lock().unwrap_or_else(|e| e.into_inner()).push(r);
+            });
+        }
+    });
+    let mut outcomes = vec![null];
+    for r in results.into_inner().unwrap_or_else(|e| e.into_inner()) {
+        outcomes.push(r?);
+    }
+    outcomes.sort_by_key(|o| o.mutant.id);
+    let mut methods = vec![Method::Direct];
+    if a.quick {
+        methods = vec![Method::Prove, Method::Direct];
+    } else {
+        methods.extend(&a.method);
+    }
+    println!(
+        "{:<8} {:>7} {:>11} {:>15} {:>7} {:>9} {:>17}",
+        "method",
+        "judged",
+        "equivalent",
+        "non-equivalent",
+        "killed",
+        "survived",
+        "killed unclassed"
+    );
+    let tallies: Vec<_> = methods
+        .iter()
+        .map(|&m| mutants::tally(m, &outcomes))
+        .collect();
+    for t in &tallies {
+        println!(
+            "{:<8} {:>7} {:>11} {:>15} {:>7} {:>9} {:>17}",
+            t.method,
+            t.judged,
+            t.equivalent,
+            t.non_equivalent,
+            t.killed,
+            t.survived,
+            t.killed_unclassed
+        );
+    }
+    let unsound: Vec<&Outcome> = outcomes.iter().filter(|o| o.unsound()).collect();
+    for o in &unsound {
+        println!(
+            "SURVIVED (outputs differ under prove --direct, passed by prove): {}",
+            o.mutant.describe()
+        );
+    }
+    println!(
+        "{}: {} mutants in {:.0} s",
+        if unsound.is_empty() {
+            "SOUND"
+        } else {
+            "UNSOUND"
+        },
+        outcomes.len() - 1,
+        t0.elapsed().as_secs_f64()
+    );
+    staged.commit()?;
+    if let Some(f) = out {
+        let json = serde_json::json!({
+            "format": "rmapgen-mutants-1",
+            "design": design.path().display().to_string(),
+            "config": design.config,
+            "seed": a.seed,
+            "quick": a.quick,
+            "tallies": tallies,
+            "outcomes": outcomes,
+        });
+        std::fs::write(f.path(), serde_json::to_string_pretty(&json)? + "\n")?;
+        f.commit()?;
+    }
+    Ok(if unsound.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+fn parse_id(text: &str) -> Result<usize, String> {
+    text.trim_start_matches('m')
+        .parse()
+        .map_err(|_| format!("{text:?} is not a mutant number (m29 or 29)"))
+}
+
+fn print_outcome(o: &Outcome, n: usize) {
+    let verdicts: Vec<String> = o
+        .verdicts
+        .iter()
+        .map(|(m, v)| format!("{} {}", m.name(), format!("{v:?}").to_lowercase()))
+        .collect();
+    println!(
+        "  [{}/{}] {:>6.1} s  {}: {}",
+        o.mutant.id,
+        n - 1,
+        o.seconds,
+        verdicts.join(", "),
+        o.mutant.describe()
+    );
+}

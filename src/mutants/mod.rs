@@ -1,0 +1,676 @@
+//! `rmapgen mutants`: mutation testing of the checks that issue verdicts on a design
+//! (docs/VERIFICATION.md, "Every verdict can fail"). A check that passes a design whose
+//! outputs differ from the model's is unsound; planted faults chosen by the check's own
+//! authors did not find the one that mattered, so the faults here are drawn by an existing
+//! tool:
+//!
+//! - **Verilog mutants**: Yosys's `mutate` pass (the engine of YosysHQ's mcy) draws `N`
+//!   mutations of the design's netlist after `proc` (`mutate -list N -seed S`). Each is
+//!   applied by Yosys to the design, which is written back as Verilog: the top flattened,
+//!   the front modules (zero detect, sort & shift) kept as modules of their own, since the
+//!   proof reads them by file ([`materialise`]). The same flow with no mutation (the null
+//!   mutant) must pass every check, or the flow itself changed the design.
+//! - **Memory mutants**: one entry of a memory file changed (a bit within its width), for
+//!   every file the top reads with `$readmemh` (both halves of a banked map: both buffers)
+//!   and the scene's map files that the model reads.
+//!
+//! Every mutant is judged by the ground truth, `rmapgen prove --direct` (every gradient
+//! through the top, on both map buffers): a mutant it passes is equivalent (no output
+//! differs) and set aside. A non-equivalent mutant that the factored `rmapgen prove` passes
+//! is a soundness bug: the command exits 1. Each check runs as a child process of this
+//! binary (the same build users run), bounded in time, in a process group of its own that
+//! an interrupt takes down.
+
+use crate::design_dir::DesignDir;
+use crate::output::signals::{self, Undo};
+use crate::prove::front::FRONT;
+use crate::rng::SplitMix64;
+use crate::stages::unit::file_params;
+use crate::stages::TOP;
+use anyhow::{bail, ensure, Context, Result};
+use serde::Serialize;
+use std::os::unix::process::CommandExt;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// The most Verilog mutants one run draws.
+pub const MAX_MUTANTS: usize = 10_000;
+/// The most memory mutants per memory file.
+pub const MAX_PER_MEMORY: usize = 1_000;
+
+/// What a mutant changes.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum Change {
+    /// The design as Yosys writes it back, unchanged: the control.
+    Null,
+    /// One `mutate` command of Yosys (`mutate -mode M -module X -cell C ...`).
+    Verilog { command: String },
+    /// Entry `entry` (0-based, data lines) of `file` XORed with `xor`.
+    Memory {
+        file: String,
+        entry: usize,
+        xor: u64,
+    },
+}
+
+/// One mutant: its number in the run and its change.
+#[derive(Clone, Debug, Serialize)]
+pub struct Mutant {
+    pub id: usize,
+    pub change: Change,
+}
+
+impl Mutant {
+    /// One line for reports: `m7 mutate -mode inv -module sort_shift ...`.
+    pub fn describe(&self) -> String {
+        match &self.change {
+            Change::Null => format!("m{} the null mutant (the flow, no mutation)", self.id),
+            Change::Verilog { command } => {
+                // The -src attributes are long and repeat the cell; keep the mutation itself.
+                let short: Vec<&str> = command
+                    .split(" -src ")
+                    .next()
+                    .unwrap_or(command)
+                    .split_whitespace()
+                    .collect();
+                format!("m{} {}", self.id, short.join(" "))
+            }
+            Change::Memory { file, entry, xor } => {
+                format!("m{} {file} entry {entry} ^ {xor:#x}", self.id)
+            }
+        }
+    }
+
+    /// The module a Verilog mutant changes (a derived module's base name).
+    fn module(&self) -> Option<String> {
+        let Change::Verilog { command } = &self.change else {
+            return None;
+        };
+        let mut words = command.split_whitespace();
+        while let Some(w) = words.next() {
+            if w == "-module" {
+                let m = words.next()?;
+                // `$paramod$<hash>\name` is a parameterised instance of `name`.
+                return Some(m.rsplit('\\').next().unwrap_or(m).to_string());
+            }
+        }
+        None
+    }
+}
+
+/// The Yosys script lines that read design `d` (run in its directory: `$readmemh` paths
+/// resolve there) and elaborate its top after `proc`.
+fn read_script(d: &DesignDir) -> String {
+    format!(
+        "read_verilog {}\nhierarchy -top {}\nproc\n",
+        d.file_names().join(" "),
+        TOP.module(&d.config)
+    )
+}
+
+/// Runs Yosys on `script` in `dir`, its log in `log`.
+fn yosys(dir: &Path, script: &str, log: &Path) -> Result<()> {
+    let file = log.with_extension("ys");
+    std::fs::write(&file, script).with_context(|| format!("cannot write {}", file.display()))?;
+    let mut c = Command::new(crate::toolchain::yosys::yosys());
+    c.args(["-q", "-l"])
+        .arg(log)
+        .arg("-s")
+        .arg(&file)
+        .current_dir(dir);
+    let ran = crate::toolchain::capture(&mut c)?;
+    if !ran.success() {
+        bail!(
+            "Yosys failed ({}; {}): {}",
+            ran.exit(),
+            log.display(),
+            crate::toolchain::tail(&ran.output, 3).join(" | ")
+        );
+    }
+    Ok(())
+}
+
+/// Draws `count` Verilog mutants of design `d` with Yosys's `mutate -list` (seed `seed`),
+/// working in `work`.
+pub fn draw_verilog(d: &DesignDir, count: usize, seed: u64, work: &Path) -> Result<Vec<Change>> {
+    ensure!(
+        count <= MAX_MUTANTS,
+        "--count {count}: at most {MAX_MUTANTS} mutants a run"
+    );
+    if count == 0 {
+        return Ok(Vec::new());
+    }
+    std::fs::create_dir_all(work)?;
+    let list = work.join("mutations.ys");
+    let script = format!(
+        "{}mutate -list {count} -seed {seed} -o {}\n",
+        read_script(d),
+        list.display()
+    );
+    yosys(d.path(), &script, &work.join("list.log"))?;
+    let text = std::fs::read_to_string(&list)
+        .with_context(|| format!("cannot read {}", list.display()))?;
+    Ok(text
+        .lines()
+        .filter(|l| l.starts_with("mutate "))
+        .map(|l| Change::Verilog {
+            command: l.to_string(),
+        })
+        .collect())
+}
+
+/// The memory files of design `d` that a mutant may change, with their entry widths: every
+/// `$readmemh` file of the top, and the scene's map files (buffer 0) that the model reads.
+pub fn memory_files(d: &DesignDir) -> Vec<(String, u32)> {
+    let cfg = &d.config;
+    let mut v: Vec<(String, u32)> = file_params(&TOP.memories(cfg))
+        .into_iter()
+        .map(|p| (p.default, p.width))
+        .collect();
+    for axis in crate::model::map_set::AXES {
+        let f = crate::model::map_set::map_file(cfg, 0, axis);
+        if !v.iter().any(|(n, _)| *n == f) {
+            v.push((f, cfg.map_bits));
+        }
+    }
+    v
+}
+
+/// The data lines of a `$readmemh` file (not `//` comments or blank lines).
+fn data_lines(text: &str) -> Vec<usize> {
+    text.lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with("//"))
+        .map(|(i, _)| i)
+        .collect()
+}
+
+/// Draws `per_file` memory mutants of every file of [`memory_files`]: an entry and a bit
+/// within its width, from `seed`.
+pub fn draw_memories(d: &DesignDir, per_file: usize, seed: u64) -> Result<Vec<Change>> {
+    ensure!(
+        per_file <= MAX_PER_MEMORY,
+        "--memories {per_file}: at most {MAX_PER_MEMORY} mutants a file"
+    );
+    let mut out = Vec::new();
+    for (k, (file, width)) in memory_files(d).into_iter().enumerate() {
+        let p = d.path().join(&file);
+        let text =
+            std::fs::read_to_string(&p).with_context(|| format!("cannot read {}", p.display()))?;
+        let n = data_lines(&text).len();
+        ensure!(n > 0, "{} has no entries", p.display());
+        let mut r = SplitMix64::new(seed ^ (k as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+        for _ in 0..per_file {
+            let entry = (r.next_u64() % n as u64) as usize;
+            let bit = r.next_u64() % width as u64;
+            out.push(Change::Memory {
+                file: file.clone(),
+                entry,
+                xor: 1 << bit,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// Copies the files of directory `from` into `to` (subdirectories too), both existing.
+fn copy_tree(from: &Path, to: &Path) -> Result<()> {
+    std::fs::create_dir_all(to)?;
+    for e in std::fs::read_dir(from)? {
+        let e = e?;
+        let (src, dst) = (e.path(), to.join(e.file_name()));
+        let ty = e.file_type()?;
+        if ty.is_dir() {
+            copy_tree(&src, &dst)?;
+        } else if ty.is_file() {
+            std::fs::copy(&src, &dst).with_context(|| format!("cannot copy {}", src.display()))?;
+        }
+    }
+    Ok(())
+}
+
+/// The modules of a Verilog file Yosys wrote, by name, each from `module` to `endmodule`.
+fn split_modules(text: &str) -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    let mut cur: Option<(String, String)> = None;
+    for line in text.lines() {
+        if let Some(rest) = line.strip_prefix("module ") {
+            let name = rest
+                .split(|c: char| c == '(' || c.is_whitespace() || c == ';')
+                .next()
+                .unwrap_or("")
+                .to_string();
+            cur = Some((name, String::new()));
+        }
+        if let Some((_, body)) = cur.as_mut() {
+            body.push_str(line);
+            body.push('\n');
+            if line.trim_start().starts_with("endmodule") {
+                out.push(cur.take().expect("some"));
+            }
+        }
+    }
+    out
+}
+
+/// Writes mutant `m` of design `d` into the empty directory `to`: a copy of the design with
+/// the change applied. A Verilog mutant (and the null mutant) is the design read by Yosys,
+/// `proc`, the mutation, every undefined multiplexer input replaced by the other input
+/// (`opt_expr -mux_undef`, a refinement of `x`: `proc` writes `x` for defaults no path of
+/// the design selects, a mutant may select them, and its meaning must not depend on how a
+/// simulator or the front's gates read `x`), then flattened but for the front modules and written back: the top's
+/// file holds the flat top (its memories' contents written in, its file parameters declared
+/// for the harnesses that set them), the front modules' files the front as Yosys wrote it
+/// when the mutation is in one of them.
+pub fn materialise(d: &DesignDir, m: &Mutant, to: &Path) -> Result<()> {
+    copy_tree(d.path(), to)?;
+    match &m.change {
+        Change::Memory { file, entry, xor } => {
+            let p = to.join(file);
+            let text = std::fs::read_to_string(&p)?;
+            let lines = data_lines(&text);
+            let at = *lines
+                .get(*entry)
+                .with_context(|| format!("{file} has no entry {entry}"))?;
+            let out: Vec<String> = text
+                .lines()
+                .enumerate()
+                .map(|(i, l)| {
+                    if i != at {
+                        return l.to_string();
+                    }
+                    let t = l.trim();
+                    let v = u64::from_str_radix(t, 16).unwrap_or(0) ^ xor;
+                    format!("{v:0w$x}", w = t.len())
+                })
+                .collect();
+            std::fs::write(&p, out.join("\n") + "\n")?;
+        }
+        Change::Null | Change::Verilog { .. } => {
+            let cfg = &to_config(d);
+            let front: Vec<String> = FRONT.iter().map(|u| u.module(cfg)).collect();
+            let mutation = match &m.change {
+                Change::Verilog { command } => format!("{command}\n"),
+                _ => String::new(),
+            };
+            let script = format!(
+                "{}{mutation}opt_expr -mux_undef\nsetattr -mod -set keep_hierarchy 1 {}\nflatten\nopt_clean\nwrite_verilog -noattr mutant.v\n",
+                read_script(d),
+                front.join(" ")
+            );
+            yosys(to, &script, &to.join("mutant.log"))?;
+            let text = std::fs::read_to_string(to.join("mutant.v"))?;
+            let modules = split_modules(&text);
+            let top = TOP.module(cfg);
+            let (_, top_text) = modules
+                .iter()
+                .find(|(n, _)| *n == top)
+                .with_context(|| format!("Yosys wrote no module {top}"))?;
+            // The flat top keeps the file parameters the harnesses set (now unused: Yosys
+            // wrote the memories' contents into it).
+            let params: String = file_params(&TOP.memories(cfg))
+                .iter()
+                .map(|p| format!("  parameter {} = \"{}\";\n", p.name, p.default))
+                .collect();
+            let header_end = top_text
+                .find(");\n")
+                .context("the flat top has no port list")?
+                + 3;
+            let top_file = format!(
+                "{YOSYS_WAIVERS}{}{params}{}",
+                &top_text[..header_end],
+                &top_text[header_end..]
+            );
+            std::fs::write(to.join(TOP.file(cfg)), top_file)?;
+            let changed = m.module();
+            for u in FRONT {
+                if changed.as_deref() == Some(u.module(cfg).as_str()) {
+                    let (_, t) = modules
+                        .iter()
+                        .find(|(n, _)| *n == u.module(cfg))
+                        .with_context(|| format!("Yosys wrote no module {}", u.module(cfg)))?;
+                    std::fs::write(to.join(u.file(cfg)), format!("{YOSYS_WAIVERS}{t}"))?;
+                }
+            }
+            std::fs::remove_file(to.join("mutant.v")).ok();
+        }
+    }
+    Ok(())
+}
+
+/// Verilator's warnings on Verilog that Yosys writes (its case statements overlap, its
+/// logical operators take vectors), which would stop the proof's build: the mutants are
+/// judged on what they compute, not on their style.
+const YOSYS_WAIVERS: &str = "/* verilator lint_off WIDTH */\n/* verilator lint_off CASEOVERLAP */\n/* verilator lint_off CASEINCOMPLETE */\n/* verilator lint_off UNOPTFLAT */\n/* verilator lint_off LATCH */\n/* verilator lint_off MULTIDRIVEN */\n/* verilator lint_off COMBDLY */\n";
+
+fn to_config(d: &DesignDir) -> crate::config::Config {
+    d.config.clone()
+}
+
+/// A check run on one mutant.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// `rmapgen prove --direct`: the ground truth.
+    Direct,
+    /// `rmapgen prove`: the factored proof.
+    Prove,
+    /// `rmapgen sim --verilator --stream`: every testbench and a random stream.
+    Sim,
+    /// `rmapgen sim --gate`: the top's testbench on the synthesised netlist.
+    Gate,
+}
+
+impl Method {
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Direct => "direct",
+            Method::Prove => "prove",
+            Method::Sim => "sim",
+            Method::Gate => "gate",
+        }
+    }
+
+    fn args(self, sim_stream: u64) -> Vec<String> {
+        let v: Vec<&str> = match self {
+            Method::Direct => vec!["prove", "--direct"],
+            Method::Prove => vec!["prove"],
+            Method::Sim => vec!["sim", "--verilator"],
+            Method::Gate => vec!["sim", "--gate"],
+        };
+        let mut v: Vec<String> = v.into_iter().map(String::from).collect();
+        if self == Method::Sim {
+            v.extend(["--stream".to_string(), sim_stream.to_string()]);
+        }
+        v
+    }
+}
+
+/// What a check said of a mutant.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Verdict {
+    /// It passed the mutant (exit 0).
+    Passed,
+    /// It failed the mutant (exit 1).
+    Failed,
+    /// It refused the mutant as bad input (exit 2: for example Verilator could not build it).
+    Refused,
+    /// It ran past the time limit (killed).
+    Timeout,
+}
+
+impl Verdict {
+    /// Whether the check did not certify the mutant.
+    pub fn kills(&self) -> bool {
+        *self != Verdict::Passed
+    }
+}
+
+/// Runs `method` on the mutant design `dir`, as a child process of this binary in a process
+/// group of its own (killed with everything it started on an interrupt or at `timeout`),
+/// its output in `log`.
+pub fn check(
+    method: Method,
+    dir: &Path,
+    build: &Path,
+    log: &Path,
+    timeout: Duration,
+    sim_stream: u64,
+) -> Result<Verdict> {
+    let exe = std::env::current_exe().context("cannot find the rmapgen binary")?;
+    let out =
+        std::fs::File::create(log).with_context(|| format!("cannot write {}", log.display()))?;
+    let err = out.try_clone()?;
+    let mut c = Command::new(exe);
+    c.args(method.args(sim_stream))
+        .arg("--build")
+        .arg(build)
+        .arg(dir)
+        .stdin(Stdio::null())
+        .stdout(out)
+        .stderr(err)
+        .process_group(0);
+    let mut child = c
+        .spawn()
+        .with_context(|| format!("cannot start rmapgen {}", method.name()))?;
+    let token = signals::register(Undo::KillGroup(child.id()));
+    let start = Instant::now();
+    let status = loop {
+        if let Some(s) = child.try_wait()? {
+            break Some(s);
+        }
+        if start.elapsed() > timeout {
+            Undo::KillGroup(child.id()).run_now();
+            child.wait()?;
+            break None;
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    token.release();
+    Ok(match status.and_then(|s| s.code()) {
+        None if status.is_none() => Verdict::Timeout,
+        Some(0) => Verdict::Passed,
+        Some(1) => Verdict::Failed,
+        _ => Verdict::Refused,
+    })
+}
+
+/// One mutant's verdicts, method by method, in the order they ran.
+#[derive(Clone, Debug, Serialize)]
+pub struct Outcome {
+    pub mutant: Mutant,
+    pub verdicts: Vec<(Method, Verdict)>,
+    pub seconds: f64,
+}
+
+impl Outcome {
+    pub fn verdict(&self, m: Method) -> Option<&Verdict> {
+        self.verdicts.iter().find(|(k, _)| *k == m).map(|(_, v)| v)
+    }
+
+    /// The ground truth's class: `None` when `--direct` did not run on it.
+    pub fn equivalent(&self) -> Option<bool> {
+        self.verdict(Method::Direct).map(|v| *v == Verdict::Passed)
+    }
+
+    /// A non-equivalent mutant that the factored proof passed: a soundness bug.
+    pub fn unsound(&self) -> bool {
+        self.equivalent() == Some(false) && self.verdict(Method::Prove) == Some(&Verdict::Passed)
+    }
+}
+
+/// How a run judges its mutants.
+pub struct Plan {
+    /// The checks after the ground truth, in order.
+    pub methods: Vec<Method>,
+    /// Run the ground truth only on mutants the factored proof passes (the bounded sample
+    /// of `make test`: a killed mutant needs no class to show the proof sound).
+    pub quick: bool,
+    pub timeout: Duration,
+    pub sim_stream: u64,
+}
+
+/// Judges mutant `m` of design `d` in `work/m<id>` (design, builds, logs).
+pub fn judge(d: &DesignDir, m: &Mutant, plan: &Plan, work: &Path) -> Result<Outcome> {
+    let t0 = Instant::now();
+    let dir = work.join(format!("m{}", m.id));
+    if dir.exists() {
+        std::fs::remove_dir_all(&dir)?;
+    }
+    let design = dir.join("design");
+    std::fs::create_dir_all(&design)?;
+    materialise(d, m, &design)?;
+    let mut verdicts = Vec::new();
+    let mut run = |method: Method| -> Result<Verdict> {
+        let v = check(
+            method,
+            &design,
+            &dir.join(format!("build-{}", method.name())),
+            &dir.join(format!("{}.log", method.name())),
+            plan.timeout,
+            plan.sim_stream,
+        )?;
+        verdicts.push((method, v.clone()));
+        Ok(v)
+    };
+    if plan.quick {
+        if run(Method::Prove)? == Verdict::Passed {
+            run(Method::Direct)?;
+        }
+    } else {
+        run(Method::Direct)?;
+        for &method in &plan.methods {
+            run(method)?;
+        }
+    }
+    Ok(Outcome {
+        mutant: m.clone(),
+        verdicts,
+        seconds: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// Per method: mutants judged, equivalent, non-equivalent, killed among the non-equivalent,
+/// survived (non-equivalent and passed), and kills of mutants the ground truth did not class.
+#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+pub struct Tally {
+    pub method: String,
+    pub judged: usize,
+    pub equivalent: usize,
+    pub non_equivalent: usize,
+    pub killed: usize,
+    pub survived: usize,
+    /// Killed without a ground-truth class (the quick plan's kills).
+    pub killed_unclassed: usize,
+}
+
+/// The tally of `method` over `outcomes` (the null mutant left out).
+pub fn tally(method: Method, outcomes: &[Outcome]) -> Tally {
+    let mut t = Tally {
+        method: method.name().to_string(),
+        ..Tally::default()
+    };
+    for o in outcomes.iter().filter(|o| o.mutant.change != Change::Null) {
+        let Some(v) = o.verdict(method) else {
+            continue;
+        };
+        t.judged += 1;
+        match o.equivalent() {
+            Some(true) => t.equivalent += 1,
+            Some(false) => {
+                t.non_equivalent += 1;
+                if v.kills() {
+                    t.killed += 1;
+                } else {
+                    t.survived += 1;
+                }
+            }
+            None => {
+                if v.kills() {
+                    t.killed_unclassed += 1;
+                }
+            }
+        }
+    }
+    t
+}
+
+/// Where a run's mutants, builds and logs go: `build/mutants/<design name>`.
+pub fn work_dir(build: &Path, d: &DesignDir) -> PathBuf {
+    build.join(d.name())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn outcome(id: usize, verdicts: &[(Method, Verdict)]) -> Outcome {
+        Outcome {
+            mutant: Mutant {
+                id,
+                change: if id == 0 {
+                    Change::Null
+                } else {
+                    Change::Memory {
+                        file: "recip_rom.hex".into(),
+                        entry: id,
+                        xor: 1,
+                    }
+                },
+            },
+            verdicts: verdicts.to_vec(),
+            seconds: 0.0,
+        }
+    }
+
+    #[test]
+    fn a_non_equivalent_mutant_that_prove_passes_is_unsound_and_nothing_else_is() {
+        use Method::*;
+        use Verdict::*;
+        let killed = outcome(1, &[(Direct, Failed), (Prove, Failed)]);
+        let refused = outcome(2, &[(Direct, Failed), (Prove, Refused)]);
+        let equivalent = outcome(3, &[(Direct, Passed), (Prove, Passed)]);
+        let unsound = outcome(4, &[(Direct, Failed), (Prove, Passed)]);
+        let quick_kill = outcome(5, &[(Prove, Failed)]);
+        let timeout = outcome(6, &[(Direct, Timeout), (Prove, Passed)]);
+        assert!(!killed.unsound() && !refused.unsound() && !equivalent.unsound());
+        assert!(!quick_kill.unsound());
+        assert!(unsound.unsound());
+        // A ground truth that timed out is no "equivalent": the mutant counts as different.
+        assert!(timeout.unsound());
+        let all = [
+            outcome(0, &[(Direct, Passed), (Prove, Passed)]),
+            killed,
+            refused,
+            equivalent,
+            unsound,
+            quick_kill,
+            timeout,
+        ];
+        let t = tally(Prove, &all);
+        assert_eq!(
+            (
+                t.judged,
+                t.equivalent,
+                t.non_equivalent,
+                t.killed,
+                t.survived,
+                t.killed_unclassed
+            ),
+            (6, 1, 4, 2, 2, 1),
+            "{t:?}"
+        );
+        let d = tally(Direct, &all);
+        assert_eq!(
+            (d.judged, d.equivalent, d.non_equivalent, d.killed),
+            (5, 1, 4, 4)
+        );
+    }
+
+    #[test]
+    fn a_mutation_names_its_module_and_yosys_output_splits_into_modules() {
+        let m = Mutant {
+            id: 3,
+            change: Change::Verilog {
+                command: r"mutate -mode inv -module $paramod$86c2\normalise -cell $x -port A -portbit 1 -src n.v:1.2-3.4".into(),
+            },
+        };
+        assert_eq!(m.module().as_deref(), Some("normalise"));
+        assert_eq!(
+            m.describe(),
+            r"m3 mutate -mode inv -module $paramod$86c2\normalise -cell $x -port A -portbit 1"
+        );
+        let text = "/* head */\nmodule a(x);\n  input x;\nendmodule\n\nmodule b (y);\nendmodule\n";
+        let v = split_modules(text);
+        assert_eq!(v.len(), 2);
+        assert_eq!(v[0].0, "a");
+        assert_eq!(
+            v[1],
+            ("b".to_string(), "module b (y);\nendmodule\n".to_string())
+        );
+        assert_eq!(data_lines("// c\n0a\n\n ff\n"), vec![1, 3]);
+    }
+}
