@@ -210,10 +210,11 @@ impl Report {
             } else {
                 format!("{} ({})", p.name, p.engine)
             };
+            // What the part checked (counted as it ran), of its total, and its range.
             s += &format!(
                 "  {:<17} {:>14} of {:>14} inputs [{}..{}) {:>7.1} s ({:.1} s CPU): {}\n",
                 name,
-                p.end - p.first,
+                p.ran,
                 p.total,
                 p.first,
                 p.end,
