@@ -505,3 +505,242 @@ fn read(f: &Path) -> Result<Report> {
     );
     Ok(r)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::Config;
+
+    /// The narrowest grid row: 2^24 gradients, 1,872,000 states.
+    fn cfg() -> Config {
+        crate::grid::narrowest()
+    }
+
+    fn files() -> Vec<FileHash> {
+        ["manifest.json", "recip_rom.hex", "rmap_top.v"]
+            .iter()
+            .enumerate()
+            .map(|(k, n)| FileHash {
+                name: n.to_string(),
+                sha256: format!("{k:064x}"),
+                as_generated: true,
+            })
+            .collect()
+    }
+
+    /// The reports of an honest run of `n` shards that every part passed.
+    fn run(n: u64, direct: bool) -> Vec<Report> {
+        let cfg = cfg();
+        let totals = crate::prove::totals(&cfg, direct).unwrap();
+        (1..=n)
+            .map(|k| {
+                let shard = Shard { index: k, count: n };
+                let parts = totals
+                    .iter()
+                    .map(|&(name, total)| {
+                        let range = match name {
+                            "structure" if k == 1 => 0..1,
+                            "structure" => 1..1,
+                            _ => shard.range(total),
+                        };
+                        let f = Failures {
+                            checked: range.end - range.start,
+                            ..Failures::default()
+                        };
+                        Part::new(name, range, total, f)
+                    })
+                    .collect();
+                Report {
+                    format: FORMAT.into(),
+                    design: "d".into(),
+                    config: cfg.clone(),
+                    config_summary: cfg.summary(),
+                    files: files(),
+                    mode: if direct { "direct" } else { "factored" }.into(),
+                    shard,
+                    parts,
+                    seconds: 1.0,
+                    passed: true,
+                }
+            })
+            .collect()
+    }
+
+    fn merge_reports(reports: &[Report]) -> Result<Merged> {
+        let dir = tempfile::tempdir().unwrap();
+        let paths: Vec<PathBuf> = reports
+            .iter()
+            .enumerate()
+            .map(|(k, r)| {
+                let p = dir.path().join(format!("{k}.json"));
+                std::fs::write(&p, serde_json::to_string(r).unwrap()).unwrap();
+                p
+            })
+            .collect();
+        merge(&paths)
+    }
+
+    fn refused(reports: &[Report], want: &str) {
+        match merge_reports(reports) {
+            Ok(m) => panic!("merged, should be refused ({want}):\n{}", m.text),
+            Err(e) => {
+                let e = format!("{e:#}");
+                assert!(e.contains(want), "{e:?} should contain {want:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn an_honest_run_merges_and_a_failed_part_fails_it() {
+        for direct in [false, true] {
+            for n in [1, 3] {
+                let m = merge_reports(&run(n, direct)).unwrap();
+                assert!(m.passed, "{}", m.text);
+                assert!(m.text.contains("PROVEN: G8 "), "{}", m.text);
+                assert!(m.text.contains("(16777216 gradients)"), "{}", m.text);
+                assert!(m.text.contains("3 proven by SHA-256, all as generated"));
+            }
+        }
+        let mut r = run(2, false);
+        r[1].parts[1].failures = 1;
+        r[1].parts[1].examples = vec!["states (buffer 0 as loaded): sample 7".into()];
+        let m = merge_reports(&r).unwrap();
+        assert!(!m.passed && m.text.contains("FAILED") && m.text.contains("sample 7"));
+        // An edited file is named.
+        let mut r = run(1, false);
+        r[0].files[1].as_generated = false;
+        let m = merge_reports(&r).unwrap();
+        assert!(
+            m.text.contains("edited since generated: recip_rom.hex"),
+            "{}",
+            m.text
+        );
+    }
+
+    #[test]
+    fn merge_refuses_what_does_not_cover_the_whole_run() {
+        let base = run(2, false);
+        let edit = |f: &dyn Fn(&mut Vec<Report>)| {
+            let mut r = base.clone();
+            f(&mut r);
+            r
+        };
+        refused(&base[..1], "shard 2/2 is missing");
+        refused(&[base[0].clone(), base[0].clone()], "given twice");
+        refused(
+            &edit(&|r| r[0].parts.retain(|p| p.name == "structure")),
+            "front, states, zero missing",
+        );
+        refused(&edit(&|r| r[1].parts.clear()), "has the parts []");
+        refused(
+            &edit(&|r| {
+                let p = r[0].parts[0].clone();
+                r[0].parts.push(p)
+            }),
+            "not those of a factored run",
+        );
+        refused(
+            &edit(&|r| {
+                for rep in r.iter_mut() {
+                    for p in rep.parts.iter_mut().filter(|p| p.name == "front") {
+                        p.total = 10;
+                        p.first = p.first.min(10);
+                        p.end = p.end.min(10);
+                        p.ran = p.end - p.first;
+                    }
+                }
+            }),
+            "claims 10 inputs; the configuration gives 16777216",
+        );
+        refused(
+            &edit(&|r| r[0].parts[1].ran -= 1),
+            "checked 3743999 inputs of its 3744000",
+        );
+        refused(
+            &edit(&|r| {
+                let p = &mut r[1].parts[3];
+                p.first += 1;
+                p.ran -= 1;
+            }),
+            "do not tile",
+        );
+        refused(
+            &edit(&|r| {
+                let p = &mut r[1].parts[3];
+                p.end -= 1;
+                p.ran -= 1;
+            }),
+            "the shards stop at 16777215 of 16777216",
+        );
+        refused(
+            &edit(&|r| r[1].files[2].sha256 = "f".repeat(64)),
+            "proved other files",
+        );
+        refused(
+            &edit(&|r| r[1].files.pop().map(|_| ()).unwrap()),
+            "proved other files",
+        );
+        refused(
+            &edit(&|r| r[1].config.map_bits += 1),
+            "another configuration or mode",
+        );
+        refused(
+            &edit(&|r| r[1].mode = "direct".into()),
+            "another configuration or mode",
+        );
+        refused(
+            &edit(&|r| {
+                r[0].mode = "sampled".into();
+                r[1].mode = "sampled".into();
+            }),
+            "neither factored nor direct",
+        );
+        refused(
+            &edit(&|r| {
+                r[0].config.grad_bits = 14;
+                r[1].config.grad_bits = 14;
+            }),
+            "grad_bits = 14 is above 12",
+        );
+        refused(&edit(&|r| r[1].shard.count = 3), "is shard 2/3, not of 2");
+        refused(
+            &edit(&|r| {
+                r[0].shard.count = 1 << 62;
+                r[1].shard.count = 1 << 62;
+            }),
+            "is not a shard",
+        );
+        refused(&edit(&|r| r[0].shard.index = 3), "is not a shard");
+        refused(
+            &edit(&|r| r[0].format = "rmapgen-prove-1".into()),
+            "its format is",
+        );
+    }
+
+    #[test]
+    fn a_part_that_checked_other_than_its_range_fails() {
+        let ok = Part::new(
+            "states",
+            10..20,
+            40,
+            Failures {
+                checked: 10,
+                ..Failures::default()
+            },
+        );
+        assert_eq!((ok.ran, ok.failures), (10, 0));
+        for checked in [0, 9, 11] {
+            let p = Part::new(
+                "states",
+                10..20,
+                40,
+                Failures {
+                    checked,
+                    ..Failures::default()
+                },
+            );
+            assert_eq!((p.ran, p.failures), (checked, 1));
+            assert!(p.examples[0].contains(&format!("checked {checked} inputs, not the 10")));
+        }
+    }
+}
