@@ -547,7 +547,12 @@ mod tests {
                             checked: range.end - range.start,
                             ..Failures::default()
                         };
-                        Part::new(name, range, total, f)
+                        let p = Part::new(name, range, total, f);
+                        if name == "front" {
+                            p.engine(if k == 1 { "gates" } else { "verilator" })
+                        } else {
+                            p
+                        }
                     })
                     .collect();
                 Report {
@@ -599,6 +604,14 @@ mod tests {
                 assert!(m.text.contains("PROVEN: G8 "), "{}", m.text);
                 assert!(m.text.contains("(16777216 gradients)"), "{}", m.text);
                 assert!(m.text.contains("3 proven by SHA-256, all as generated"));
+                // The engines the shards used, each named once; parts without one bare.
+                let want = if n == 1 {
+                    "front (gates)"
+                } else {
+                    "front (gates, verilator)"
+                };
+                assert_eq!(direct, !m.text.contains(want), "{}", m.text);
+                assert!(m.text.contains("  states ") || direct, "{}", m.text);
             }
         }
         let mut r = run(2, false);
@@ -674,7 +687,7 @@ mod tests {
         );
         refused(
             &edit(&|r| r[1].files[2].sha256 = "f".repeat(64)),
-            "proved other files",
+            "0.json (they differ in rmap_top.v)",
         );
         refused(
             &edit(&|r| r[1].files.pop().map(|_| ()).unwrap()),
