@@ -496,10 +496,14 @@ pub struct Plan {
 /// Judges mutant `m` of design `d` in `work/m<id>` (design, builds, logs).
 pub fn judge(d: &DesignDir, m: &Mutant, plan: &Plan, work: &Path) -> Result<Outcome> {
     let t0 = Instant::now();
+    // `work` is the run's own fresh staging directory (cmd/mutants.rs) and each id is judged
+    // once, so this directory is new: refused, never replaced, if anything is there.
     let dir = work.join(format!("m{}", m.id));
-    if dir.exists() {
-        std::fs::remove_dir_all(&dir)?;
-    }
+    ensure!(
+        !dir.exists(),
+        "{} exists; rmapgen mutants writes only new directories",
+        dir.display()
+    );
     let design = dir.join("design");
     std::fs::create_dir_all(&design)?;
     materialise(d, m, &design)?;
