@@ -102,7 +102,25 @@ impl<'a> Batch<'a> {
             return Ok(());
         }
         let cfg = &self.model.cfg;
-        let ran = self.top.run(&self.input, &mut self.out[..TOP_OUT * n])?;
+        let pass = if self.pass.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", self.pass)
+        };
+        let Some(ran) = self.top.run(&self.input, &mut self.out[..TOP_OUT * n]) else {
+            // The results cannot be matched to their samples: none of them was checked.
+            failures.add(format!(
+                "{}{pass}: samples {}..={}: the top lost or added a result (valid_o did not \
+                 pulse once per sample driven)",
+                self.part,
+                self.ordinals[0],
+                self.ordinals[n - 1],
+            ));
+            progress(n as u64);
+            self.input.clear();
+            self.ordinals.clear();
+            return Ok(());
+        };
         failures.checked += ran;
         for k in 0..n {
             let i = &self.input[TOP_IN * k..TOP_IN * k + TOP_IN];
@@ -116,11 +134,6 @@ impl<'a> Batch<'a> {
                     format!(" colour {rgb:?}")
                 } else {
                     String::new()
-                };
-                let pass = if self.pass.is_empty() {
-                    String::new()
-                } else {
-                    format!(" ({})", self.pass)
                 };
                 failures.add(format!(
                     "{}{pass}: sample {} gradient {g:?}{colour}: expected zero={} i={:#x}{}, got zero={} i={:#x}{}",

@@ -247,6 +247,23 @@ fn a_small_design_is_proven_in_two_shards_and_every_part_catches_a_planted_fault
     let o = prove(&d, &build, &["--part", "structure"]);
     assert_fails(&o, "structure", &["different clock edges", "polarity 0"]);
 
+    // The last stage never raises valid_o: no result leaves the top. A wrong design, so a
+    // failed proof (exit 1) naming the part and its samples, not an error of the tool.
+    let d = tmp.path().join("silent");
+    plant(
+        &dir,
+        &d,
+        "interpolate.v",
+        "assign valid_o = valid_q[LATENCY-1];",
+        "assign valid_o = 1'b0;",
+    );
+    let o = prove(&d, &build, &["--part", "states"]);
+    assert_fails(
+        &o,
+        "states",
+        &["states (buffer 0 as loaded): samples 0..=", "the top lost or added a result"],
+    );
+
     // An undefined literal in the front: the gates would take it as "any value", so the
     // gate engine refuses the design (bad input), naming the line.
     let d = tmp.path().join("undef");
