@@ -245,7 +245,7 @@ MUTANTS_DESIGN  ?= build/mutants-design
 MUTANTS_FLAGS   ?= --grad-bits 8 --red-bits 6
 MUTANTS_SEED    ?= 1
 MUTANTS_SAMPLE  ?= 40
-MUTANTS_COUNT   ?= 200
+MUTANTS_COUNT   ?= 100
 MUTANTS_JOBS    ?= 2
 MUTANTS_METHODS ?= prove,sim,gate
 

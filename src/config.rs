@@ -581,6 +581,16 @@ impl Config {
         }
     }
 
+    /// [`Config::summary`] with the prefix when there is one: every field, for messages that
+    /// tell two configurations apart.
+    pub fn summary_full(&self) -> String {
+        if self.prefix.is_empty() {
+            self.summary()
+        } else {
+            format!("{} prefix={}", self.summary(), self.prefix)
+        }
+    }
+
     /// One line naming every field but the prefix; the target only when it is not generic
     /// (the default), so a default design's summary reads as before the field existed.
     pub fn summary(&self) -> String {

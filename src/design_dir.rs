@@ -3,7 +3,8 @@
 //! `manifest.json` lists, and the testbenches in its `tb/`.
 
 use crate::config::Config;
-use crate::rtl::manifest;
+use crate::rtl::manifest::{self, VectorsInfo};
+use crate::scene::Scene;
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
 
@@ -17,6 +18,11 @@ pub struct DesignDir {
     pub config: Config,
     /// The design's Verilog files (names in the directory), in the manifest's order.
     files: Vec<String>,
+    /// The scene whose maps the design holds, named (absent from a manifest written
+    /// before rmapgen recorded it).
+    pub scene: Option<Scene>,
+    /// The test vectors it holds.
+    pub vectors: Option<VectorsInfo>,
 }
 
 impl DesignDir {
@@ -60,6 +66,22 @@ impl DesignDir {
         if let Some(f) = files.iter().find(|f| !dir.join(f).is_file()) {
             bail!("{shown}: {f} is missing (listed in {})", manifest::FILE);
         }
+        let scene = match m.get("scene") {
+            None => None,
+            Some(v) => {
+                let mut scene: Scene = serde_json::from_value(v.clone())
+                    .with_context(|| format!("{}: scene", file.display()))?;
+                scene.name = m["scene_name"].as_str().unwrap_or_default().to_string();
+                Some(scene)
+            }
+        };
+        let vectors = match m.get("vectors") {
+            None => None,
+            Some(v) => Some(
+                serde_json::from_value(v.clone())
+                    .with_context(|| format!("{}: vectors", file.display()))?,
+            ),
+        };
         let path = dir
             .canonicalize()
             .with_context(|| format!("design directory {shown}"))?;
@@ -68,6 +90,8 @@ impl DesignDir {
             top,
             config,
             files,
+            scene,
+            vectors,
         })
     }
 

@@ -16,7 +16,7 @@
 use crate::config::Config;
 use crate::model::Maps;
 use crate::scene::Scene;
-use crate::stages::TOP;
+use crate::stages;
 use anyhow::{bail, Context, Result};
 
 /// The first characters of a hex or C stream rmapgen wrote (after `//` or `/*`).
@@ -82,9 +82,10 @@ pub fn to_maps(cfg: &Config, writes: &[Write]) -> Result<Maps> {
     ))
 }
 
-/// The C array's name: `<top module>_map_writes`.
+/// The C array's name: `<top module>_map_writes`, the design's top ([`stages::top`]: with
+/// the prefix, `rmap_lanes` with lanes, `rmap_axis` with AXI4-Stream ports).
 pub fn c_array(cfg: &Config) -> String {
-    format!("{}_map_writes", TOP.module(cfg))
+    format!("{}_map_writes", stages::top(cfg).module(cfg))
 }
 
 /// The C array's length macro: `<TOP MODULE>_MAP_WRITES_COUNT`.
@@ -348,6 +349,40 @@ mod tests {
         assert!(c.contains(
             "static const uint16_t rmap_top_map_writes[RMAP_TOP_MAP_WRITES_COUNT][3] = {"
         ));
+        // The array takes the name of the design's top module, whichever it is.
+        for (flags, top) in [
+            (
+                Config {
+                    prefix: "vr_".into(),
+                    ..cfg.clone()
+                },
+                "vr_rmap_top",
+            ),
+            (
+                Config {
+                    lanes: 4,
+                    ..cfg.clone()
+                },
+                "rmap_lanes",
+            ),
+            (
+                Config {
+                    handshake: true,
+                    axis: true,
+                    ..cfg.clone()
+                },
+                "rmap_axis",
+            ),
+        ] {
+            let c = String::from_utf8(encode(&flags, &scene, &maps, Format::C)).unwrap();
+            let upper = top.to_uppercase();
+            assert!(
+                c.contains(&format!(
+                    "static const uint16_t {top}_map_writes[{upper}_MAP_WRITES_COUNT][3] = {{"
+                )),
+                "{top}: {c}"
+            );
+        }
         let bin = encode(&cfg, &scene, &maps, Format::Bin);
         assert_eq!(bin.len(), 1536 * RECORD_BYTES);
         assert_eq!(&bin[6..12], &[0, 0, 1, 0, maps.get(0, 1) as u8, 0]);

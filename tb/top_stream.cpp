@@ -5,12 +5,13 @@
 // command line is rmapgen::toolchain::verilator::harness:
 //   verilator --cc --exe --build -O3 ... --top-module rmap_top <out>/*.v top_stream.cpp \
 //             -CFLAGS "-O2 -I<out>/tb" --Mdir build/... -o top_stream
-// Run from the generated directory (the design's $readmemh files and map2_<axis>.hex resolve
-// against it):
-//   top_stream VECTOR_FILE
+// Run as
+//   top_stream VECTOR_FILE MAP2_X MAP2_Y MAP2_Z
+// with the design's second map files (<prefix>map2_<axis>.hex); the design's own $readmemh
+// files are compiled in as absolute paths.
 // VECTOR_FILE has the format of vectors/rmap_top.hex (`rmapgen vectors --count N` writes
 // one): fields `map gx gy gz [r g b] zero i [r_o g_o b_o]`. While the map-0 vectors stream,
-// the harness writes map2_<axis>.hex through the host port into the back buffer, one word
+// the harness writes the second map MAP2_<AXIS> through the host port into the back buffer, one word
 // per clock; the first map-1 vector waits for the load and is presented with swap_i high.
 // Every output must appear in order, exactly RMAP_LATENCY clocks after its input. With the
 // valid/ready handshake (RMAP_HANDSHAKE) the harness applies random backpressure (ready_i low
@@ -125,11 +126,11 @@ std::vector<Vector> load_vectors(const std::string& path) {
     return v;
 }
 
-// map2_x.hex, map2_y.hex, map2_z.hex: `//` comment lines, then one hex entry per line.
-std::vector<uint32_t> load_map2() {
+// The second map's three files (x, y, z): `//` comment lines, then one hex entry per line.
+std::vector<uint32_t> load_map2(char** paths) {
     std::vector<uint32_t> m;
-    for (const char* axis : {"x", "y", "z"}) {
-        const std::string path = std::string("map2_") + axis + ".hex";
+    for (int a = 0; a < 3; ++a) {
+        const std::string path = paths[a];
         const std::string text = read_file(path);
         size_t before = m.size();
         size_t pos = 0;
@@ -158,12 +159,12 @@ std::vector<uint32_t> load_map2() {
 }  // namespace
 
 int main(int argc, char** argv) {
-    if (argc < 2) {
-        std::fprintf(stderr, "usage: %s VECTOR_FILE (run from the generated directory)\n", argv[0]);
+    if (argc != 5) {
+        std::fprintf(stderr, "usage: %s VECTOR_FILE MAP2_X MAP2_Y MAP2_Z\n", argv[0]);
         return 2;
     }
     const std::vector<Vector> vecs = load_vectors(argv[1]);
-    const std::vector<uint32_t> map2 = load_map2();
+    const std::vector<uint32_t> map2 = load_map2(&argv[2]);
     const size_t n = vecs.size();
     if (n == 0) die(std::string(argv[1]) + " holds no vectors");
 
@@ -276,7 +277,17 @@ int main(int argc, char** argv) {
 #endif
                         std::printf(" after %llu clocks\n", static_cast<unsigned long long>(lat));
                     } else {
-                        std::printf("MISMATCH line %u\n", e.line);
+                        std::printf("MISMATCH line %u: expected zero=%x i=%x", e.line, e.zero, e.i);
+#if RMAP_COLOR
+                        std::printf(" r_o=%x g_o=%x b_o=%x", e.rgb_o[0], e.rgb_o[1], e.rgb_o[2]);
+#endif
+                        std::printf(", got zero=%x i=%x", static_cast<unsigned>(top->zero_o),
+                                    static_cast<unsigned>(top->i_o));
+#if RMAP_COLOR
+                        std::printf(" r_o=%x g_o=%x b_o=%x", static_cast<unsigned>(top->r_o),
+                                    static_cast<unsigned>(top->g_o), static_cast<unsigned>(top->b_o));
+#endif
+                        std::printf(" after %llu clocks\n", static_cast<unsigned long long>(lat));
                     }
                 }
                 ++nout;

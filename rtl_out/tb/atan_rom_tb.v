@@ -146,7 +146,8 @@ module atan_rom_tb;
           $display("  expected pu=%h pv=%h", v_pu[so], v_pv[so]);
           $display("  got      pu=%h pv=%h", pu_o, pv_o);
         end else begin
-          $display("MISMATCH line %0d", v_line[so]);
+          $display("MISMATCH line %0d: expected pu=%h pv=%h, got pu=%h pv=%h", v_line[so],
+                   v_pu[so], v_pv[so], pu_o, pv_o);
         end
         shown = shown + 1;
         give_up_if_flooded;

@@ -159,7 +159,8 @@ module interpolate_tb;
           $display("  expected i=%h", v_i[so]);
           $display("  got      i=%h", i_o);
         end else begin
-          $display("MISMATCH line %0d", v_line[so]);
+          $display("MISMATCH line %0d: expected i=%h, got i=%h", v_line[so],
+                   v_i[so], i_o);
         end
         shown = shown + 1;
         give_up_if_flooded;

@@ -160,7 +160,7 @@ fn configuration(
     let tmp = crate::output::Scratch::new()?;
     let rtl = StagedDir::new(&tmp.path().join("rtl"), &Default::default())?;
     let design = crate::design::Design::standard(cfg)?;
-    crate::rtl::write_design(&design, &rtl)?;
+    crate::rtl::write_design(&design, &rtl, None)?;
     let dir = rtl.commit()?;
     let memories = crate::rtl::manifest::memories(cfg);
     let memory_bits: u64 = memories.iter().map(|m| m.bits).sum();

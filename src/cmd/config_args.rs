@@ -6,7 +6,7 @@ use crate::config::Config;
 use crate::toml_input;
 use anyhow::Result;
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug, Clone, Default)]
 pub struct ConfigArgs {
@@ -121,16 +121,116 @@ impl ConfigArgs {
     /// accepted. An error names where each value it is about came from (a flag, the file's
     /// line and column, or the default).
     pub fn resolve(&self) -> Result<Config> {
-        let file = match &self.config {
-            Some(p) => {
-                let text = toml_input::read(p, "config")?;
-                let what = format!("config {}", p.display());
-                let c: Config = toml_input::parse(&text, &what)?;
-                Some((c, text, what))
-            }
-            None => None,
+        let file = self.file()?;
+        let base = file.as_ref().map_or_else(Config::default, |f| f.0.clone());
+        let (c, flags) = self.apply(base);
+        let Err(e) = c.validate() else {
+            return Ok(c);
         };
-        let mut c = file.as_ref().map_or_else(Config::default, |f| f.0.clone());
+        let fields = e.fields();
+        let flag = |f: &str| flags.iter().find(|x| x.0 == f).map(|x| x.1.clone());
+        match &file {
+            // Every value involved is the file's: point at the first one in it.
+            Some((_, text, what)) if fields.iter().all(|f| flag(f).is_none()) => {
+                let key = fields
+                    .iter()
+                    .find(|f| toml_input::span_of(text, f).is_some())
+                    .unwrap_or(&fields[0]);
+                Err(toml_input::invalid(
+                    text,
+                    what,
+                    &toml_input::Invalid::new(*key, e.to_string()),
+                ))
+            }
+            _ => {
+                let from: Vec<String> = fields
+                    .iter()
+                    .map(|f| match (flag(f), &file) {
+                        (Some(fl), _) => format!("{f} from {fl}"),
+                        (None, Some((_, text, what))) => match toml_input::span_of(text, f) {
+                            Some(s) => {
+                                let (l, col) = toml_input::line_col(text, s.start);
+                                format!("{f} from {what}:{l}:{col}")
+                            }
+                            None => format!("{f} by default"),
+                        },
+                        (None, None) => format!("{f} by default"),
+                    })
+                    .collect();
+                anyhow::bail!("{e} ({})", from.join(", "))
+            }
+        }
+    }
+
+    /// The configuration of the generated design `dir` (its manifest's, `design`) for a
+    /// command given that design: a design is read, never re-described. Configuration flags
+    /// (and `--config`) may be given only if they agree with it; a flag or file that
+    /// contradicts the manifest is refused in one line naming both.
+    pub fn for_design(&self, design: &Config, dir: &Path) -> Result<Config> {
+        let file = self.file()?;
+        let base = file
+            .as_ref()
+            .map_or_else(|| design.clone(), |f| f.0.clone());
+        let (c, flags) = self.apply(base);
+        let (want, have) = (serde_json::to_value(&c)?, serde_json::to_value(design)?);
+        let keys = |v: &serde_json::Value| -> Vec<String> {
+            v.as_object()
+                .map_or_else(Vec::new, |o| o.keys().cloned().collect())
+        };
+        let mut fields: Vec<String> = keys(&want);
+        fields.extend(keys(&have));
+        fields.sort();
+        fields.dedup();
+        let shown = |v: Option<&serde_json::Value>| match v {
+            None => "its default".to_string(),
+            Some(serde_json::Value::String(s)) => format!("{s:?}"),
+            Some(v) => v.to_string(),
+        };
+        let diffs: Vec<String> = fields
+            .iter()
+            .filter(|f| want.get(f.as_str()) != have.get(f.as_str()))
+            .map(|f| {
+                let from = match (flags.iter().find(|x| x.0 == f.as_str()), &file) {
+                    (Some(fl), _) => fl.1.clone(),
+                    (None, Some((_, _, what))) => what.clone(),
+                    (None, None) => "the flags".into(),
+                };
+                format!(
+                    "{from} sets {f} {}, the design has {}",
+                    shown(want.get(f.as_str())),
+                    shown(have.get(f.as_str()))
+                )
+            })
+            .collect();
+        if !diffs.is_empty() {
+            anyhow::bail!(
+                "{}: {} (its {}); a command given a design takes the design's configuration: drop the contradicting flags, or generate the design again",
+                dir.display(),
+                diffs.join("; "),
+                crate::rtl::manifest::FILE
+            );
+        }
+        Ok(design.clone())
+    }
+
+    /// Whether any configuration flag or `--config` was given.
+    pub fn any(&self) -> bool {
+        self.config.is_some() || !self.apply(Config::default()).1.is_empty()
+    }
+
+    /// `--config`, read and parsed: the configuration, the text and how messages name it.
+    fn file(&self) -> Result<Option<(Config, String, String)>> {
+        let Some(p) = &self.config else {
+            return Ok(None);
+        };
+        let text = toml_input::read(p, "config")?;
+        let what = format!("config {}", p.display());
+        let c: Config = toml_input::parse(&text, &what)?;
+        Ok(Some((c, text, what)))
+    }
+
+    /// `c` with the flags applied, and the fields they set, each with its flag.
+    fn apply(&self, mut c: Config) -> (Config, Vec<(&'static str, String)>) {
         // The fields set by a flag, with the flag.
         let mut flags: Vec<(&'static str, String)> = Vec::new();
         macro_rules! set {
@@ -189,42 +289,7 @@ impl ConfigArgs {
             c.mult = m;
             flags.push(("mult", format!("--mult {}", m.name())));
         }
-        let Err(e) = c.validate() else {
-            return Ok(c);
-        };
-        let fields = e.fields();
-        let flag = |f: &str| flags.iter().find(|x| x.0 == f).map(|x| x.1.clone());
-        match &file {
-            // Every value involved is the file's: point at the first one in it.
-            Some((_, text, what)) if fields.iter().all(|f| flag(f).is_none()) => {
-                let key = fields
-                    .iter()
-                    .find(|f| toml_input::span_of(text, f).is_some())
-                    .unwrap_or(&fields[0]);
-                Err(toml_input::invalid(
-                    text,
-                    what,
-                    &toml_input::Invalid::new(*key, e.to_string()),
-                ))
-            }
-            _ => {
-                let from: Vec<String> = fields
-                    .iter()
-                    .map(|f| match (flag(f), &file) {
-                        (Some(fl), _) => format!("{f} from {fl}"),
-                        (None, Some((_, text, what))) => match toml_input::span_of(text, f) {
-                            Some(s) => {
-                                let (l, col) = toml_input::line_col(text, s.start);
-                                format!("{f} from {what}:{l}:{col}")
-                            }
-                            None => format!("{f} by default"),
-                        },
-                        (None, None) => format!("{f} by default"),
-                    })
-                    .collect();
-                anyhow::bail!("{e} ({})", from.join(", "))
-            }
-        }
+        (c, flags)
     }
 }
 

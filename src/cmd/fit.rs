@@ -8,6 +8,7 @@ use crate::config::Config;
 use crate::fit::outcome::Outcome;
 use crate::fit::target::Target;
 use crate::fit::{self, CostKind, Options};
+use crate::rtl::manifest::VectorsInfo;
 use anyhow::Result;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -169,9 +170,12 @@ pub fn run(a: &FitArgs) -> Result<()> {
         &scene,
         &a.out,
         &a.force.policy(&[a.map.input()]),
-        a.vectors,
-        a.seed,
+        VectorsInfo {
+            random: a.vectors,
+            seed: a.seed,
+        },
         &[("fit.json".to_string(), json)],
+        generate::Keep::Nothing,
     )?;
     println!(
         "fit: {} ({}), {}x{} sphere ({} pixels), maps {}; target {}; cost {}",

@@ -71,6 +71,11 @@ pub fn run(a: &FpgaArgs) -> Result<()> {
         !a.ooc || a.family == Family::Ecp5,
         "--ooc (out-of-context place and route) is for --family ecp5 only; nextpnr-ice40 has no such mode"
     );
+    // A design given: its configuration, which the flags may only agree with.
+    if let Some(d) = &a.dir {
+        a.cfg
+            .for_design(&crate::design_dir::DesignDir::open(d)?.config, d)?;
+    }
     let logs = StagedDir::new(
         &a.logs,
         &a.force.policy(&[a.dir.as_deref(), a.cfg.config.as_deref()]),

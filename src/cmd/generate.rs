@@ -6,7 +6,9 @@ use super::config_args::ConfigArgs;
 use super::map_args::MapArgs;
 use crate::config::Config;
 use crate::design::Design;
+use crate::design_dir::DesignDir;
 use crate::output::{Policy, StagedDir};
+use crate::rtl::manifest::VectorsInfo;
 use crate::rtl::Manifest;
 use crate::rtl::{self, tb};
 use crate::scene::Scene;
@@ -44,10 +46,20 @@ pub fn run(a: &GenerateArgs) -> Result<()> {
     let cfg = a.cfg.resolve()?;
     let scene = a.map.scene()?;
     let policy = a.force.policy(&[a.cfg.config.as_deref(), a.map.input()]);
-    let (p, manifest) = write_dir(&cfg, &scene, &a.out, &policy, a.vectors, a.seed, &[])?;
+    // A design already there: its configuration, to say what this run changes.
+    let before = DesignDir::open(&a.out).ok().map(|d| d.config);
+    let vectors = VectorsInfo {
+        random: a.vectors,
+        seed: a.seed,
+    };
+    let (p, manifest) = write_dir(&cfg, &scene, &a.out, &policy, vectors, &[], Keep::Nothing)?;
+    let replaced = match before {
+        Some(old) if old != cfg => format!(", replacing its {} design", old.summary_full()),
+        _ => String::new(),
+    };
     eprintln!(
-        "rmapgen: wrote {} ({} modules, latency {}, {} memory bits) to {}",
-        cfg.summary(),
+        "rmapgen: wrote {} ({} modules, latency {}, {} memory bits) to {}{replaced}",
+        cfg.summary_full(),
         manifest.modules.len(),
         manifest.latency,
         manifest.memory_bits,
@@ -56,28 +68,42 @@ pub fn run(a: &GenerateArgs) -> Result<()> {
     Ok(())
 }
 
+/// What [`write_dir`] keeps of an existing directory it replaces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Keep {
+    /// The directory is replaced whole.
+    Nothing,
+    /// The files rmapgen wrote there before and does not write now (`fit.json` of a design
+    /// `fit` chose) are kept: `roms --update`.
+    Others,
+}
+
 /// Everything `generate` writes for one validated configuration and scene, into `out`
-/// (replaced whole on success as `policy` allows, untouched on failure), plus `extra` files (relative name,
-/// text) beside them. `rmapgen fit` writes its chosen design through this too. Returns the
+/// (replaced as `policy` allows, keeping what `keep` says; untouched on failure), plus
+/// `extra` files (relative name, text) beside them. `rmapgen fit` writes its chosen design
+/// through this too, and `roms --update` writes a design again for new maps. Returns the
 /// directory and the manifest.
 pub fn write_dir(
     cfg: &Config,
     scene: &Scene,
     out: &Path,
     policy: &Policy,
-    vectors: usize,
-    seed: u64,
+    vectors: VectorsInfo,
     extra: &[(String, String)],
+    keep: Keep,
 ) -> Result<(PathBuf, Manifest)> {
     let out = StagedDir::new(out, policy)?;
     // Built once: the design's init files and the vectors see the same maps, this scene's
     // and the alternate scene's that testbenches load through the host port.
     let design = Design::for_scene(cfg, scene)?;
-    let manifest = rtl::write_design(&design, &out)?;
-    vectors::write_all(&design, &out, vectors, seed)?;
+    let manifest = rtl::write_design(&design, &out, Some(vectors))?;
+    vectors::write_all(&design, &out, vectors.random, vectors.seed)?;
     tb::write_all(&design, &out)?;
     for (name, text) in extra {
         out.write_text(name, text)?;
+    }
+    if keep == Keep::Others {
+        out.keep_others()?;
     }
     Ok((out.commit()?, manifest))
 }

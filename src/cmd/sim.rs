@@ -13,6 +13,7 @@ use super::parse;
 use crate::design_dir::DesignDir;
 use crate::grid::{self, GridRow};
 use crate::output::{absolute, Policy, StagedDir};
+use crate::rtl::manifest::VectorsInfo;
 use crate::scene::Scene;
 use crate::sim::{self, Options, Outcome};
 use crate::vectors::MAX_STREAM_VECTORS;
@@ -222,9 +223,12 @@ pub(crate) fn generate_row(r: &GridRow, dir: &Path, policy: &Policy) -> Result<D
         &Scene::standard(),
         dir,
         policy,
-        generate::DEFAULT_VECTORS,
-        generate::DEFAULT_SEED,
+        VectorsInfo {
+            random: generate::DEFAULT_VECTORS,
+            seed: generate::DEFAULT_SEED,
+        },
         &[],
+        generate::Keep::Nothing,
     )?;
     DesignDir::open(&dir)
 }

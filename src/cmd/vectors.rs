@@ -3,6 +3,7 @@
 
 use super::config_args::ConfigArgs;
 use super::map_args::MapArgs;
+use crate::design_dir::DesignDir;
 use crate::output::StagedFile;
 use crate::scene::Scene;
 use crate::vectors::{self, MapSet};
@@ -23,8 +24,9 @@ pub struct VectorsArgs {
     /// Seed of the random vectors.
     #[arg(long, value_name = "S", default_value_t = 1)]
     pub seed: u64,
-    /// Take the maps from a generated directory (map_<axis>.hex and map2_<axis>.hex), so the
-    /// vectors match the scene it was generated with.
+    /// Take the configuration and the maps from a generated design (its manifest.json,
+    /// `<prefix>map_<axis>.hex` and `<prefix>map2_<axis>.hex`), so the vectors match the scene
+    /// it was generated with; configuration flags may only agree with it.
     #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "map_fit"])]
     pub maps: Option<PathBuf>,
     /// The scene and fit of map 0; map 1 is always the alternate scene's
@@ -39,7 +41,11 @@ pub struct VectorsArgs {
 }
 
 pub fn run(a: &VectorsArgs) -> Result<()> {
-    let cfg = a.cfg.resolve()?;
+    // With --maps DIR the design's configuration, which the flags may only agree with.
+    let cfg = match &a.maps {
+        Some(dir) => a.cfg.for_design(&DesignDir::open(dir)?.config, dir)?,
+        None => a.cfg.resolve()?,
+    };
     vectors::check_stream_vectors(a.count as u64)?;
     let maps = match &a.maps {
         Some(dir) => MapSet::from_dir(&cfg, dir)?,

@@ -16,7 +16,8 @@ pub fn cells(cfg: &Config, scene: &Scene, family: Family) -> Result<u64> {
     let cfg = &cfg.for_target(crate::config::Target::Ice40);
     let tmp = crate::output::Scratch::new()?;
     let out = crate::output::StagedDir::new(&tmp.path().join("design"), &Default::default())?;
-    let manifest = crate::rtl::write_design(&crate::design::Design::for_scene(cfg, scene)?, &out)?;
+    let manifest =
+        crate::rtl::write_design(&crate::design::Design::for_scene(cfg, scene)?, &out, None)?;
     let dir = out.commit()?;
     let files: Vec<String> = manifest.modules.iter().map(|m| m.file.clone()).collect();
     let synth = match family {

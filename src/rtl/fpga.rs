@@ -212,7 +212,7 @@ pub fn report(cfg: &Config, opts: &Options) -> Result<FpgaReport> {
     let cfg = &cfg.for_target(Target::Ice40);
     let tmp = crate::output::Scratch::new()?;
     let out = StagedDir::new(&tmp.path().join("rtl"), &Default::default())?;
-    super::write_design(&crate::design::Design::standard(cfg)?, &out)?;
+    super::write_design(&crate::design::Design::standard(cfg)?, &out, None)?;
     let dir = out.commit()?;
     run_dir(&dir, opts)
 }

@@ -4,14 +4,25 @@
 
 use super::ports;
 use crate::config::Config;
+use crate::scene::Scene;
 use crate::stages;
 use crate::stages::rmap_axis::AxisInfo;
 use crate::stages::rmap_lanes::LanesInfo;
 use crate::stages::rmap_top::{self, SidebandDelays};
 pub use crate::stages::unit::Memory;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 pub const FILE: &str = "manifest.json";
+
+/// The test vectors a design directory holds (`generate --vectors N --seed S`): what
+/// `roms --update` writes again for new maps, so the design stays consistent.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VectorsInfo {
+    /// Seeded random vectors per stage, after the corner cases.
+    pub random: usize,
+    pub seed: u64,
+}
 
 #[derive(Clone, Debug, Serialize)]
 pub struct Manifest {
@@ -31,6 +42,13 @@ pub struct Manifest {
     pub memory_bits: u64,
     /// Every file of the directory written by the design generator, in writing order.
     pub files: Vec<String>,
+    /// Where the maps of buffer 0 come from: the scene's name (`scenes/standard.toml`, a
+    /// file's name) and the scene itself, its `map_fit` the one that filled the maps.
+    pub scene_name: String,
+    pub scene: Scene,
+    /// The test vectors in `vectors/` (absent when the directory has none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub vectors: Option<VectorsInfo>,
     /// The AXI4-Stream `tdata` layouts and `tuser` width (`axis` only; absent without it).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub axis: Option<AxisInfo>,
@@ -58,7 +76,14 @@ pub fn memories(cfg: &Config) -> Vec<Memory> {
 }
 
 impl Manifest {
-    pub fn new(cfg: &Config, files: Vec<String>) -> Manifest {
+    /// The manifest of configuration `cfg` whose maps are `scene`'s, listing `files`, with
+    /// `vectors` when the directory holds test vectors.
+    pub fn new(
+        cfg: &Config,
+        scene: &Scene,
+        vectors: Option<VectorsInfo>,
+        files: Vec<String>,
+    ) -> Manifest {
         let parents = stages::parents(cfg);
         let modules = stages::modules(cfg)
             .into_iter()
@@ -86,6 +111,9 @@ impl Manifest {
             memory_bits: memories.iter().map(|m| m.bits).sum(),
             memories,
             files,
+            scene_name: scene.name.clone(),
+            scene: scene.clone(),
+            vectors,
             axis: AxisInfo::new(cfg),
             lanes: LanesInfo::new(cfg),
         }
@@ -104,13 +132,13 @@ mod tests {
     fn memory_bits_add_up() {
         // Generic (the default): recip 128 x 10, one atan ROM 256 x 6, four banks 1024 x 8.
         let cfg = Config::default();
-        let m = Manifest::new(&cfg, vec![]);
+        let m = Manifest::new(&cfg, &Scene::standard(), None, vec![]);
         assert_eq!(m.memory_bits, 1280 + 1536 + 4 * 8192);
         assert_eq!(m.memory_bits, cfg.rom_total_bits() + cfg.bank_total_bits());
         assert_eq!(m.latency, 24);
         // iCE40: the atan ROM twice, one copy per read port.
         let ice40 = cfg.for_target(crate::config::Target::Ice40);
-        let m = Manifest::new(&ice40, vec![]);
+        let m = Manifest::new(&ice40, &Scene::standard(), None, vec![]);
         assert_eq!(m.memory_bits, 1280 + 2 * 1536 + 4 * 8192);
         assert_eq!(
             m.memory_bits,
@@ -125,8 +153,9 @@ mod tests {
                 lanes: l,
                 ..Config::default()
             };
-            let m = Manifest::new(&cfg, vec![]);
-            let one = Manifest::new(&Config::default(), vec![]).memory_bits;
+            let m = Manifest::new(&cfg, &Scene::standard(), None, vec![]);
+            let one =
+                Manifest::new(&Config::default(), &Scene::standard(), None, vec![]).memory_bits;
             // Two lanes share a reciprocal ROM (128 x 10): half of it a lane.
             assert_eq!(m.memory_bits, l as u64 * (one - 640));
             assert_eq!(m.lanes.as_ref().unwrap().memory_bits_per_lane, one - 640);
@@ -138,13 +167,22 @@ mod tests {
             let ice40 = cfg.for_target(crate::config::Target::Ice40);
             let one = Manifest::new(
                 &Config::default().for_target(crate::config::Target::Ice40),
+                &Scene::standard(),
+                None,
                 vec![],
             )
             .memory_bits;
-            assert_eq!(Manifest::new(&ice40, vec![]).memory_bits, l as u64 * one);
+            assert_eq!(
+                Manifest::new(&ice40, &Scene::standard(), None, vec![]).memory_bits,
+                l as u64 * one
+            );
             assert_eq!(m.top, "rmap_lanes");
             assert_eq!(m.latency, 24);
         }
-        assert!(Manifest::new(&Config::default(), vec![]).lanes.is_none());
+        assert!(
+            Manifest::new(&Config::default(), &Scene::standard(), None, vec![])
+                .lanes
+                .is_none()
+        );
     }
 }

@@ -54,7 +54,11 @@ pub fn hex_files(design: &Design) -> Vec<(String, String)> {
 /// through the host port), the FuseSoC core and README of [`package`], and `manifest.json`.
 /// Returns the manifest. The caller builds `design` once and hands the same value to the
 /// vectors and the testbenches.
-pub fn write_design(design: &Design, out: &StagedDir) -> Result<Manifest> {
+pub fn write_design(
+    design: &Design,
+    out: &StagedDir,
+    vectors: Option<manifest::VectorsInfo>,
+) -> Result<Manifest> {
     let cfg = design.cfg();
     let mut files = Vec::new();
     let mut write = |name: String, text: &str| -> Result<()> {
@@ -74,7 +78,7 @@ pub fn write_design(design: &Design, out: &StagedDir) -> Result<Manifest> {
     write(package::core_file(cfg), &package::core(cfg)?)?;
     write(package::README_FILE.into(), &package::readme(design)?)?;
     files.push(manifest::FILE.to_string());
-    let manifest = Manifest::new(cfg, files);
+    let manifest = Manifest::new(cfg, &design.scene, vectors, files);
     out.write_text(manifest::FILE, &manifest.to_json())?;
     Ok(manifest)
 }

@@ -22,6 +22,7 @@
 //! its output, and the other runs go on; [`Outcome::failed`] lists them.
 
 use crate::design_dir::DesignDir;
+use crate::model::map_set::{map_file, AXES};
 use crate::stages::TOP;
 use crate::toolchain::{self, icarus, verilator, yosys, Ran};
 use crate::vectors::{self, MapSet};
@@ -266,8 +267,14 @@ pub fn run(
             .is_some()
         {
             let exe = sdir.join("top_stream");
-            // The harness reads map2_<axis>.hex from its working directory (tb/top_stream.cpp).
-            let run = executable(design.path(), &exe, &[vec.display().to_string()]);
+            // The harness loads the design's second map through the host port
+            // (tb/top_stream.cpp): its files by name, as the configuration (prefix) has them.
+            let mut args = vec![vec.display().to_string()];
+            args.extend(AXES.iter().map(|a| {
+                let f = map_file(&design.config, 1, a);
+                design.path().join(f).display().to_string()
+            }));
+            let run = executable(design.path(), &exe, &args);
             r.simulation("verilator top_stream (C++)", run, &sdir.join("run.log"))?;
         }
     }

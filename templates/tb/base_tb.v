@@ -164,7 +164,8 @@ module {= t.module =}_tb;
           $display("  expected {= t.out_format =}", {= t.exp_args =});
           $display("  got      {= t.out_format =}", {= t.got_args =});
         end else begin
-          $display("MISMATCH line %0d", v_line[so]);
+          $display("MISMATCH line %0d: expected {= t.out_format =}, got {= t.out_format =}", v_line[so],
+                   {= t.exp_args =}, {= t.got_args =});
         end
         shown = shown + 1;
         give_up_if_flooded;

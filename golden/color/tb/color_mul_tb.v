@@ -157,7 +157,8 @@ module color_mul_tb;
           $display("  expected r_o=%h g_o=%h b_o=%h", v_r_o[so], v_g_o[so], v_b_o[so]);
           $display("  got      r_o=%h g_o=%h b_o=%h", r_o, g_o, b_o);
         end else begin
-          $display("MISMATCH line %0d", v_line[so]);
+          $display("MISMATCH line %0d: expected r_o=%h g_o=%h b_o=%h, got r_o=%h g_o=%h b_o=%h", v_line[so],
+                   v_r_o[so], v_g_o[so], v_b_o[so], r_o, g_o, b_o);
         end
         shown = shown + 1;
         give_up_if_flooded;

@@ -249,7 +249,8 @@ module map_lookup_tb;
           $display("  expected e00=%h e10=%h e01=%h e11=%h wu=%h wv=%h", v_e00[so], v_e10[so], v_e01[so], v_e11[so], v_wu[so], v_wv[so]);
           $display("  got      e00=%h e10=%h e01=%h e11=%h wu=%h wv=%h", e00_o, e10_o, e01_o, e11_o, wu_o, wv_o);
         end else begin
-          $display("MISMATCH line %0d", v_line[so]);
+          $display("MISMATCH line %0d: expected e00=%h e10=%h e01=%h e11=%h wu=%h wv=%h, got e00=%h e10=%h e01=%h e11=%h wu=%h wv=%h", v_line[so],
+                   v_e00[so], v_e10[so], v_e01[so], v_e11[so], v_wu[so], v_wv[so], e00_o, e10_o, e01_o, e11_o, wu_o, wv_o);
         end
         shown = shown + 1;
         give_up_if_flooded;

@@ -154,7 +154,8 @@ module normalise_tb;
           $display("  expected u=%h v=%h", v_u[so], v_v[so]);
           $display("  got      u=%h v=%h", u_o, v_o);
         end else begin
-          $display("MISMATCH line %0d", v_line[so]);
+          $display("MISMATCH line %0d: expected u=%h v=%h, got u=%h v=%h", v_line[so],
+                   v_u[so], v_v[so], u_o, v_o);
         end
         shown = shown + 1;
         give_up_if_flooded;

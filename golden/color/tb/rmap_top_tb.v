@@ -242,7 +242,8 @@ module rmap_top_tb;
           $display("  expected zero=%h i=%h r_o=%h g_o=%h b_o=%h", v_zero[so], v_i[so], v_r_o[so], v_g_o[so], v_b_o[so]);
           $display("  got      zero=%h i=%h r_o=%h g_o=%h b_o=%h", zero_o, i_o, r_o, g_o, b_o);
         end else begin
-          $display("MISMATCH line %0d", v_line[so]);
+          $display("MISMATCH line %0d: expected zero=%h i=%h r_o=%h g_o=%h b_o=%h, got zero=%h i=%h r_o=%h g_o=%h b_o=%h", v_line[so],
+                   v_zero[so], v_i[so], v_r_o[so], v_g_o[so], v_b_o[so], zero_o, i_o, r_o, g_o, b_o);
         end
         shown = shown + 1;
         give_up_if_flooded;

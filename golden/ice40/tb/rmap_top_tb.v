@@ -203,7 +203,8 @@ module rmap_top_tb;
           $display("  expected zero=%h i=%h", v_zero[so], v_i[so]);
           $display("  got      zero=%h i=%h", zero_o, i_o);
         end else begin
-          $display("MISMATCH line %0d", v_line[so]);
+          $display("MISMATCH line %0d: expected zero=%h i=%h, got zero=%h i=%h", v_line[so],
+                   v_zero[so], v_i[so], zero_o, i_o);
         end
         shown = shown + 1;
         give_up_if_flooded;

@@ -138,7 +138,8 @@ module zero_detect_tb;
           $display("  expected zero=%h", v_zero[so]);
           $display("  got      zero=%h", zero_o);
         end else begin
-          $display("MISMATCH line %0d", v_line[so]);
+          $display("MISMATCH line %0d: expected zero=%h, got zero=%h", v_line[so],
+                   v_zero[so], zero_o);
         end
         shown = shown + 1;
         give_up_if_flooded;

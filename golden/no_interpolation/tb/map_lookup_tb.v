@@ -213,7 +213,8 @@ module map_lookup_tb;
           $display("  expected e00=%h", v_e00[so]);
           $display("  got      e00=%h", e00_o);
         end else begin
-          $display("MISMATCH line %0d", v_line[so]);
+          $display("MISMATCH line %0d: expected e00=%h, got e00=%h", v_line[so],
+                   v_e00[so], e00_o);
         end
         shown = shown + 1;
         give_up_if_flooded;

@@ -176,7 +176,8 @@ module sort_shift_tb;
           $display("  expected axis=%h s_max=%h s_u=%h s_v=%h m=%h a=%h b=%h", v_axis[so], v_s_max[so], v_s_u[so], v_s_v[so], v_m[so], v_a[so], v_b[so]);
           $display("  got      axis=%h s_max=%h s_u=%h s_v=%h m=%h a=%h b=%h", axis_o, s_max_o, s_u_o, s_v_o, m_o, a_o, b_o);
         end else begin
-          $display("MISMATCH line %0d", v_line[so]);
+          $display("MISMATCH line %0d: expected axis=%h s_max=%h s_u=%h s_v=%h m=%h a=%h b=%h, got axis=%h s_max=%h s_u=%h s_v=%h m=%h a=%h b=%h", v_line[so],
+                   v_axis[so], v_s_max[so], v_s_u[so], v_s_v[so], v_m[so], v_a[so], v_b[so], axis_o, s_max_o, s_u_o, s_v_o, m_o, a_o, b_o);
         end
         shown = shown + 1;
         give_up_if_flooded;

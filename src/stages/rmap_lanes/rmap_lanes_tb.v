@@ -197,7 +197,9 @@ module {= t.module =}_tb;
               $display("  got      {= t.out_format =}",
                        {% for f in t.out_fields %}{% if !loop.first %}, {% endif %}{= f.port =}[lk*{= f.bits =} +: {= f.bits =}]{% endfor %});
             end else begin
-              $display("MISMATCH lane %0d line %0d", lk, v_line[vs]);
+              $display("MISMATCH lane %0d line %0d: expected {= t.out_format =}, got {= t.out_format =}", lk, v_line[vs],
+                       {% for f in t.out_fields %}{% if !loop.first %}, {% endif %}v_{= f.name =}[vs]{% endfor %},
+                       {% for f in t.out_fields %}{% if !loop.first %}, {% endif %}{= f.port =}[lk*{= f.bits =} +: {= f.bits =}]{% endfor %});
             end
             shown = shown + 1;
             give_up_if_flooded;
