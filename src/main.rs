@@ -133,7 +133,7 @@ fn parse() -> Result<Cli, ExitCode> {
                 ExitCode::SUCCESS
             }
             _ => {
-                eprintln!("rmapgen: error: {}", usage_line(&e));
+                rmapgen::errln!("rmapgen: error: {}", usage_line(&e));
                 ExitCode::from(2)
             }
         }
@@ -211,10 +211,13 @@ fn main() -> ExitCode {
     };
     match run(cli) {
         Ok(code) => code,
+        // The reader of standard output closed it: it wants no more, so the command has
+        // stopped quietly (src/output/console.rs).
+        Err(e) if rmapgen::output::console::is_stdout_closed(&e) => ExitCode::SUCCESS,
         Err(e) => {
             // One line, the whole cause chain.
             let msg = format!("{e:#}").replace(['\n', '\r'], " ");
-            eprintln!("rmapgen: error: {msg}");
+            rmapgen::errln!("rmapgen: error: {msg}");
             ExitCode::from(2)
         }
     }

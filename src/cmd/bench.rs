@@ -126,8 +126,8 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let rows = rows?;
     bench::write(&rows, &out)?;
     let p = out.commit()?;
-    print!("{}", bench::table::markdown(&rows));
-    eprintln!(
+    crate::out!("{}", bench::table::markdown(&rows))?;
+    crate::errln!(
         "rmapgen: wrote bench.md, bench.csv, bench.json and plots to {}",
         p.display()
     );
@@ -172,7 +172,7 @@ fn throughput(a: &BenchArgs) -> Result<()> {
     once("--family", &sweep.families)?;
     once("--mult", &sweep.mults)?;
     let out = StagedDir::new(&a.out, &a.force.policy(&[]))?;
-    let result = throughput::run(&sweep, &out, &|m| eprintln!("rmapgen: throughput: {m}"));
+    let result = throughput::run(&sweep, &out, &|m| crate::errln!("rmapgen: throughput: {m}"));
     // The logs are kept also when a configuration fails, so that they can be read.
     let rows = match result {
         Ok(rows) => rows,
@@ -183,8 +183,8 @@ fn throughput(a: &BenchArgs) -> Result<()> {
     };
     throughput::write(&rows, &out)?;
     let p = out.commit()?;
-    print!("{}", throughput::markdown(&rows));
-    eprintln!(
+    crate::out!("{}", throughput::markdown(&rows))?;
+    crate::errln!(
         "rmapgen: wrote throughput.md, throughput.csv, throughput.json and the logs to {}",
         p.display()
     );

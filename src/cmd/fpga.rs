@@ -79,7 +79,7 @@ pub fn run(a: &FpgaArgs) -> Result<()> {
     let dir = logs.commit()?;
     let report = result?;
     let path = dir.join("report.json");
-    println!(
+    crate::outln!(
         "fpga: {} ({:.2} MHz, {} logic cells, {} block RAMs, {} DSP blocks); report {}",
         if report.timing_met {
             "timing met"
@@ -91,7 +91,7 @@ pub fn run(a: &FpgaArgs) -> Result<()> {
         report.block_rams,
         report.dsps,
         path.display()
-    );
+    )?;
     anyhow::ensure!(
         report.timing_met || !a.require_timing,
         "post-route Fmax {:.2} MHz is below the {} MHz target (--require-timing); critical path {}",
@@ -131,7 +131,7 @@ fn flow(a: &FpgaArgs, logs: &Path) -> Result<fpga::FpgaReport> {
             (cfg.summary(), fpga::report(&cfg, &opts)?)
         }
     };
-    print!("fpga: {what}\n{}", report.summary());
+    crate::out!("fpga: {what}\n{}", report.summary())?;
     let json = serde_json::to_string_pretty(&report)?;
     let path = logs.join("report.json");
     std::fs::write(&path, json + "\n")

@@ -45,7 +45,7 @@ pub fn run(a: &GenerateArgs) -> Result<()> {
     let scene = a.map.scene()?;
     let policy = a.force.policy(&[a.cfg.config.as_deref(), a.map.input()]);
     let (p, manifest) = write_dir(&cfg, &scene, &a.out, &policy, a.vectors, a.seed, &[])?;
-    eprintln!(
+    crate::errln!(
         "rmapgen: wrote {} ({} modules, latency {}, {} memory bits) to {}",
         cfg.summary(),
         manifest.modules.len(),

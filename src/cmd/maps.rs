@@ -50,7 +50,7 @@ pub fn run(a: &MapsArgs) -> Result<()> {
     std::fs::write(out.path(), &bytes)
         .with_context(|| format!("cannot write {}", a.out.display()))?;
     let p = out.commit()?;
-    eprintln!(
+    crate::errln!(
         "rmapgen: wrote {} host writes ({}, scene {}, map_fit {}) to {}",
         3 * cfg.map_entries(),
         cfg.summary(),

@@ -55,7 +55,7 @@ pub struct ProveArgs {
 pub fn run(a: &ProveArgs) -> Result<ExitCode> {
     if !a.merge.is_empty() {
         let m = report::merge(&a.merge)?;
-        print!("{}", m.text);
+        crate::out!("{}", m.text)?;
         return Ok(if m.passed {
             ExitCode::SUCCESS
         } else {
@@ -94,7 +94,7 @@ pub fn run(a: &ProveArgs) -> Result<ExitCode> {
     bar.finish_and_clear();
     staged.commit()?;
     let r = result?;
-    print!("{}", r.summary());
+    crate::out!("{}", r.summary())?;
     if let Some(f) = out {
         std::fs::write(f.path(), serde_json::to_string_pretty(&r)? + "\n")?;
         f.commit()?;

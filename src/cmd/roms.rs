@@ -55,6 +55,6 @@ pub fn run(a: &RomsArgs) -> Result<()> {
         out.keep_others()?;
     }
     let p = out.commit()?;
-    eprintln!("rmapgen: wrote ROM and map hex files to {}", p.display());
+    crate::errln!("rmapgen: wrote ROM and map hex files to {}", p.display());
     Ok(())
 }

@@ -75,7 +75,7 @@ pub fn run(a: &StressArgs) -> Result<()> {
         bar.finish_and_clear();
         r
     };
-    print!("{}", summary(&report));
+    crate::out!("{}", summary(&report))?;
     if let Some(out) = json {
         let text = serde_json::to_string_pretty(&report)?;
         std::fs::write(out.path(), text + "\n")

@@ -72,7 +72,7 @@ pub fn run(a: &VectorsArgs) -> Result<()> {
     bar.finish_and_clear();
     let n = written?;
     out.commit()?;
-    eprintln!(
+    crate::errln!(
         "rmapgen: wrote {n} top vectors ({}) to {}",
         cfg.summary(),
         a.out.display()

@@ -552,7 +552,7 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
     let mut r = r;
     r.format = a.png;
     if let Some(text) = &chosen {
-        println!("{text}");
+        crate::outln!("{text}")?;
     }
     report::check_covered(&r, &vol)?;
     if let Some(n) = r.rtl_mismatches() {
@@ -571,21 +571,21 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
         None
     };
     let dir = out.commit()?;
-    println!("{} -> {}", r.summary(), dir.display());
+    crate::outln!("{} -> {}", r.summary(), dir.display())?;
     let float = r
         .reference_ms
         .map_or(String::new(), |t| format!(", float render {t:.1} ms"));
-    println!(
+    crate::outln!(
         "  {}: load {load_ms:.1} ms, gradients and bricks {prepare_ms:.1} ms, model render {:.1} ms{float} (skipping {})",
         vol.info.source,
         r.model_ms,
         if opts.skip { "on" } else { "off" }
-    );
+    )?;
     if let Some(text) = timing {
-        println!(
+        crate::outln!(
             "  timing, {} threads:\n{text}",
             rayon::current_num_threads()
-        );
+        )?;
     }
     Ok(())
 }

@@ -8,6 +8,7 @@
 //! it holds none of the command's inputs. [`signals`] removes staged output on SIGINT,
 //! SIGTERM and SIGHUP.
 
+pub mod console;
 mod policy;
 pub mod signals;
 pub mod stamp;

@@ -32,6 +32,7 @@ mod rtl_in_loop;
 mod rtl_ip;
 mod sim;
 mod stability;
+mod stdout;
 mod stress;
 mod symmetry;
 mod vectors;
