@@ -36,6 +36,10 @@ enum Command {
     Volume(cmd::volume::VolumeArgs),
     /// Measure one image against another (PNG, same size and kind): largest, mean and RMS
     /// error in LSBs, PSNR and where the worst sample is.
+    ///
+    /// Memory: the images are compared row by row as they are decoded, about 1 MB whatever
+    /// their size; an interlaced (Adam7) PNG is decoded whole first, its decoded size (at
+    /// most 1 GiB each, 16384 pixels a side).
     Compare(cmd::compare::CompareArgs),
     /// Run the model over every gradient (--exhaustive) or a sample sweeping every magnitude,
     /// and report the worst angular and intensity errors per magnitude class.
