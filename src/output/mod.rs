@@ -22,6 +22,32 @@ use std::path::{Path, PathBuf};
 /// Marks a staging directory as rmapgen's while it is being written; removed before commit.
 const STAGING_MARK: &str = ".rmapgen-staging";
 
+/// The longest name of a directory entry (Linux's NAME_MAX, in bytes).
+const NAME_MAX: usize = 255;
+
+/// The hidden names made beside a target named `name`: `.BASE.staging-PID` (and
+/// `.BASE.staging-PID.old`, the previous output moved aside) or `.BASE.partial-PID`, with
+/// `kind` "staging" or "partial". BASE is `name` when every such name fits [`NAME_MAX`];
+/// a longer name is cut (at a character boundary) and ends in `~` and 16 hex digits of its
+/// SHA-256, so the names stay within the limit, stay rmapgen's (`.`, `.staging-`/
+/// `.partial-`, the process id), and are the same for the same target in every run, which
+/// is how [`remove_stale`] finds a killed run's leftovers.
+pub fn hidden_prefix(name: &str, kind: &str) -> String {
+    // "." + ".KIND-" + a u32 process id + ".old".
+    let room = NAME_MAX - (1 + 1 + kind.len() + 1 + u32::MAX.to_string().len() + ".old".len());
+    if name.len() <= room {
+        return format!(".{name}.{kind}-");
+    }
+    use sha2::{Digest, Sha256};
+    let hash = Sha256::digest(name.as_bytes());
+    let tag: String = hash[..8].iter().map(|b| format!("{b:02x}")).collect();
+    let mut cut = room - 1 - tag.len();
+    while !name.is_char_boundary(cut) {
+        cut -= 1;
+    }
+    format!(".{}~{tag}.{kind}-", &name[..cut])
+}
+
 pub struct StagedDir {
     target: PathBuf,
     staging: PathBuf,
@@ -43,8 +69,9 @@ impl StagedDir {
         let parent = parent_of(target);
         let created = CreatedParents::make(&parent)
             .with_context(|| format!("cannot write output directory {}", target.display()))?;
-        remove_stale(&parent, &format!(".{name}.staging-"));
-        let staging = parent.join(format!(".{name}.staging-{}", std::process::id()));
+        let prefix = hidden_prefix(&name, "staging");
+        remove_stale(&parent, &prefix);
+        let staging = parent.join(format!("{prefix}{}", std::process::id()));
         let token = signals::register(Undo::Remove(staging.clone()));
         let made = std::fs::create_dir(&staging)
             .and_then(|()| std::fs::write(staging.join(STAGING_MARK), b""));
@@ -111,7 +138,11 @@ impl StagedDir {
         std::fs::remove_file(self.staging.join(STAGING_MARK))
             .with_context(|| format!("cannot finish {shown}"))?;
         stamp::write(&self.staging).with_context(|| format!("cannot finish {shown}"))?;
-        let old = self.staging.with_extension("old");
+        // Not with_extension: the staging name's extension is `staging-PID`, and the old
+        // output must be found by remove_stale as `<staging>.old`.
+        let mut old = self.staging.clone().into_os_string();
+        old.push(".old");
+        let old = PathBuf::from(old);
         let token = self.token.take().expect("registered until commit");
         {
             // Both renames under one hold: an interrupt sees the old output or the new one.
@@ -182,8 +213,9 @@ impl StagedFile {
         let parent = parent_of(target);
         let created = CreatedParents::make(&parent)
             .with_context(|| format!("cannot write {}", target.display()))?;
-        remove_stale(&parent, &format!(".{name}.partial-"));
-        let partial = parent.join(format!(".{name}.partial-{}", std::process::id()));
+        let prefix = hidden_prefix(&name, "partial");
+        remove_stale(&parent, &prefix);
+        let partial = parent.join(format!("{prefix}{}", std::process::id()));
         let token = signals::register(Undo::Remove(partial.clone()));
         Ok(StagedFile {
             target: target.to_path_buf(),
@@ -394,6 +426,36 @@ mod tests {
                 assert!(parent.join(format!("row{i}")).is_dir());
             }
         }
+    }
+
+    /// Staging and partial names (and the old output's) fit NAME_MAX for every target name
+    /// that fits it, keep rmapgen's marks, and are the same for the same target.
+    #[test]
+    fn hidden_names_fit_the_name_limit() {
+        for bytes in [1, 200, 230, 231, 232, 250, 254, 255] {
+            // One-byte characters, and two-byte ones (plus one byte when odd), so a cut
+            // may fall inside a character.
+            let wide = "é".repeat(bytes / 2) + &"a".repeat(bytes % 2);
+            for name in ["a".repeat(bytes), wide] {
+                assert_eq!(name.len(), bytes);
+                for kind in ["staging", "partial"] {
+                    let p = hidden_prefix(&name, kind);
+                    let longest = format!("{p}{}.old", u32::MAX);
+                    assert!(
+                        longest.len() <= NAME_MAX,
+                        "{} bytes: {longest}",
+                        longest.len()
+                    );
+                    assert!(p.starts_with('.') && p.ends_with(&format!(".{kind}-")));
+                    assert_eq!(p, hidden_prefix(&name, kind));
+                    // Up to 231 bytes the name is kept whole, as before.
+                    assert_eq!(p == format!(".{name}.{kind}-"), bytes <= 231, "{p}");
+                }
+            }
+        }
+        // Two long names that differ only at the end get different prefixes.
+        let (a, b) = ("x".repeat(254) + "a", "x".repeat(254) + "b");
+        assert_ne!(hidden_prefix(&a, "staging"), hidden_prefix(&b, "staging"));
     }
 
     /// A parent that exists as a file is still an error (only a directory made meanwhile is
