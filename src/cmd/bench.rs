@@ -54,7 +54,7 @@ pub struct BenchArgs {
     /// Lane counts of the throughput sweep [default: 1,2,4,8]; without --throughput, the one
     /// lane count each configuration is placed with (its FPGA columns then add samples/s =
     /// lanes x Fmax) [1..=8, default 1].
-    #[arg(long, value_delimiter = ',', value_parser = super::parse::field("lanes"))]
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, value_parser = super::parse::field("lanes"))]
     pub lanes: Vec<u32>,
     /// Families of the throughput sweep [default: ice40,ecp5]; without --throughput, the one
     /// family each configuration is placed on (its default part: iCE40 HX8K, ECP5-85F)

@@ -35,7 +35,7 @@ pub struct MutantsArgs {
     pub method: Vec<Method>,
     /// Judge only these mutants of the draw (their numbers, as printed: `m29` or `29`; the
     /// null mutant always runs).
-    #[arg(long, value_name = "ID", value_delimiter = ',', value_parser = parse_id)]
+    #[arg(long, value_name = "ID", value_delimiter = ',', allow_hyphen_values = true, value_parser = super::parse::named(parse_id))]
     pub only: Vec<usize>,
     /// Run the ground truth only on the mutants the factored proof passes (enough to show it
     /// sound: the bounded sample of `make test`).
@@ -232,7 +232,7 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
 fn parse_id(text: &str) -> Result<usize, String> {
     text.trim_start_matches('m')
         .parse()
-        .map_err(|_| format!("{text:?} is not a mutant number (m29 or 29)"))
+        .map_err(|_| "not a mutant number (m29 or 29)".to_string())
 }
 
 fn print_outcome(o: &Outcome, n: usize) -> Result<()> {

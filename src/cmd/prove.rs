@@ -24,7 +24,7 @@ pub struct ProveArgs {
     pub dir: Option<PathBuf>,
     /// Run shard K of N: each part's inputs split into N contiguous ranges, this run the
     /// K-th; merge the N reports with --merge [N in 1..=1048576].
-    #[arg(long, value_name = "K/N", value_parser = Shard::parse)]
+    #[arg(long, value_name = "K/N", allow_hyphen_values = true, value_parser = super::parse::named(Shard::parse))]
     pub shard: Option<Shard>,
     /// Every gradient through the top instead of the factored proof (grad_bits <= 9).
     #[arg(long)]

@@ -9,6 +9,7 @@ mod ecp5;
 mod errors;
 mod fast;
 mod fit;
+mod flag_and_path_errors;
 mod grid;
 mod hdl;
 mod helpers;

@@ -1,0 +1,83 @@
+//! Issue 32 §6: one line that names the flag, or the path.
+//!
+//! - A value starting with '-' (a negative number inside a range, a shard, a list) reaches
+//!   the flag's own parser, which names the flag, instead of clap's `unexpected argument
+//!   '-1' found`.
+//! - A write that fails names the path the user gave (a bare `Read-only file system (os
+//!   error 30)` names nothing), and fails before the command's work.
+//! - A failure that names a log names it where it is after the command ends, not in the
+//!   staging directory that is gone.
+
+use crate::helpers::{assert_error, run, tempdir};
+use std::path::Path;
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// The narrowest design (grad-bits 8), generated into `dir` with `extra` flags.
+fn narrow(dir: &Path, extra: &[&str]) {
+    let flags = crate::hdl::narrowest_flags();
+    let mut args = vec!["generate", "--vectors", "10", "--out", s(dir)];
+    args.extend(crate::hdl::strs(&flags));
+    args.extend(extra);
+    let o = run(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+#[test]
+fn values_starting_with_a_minus_name_their_flag() {
+    let t = tempdir();
+    let d = t.path().join("d");
+    narrow(&d, &[]);
+    let out = t.path().join("o");
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec![
+                "volume",
+                "--synthetic",
+                "--crop",
+                "-1:5,0:3,0:3",
+                "--out",
+                s(&out),
+            ],
+            "--crop -1:5,0:3,0:3: '-1:5' is not first:last (voxel indices >= 0)",
+        ),
+        (
+            vec![
+                "volume",
+                "--synthetic",
+                "--crop",
+                "0:5,-2:3,0:3",
+                "--out",
+                s(&out),
+            ],
+            "--crop 0:5,-2:3,0:3: '-2:3' is not first:last",
+        ),
+        (
+            vec!["prove", s(&d), "--shard", "-1/2"],
+            "--shard -1/2: K is not a whole number",
+        ),
+        (
+            vec!["prove", s(&d), "--shard", "1/-2"],
+            "--shard 1/-2: N is not a whole number",
+        ),
+        (
+            vec!["bench", "--lanes", "-1,2", "--out", s(&out)],
+            "--lanes must be in 1..=8, not -1",
+        ),
+        (
+            vec!["mutants", s(&d), "--only", "-3,4"],
+            "--only -3: not a mutant number (m29 or 29)",
+        ),
+    ];
+    for (args, want) in cases {
+        let o = run(&args);
+        assert_error(&o, want);
+        assert!(
+            !String::from_utf8_lossy(&o.stderr).contains("unexpected argument"),
+            "{args:?}"
+        );
+    }
+    assert!(!out.exists());
+}
