@@ -177,8 +177,8 @@ fn throughput(a: &BenchArgs) -> Result<()> {
     let rows = match result {
         Ok(rows) => rows,
         Err(e) => {
-            let p = out.commit()?;
-            return Err(e.context(format!("logs in {}", p.display())));
+            let shown = a.out.display().to_string();
+            return Err(out.commit_failed(e).context(format!("logs in {shown}")));
         }
     };
     throughput::write(&rows, &out)?;

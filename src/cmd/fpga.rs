@@ -75,9 +75,9 @@ pub fn run(a: &FpgaArgs) -> Result<()> {
         &a.logs,
         &a.force.policy(&[a.dir.as_deref(), a.cfg.config.as_deref()]),
     )?;
+    // The logs are committed also when the flow fails; its error names them there.
     let result = flow(a, logs.path());
-    let dir = logs.commit()?;
-    let report = result?;
+    let (dir, report) = logs.commit_with(result)?;
     let path = dir.join("report.json");
     crate::outln!(
         "fpga: {} ({:.2} MHz, {} logic cells, {} block RAMs, {} DSP blocks); report {}",

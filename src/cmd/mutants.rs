@@ -219,7 +219,7 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
             "tallies": tallies,
             "outcomes": outcomes,
         });
-        std::fs::write(f.path(), serde_json::to_string_pretty(&json)? + "\n")?;
+        f.write(serde_json::to_string_pretty(&json)? + "\n")?;
         f.commit()?;
     }
     Ok(if unsound.is_empty() {

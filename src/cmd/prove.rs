@@ -92,11 +92,10 @@ pub fn run(a: &ProveArgs) -> Result<ExitCode> {
     );
     let result = prove::run(&design, &build, &opts, &|n| bar.inc(n));
     bar.finish_and_clear();
-    staged.commit()?;
-    let r = result?;
+    let (_, r) = staged.commit_with(result)?;
     crate::out!("{}", r.summary())?;
     if let Some(f) = out {
-        std::fs::write(f.path(), serde_json::to_string_pretty(&r)? + "\n")?;
+        f.write(serde_json::to_string_pretty(&r)? + "\n")?;
         f.commit()?;
     }
     Ok(if r.passed {

@@ -198,8 +198,8 @@ fn prove(
         .current_dir(&dir);
     let ran = toolchain::capture(&mut cmd);
     let log_text = std::fs::read_to_string(dir.join(yosys::LOG)).unwrap_or_default();
-    let shown_logs = absolute(&staged.commit()?);
-    let ran = ran?;
+    let (shown_logs, ran) = staged.commit_with(ran)?;
+    let shown_logs = absolute(&shown_logs);
     let mut results = mult_proof::results(&jobs, &log_text);
     let log = shown_logs.join(yosys::LOG);
     let start = Instant::now();

@@ -45,8 +45,8 @@ pub fn run(a: &SynthArgs) -> Result<ExitCode> {
     let staged = StagedDir::new(&a.logs, &a.force.policy(&[Some(design.path())]))?;
     let logs = absolute(staged.path());
     let result = yosys::check(design.path(), &design.top, design.file_names(), &logs, flow);
-    let logs_shown = absolute(&staged.commit()?);
-    let check = result?;
+    let (logs_shown, check) = staged.commit_with(result)?;
+    let logs_shown = absolute(&logs_shown);
     let log = logs_shown.join(yosys::LOG);
     let what = format!("{} in {}", design.top, a.dir.display());
     if !check.passed {

@@ -100,15 +100,23 @@ impl StagedDir {
         self.write_bytes(rel, t.as_bytes())
     }
 
+    /// Writes one file (relative path; parents created). A failure names the file where it
+    /// will be (`out/model.png`), not in the hidden staging directory.
     pub fn write_bytes(&self, rel: &str, bytes: &[u8]) -> Result<()> {
         let p = self.staging.join(rel);
+        let shown = self.target.join(rel);
         // Held so an interrupt cannot remove the staging directory under a half-made file
         // (create_dir_all would bring it back after the cleanup).
         let _held = signals::hold();
         if let Some(d) = p.parent() {
-            std::fs::create_dir_all(d).with_context(|| format!("cannot create {}", d.display()))?;
+            std::fs::create_dir_all(d).with_context(|| {
+                format!(
+                    "cannot create {}",
+                    shown.parent().unwrap_or(&shown).display()
+                )
+            })?;
         }
-        std::fs::write(&p, bytes).with_context(|| format!("cannot write {}", p.display()))
+        std::fs::write(&p, bytes).with_context(|| format!("cannot write {}", shown.display()))
     }
 
     /// Copies into the staging directory every file of the existing target that this run
@@ -128,6 +136,41 @@ impl StagedDir {
             }
         }
         Ok(())
+    }
+
+    /// Commits the output also when `result` (the work that wrote it) failed, so its logs can
+    /// be read, and returns `result` with the committed directory: a failure that names a
+    /// path in the staging directory, which is gone once the command ends, names the same
+    /// path in the committed one instead (in whatever spelling, relative or absolute, since
+    /// only the staging directory's own name is replaced).
+    pub fn commit_with<T>(self, result: Result<T>) -> Result<(PathBuf, T)> {
+        match result {
+            Ok(v) => Ok((self.commit()?, v)),
+            Err(e) => Err(self.commit_failed(e)),
+        }
+    }
+
+    /// [`StagedDir::commit_with`] for work that failed with `e`: the error to report (the
+    /// commit's own, if it fails).
+    pub fn commit_failed(self, e: anyhow::Error) -> anyhow::Error {
+        let staging_name = self
+            .staging
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned());
+        let target_name = self
+            .target
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned());
+        if let Err(c) = self.commit() {
+            return c;
+        }
+        match (staging_name, target_name) {
+            _ if console::is_stdout_closed(&e) => e,
+            (Some(from), Some(to)) if format!("{e:#}").contains(&from) => {
+                anyhow::anyhow!("{}", format!("{e:#}").replace(&from, &to))
+            }
+            _ => e,
+        }
     }
 
     /// Replaces the target with the staging directory, stamped with what it holds. The
@@ -217,14 +260,28 @@ impl StagedFile {
         remove_stale(&parent, &prefix);
         let partial = parent.join(format!("{prefix}{}", std::process::id()));
         let token = signals::register(Undo::Remove(partial.clone()));
-        Ok(StagedFile {
+        let file = StagedFile {
             target: target.to_path_buf(),
             partial,
             policy: policy.clone(),
             ours,
             token: Some(token),
             created,
-        })
+        };
+        // Made now, empty: a place that cannot be written (a read-only file system) fails
+        // at once, naming the target, not after the command's work.
+        {
+            let _held = signals::hold();
+            std::fs::File::create(&file.partial)
+                .with_context(|| format!("cannot write {}", target.display()))?;
+        }
+        Ok(file)
+    }
+
+    /// Writes the whole file; a failure names the target.
+    pub fn write(&self, bytes: impl AsRef<[u8]>) -> Result<()> {
+        std::fs::write(&self.partial, bytes)
+            .with_context(|| format!("cannot write {}", self.target.display()))
     }
 
     /// Where to write the file now.

@@ -8,7 +8,8 @@
 //! - A failure that names a log names it where it is after the command ends, not in the
 //!   staging directory that is gone.
 
-use crate::helpers::{assert_error, run, tempdir};
+use crate::hdl::require;
+use crate::helpers::{self, assert_error, run, tempdir};
 use std::path::Path;
 
 fn s(p: &Path) -> &str {
@@ -80,4 +81,74 @@ fn values_starting_with_a_minus_name_their_flag() {
         );
     }
     assert!(!out.exists());
+}
+
+/// Every command's output path, where nothing may be created (sysfs refuses new files even
+/// to root): the error names the path given, at once, and nothing is left.
+#[test]
+fn an_unwritable_output_names_its_path() {
+    let t = tempdir();
+    let d = t.path().join("d");
+    narrow(&d, &[]);
+    let build = t.path().join("build");
+    let cases: Vec<Vec<&str>> = vec![
+        vec![
+            "prove",
+            s(&d),
+            "--report",
+            "/sys/rmapgen-r.json",
+            "--build",
+            s(&build),
+        ],
+        vec!["maps", "--out", "/sys/rmapgen-m.hex"],
+        vec!["vectors", "--count", "10", "--out", "/sys/rmapgen-v.hex"],
+        vec!["stress", "--samples", "10", "--json", "/sys/rmapgen-s.json"],
+        vec!["generate", "--out", "/sys/rmapgen-g"],
+        vec!["render", "--size", "16", "--out", "/sys/rmapgen-r"],
+        vec!["fpga", "--dir", s(&d), "--logs", "/sys/rmapgen-f"],
+        vec!["synth", s(&d), "--logs", "/sys/rmapgen-s"],
+        vec!["prove-mult", s(&d), "--logs", "/sys/rmapgen-p"],
+    ];
+    for args in cases {
+        let path = args
+            .iter()
+            .find(|a| a.starts_with("/sys/"))
+            .expect("a path under /sys");
+        let started = std::time::Instant::now();
+        let o = run(&args);
+        assert_error(&o, path);
+        assert!(
+            started.elapsed().as_secs() < 20,
+            "{args:?}: refused before its work"
+        );
+    }
+    assert!(!build.exists(), "prove's build directory was not started");
+}
+
+/// `fpga` on a design whose memories fall back to logic (generated for --target generic)
+/// fails naming the Yosys log: in the --logs directory, where it is after the command, not
+/// in the staging directory beside it that is gone.
+#[test]
+fn a_failed_fpga_names_a_log_that_exists() {
+    if !(require("yosys") && require("nextpnr-ice40")) {
+        return;
+    }
+    let t = tempdir();
+    let d = t.path().join("g");
+    narrow(&d, &["--target", "generic"]);
+    let logs = t.path().join("logs");
+    let o = run(&["fpga", "--dir", s(&d), "--logs", s(&logs)]);
+    assert_error(&o, "fell back to logic");
+    let err = String::from_utf8_lossy(&o.stderr);
+    let named = err
+        .split("(log: ")
+        .nth(1)
+        .and_then(|r| r.split(')').next())
+        .unwrap_or_else(|| panic!("no log named: {err}"));
+    assert!(Path::new(named).is_file(), "{named} does not exist: {err}");
+    assert_eq!(
+        Path::new(named),
+        logs.canonicalize().unwrap().join("yosys.log")
+    );
+    assert_eq!(helpers::entries(t.path()), ["g", "logs"]);
 }
