@@ -142,7 +142,7 @@ pub fn draw_verilog(d: &DesignDir, count: usize, seed: u64, work: &Path) -> Resu
     if count == 0 {
         return Ok(Vec::new());
     }
-    crate::disk::create_dir_all(&work)?;
+    crate::disk::create_dir_all(work)?;
     let list = work.join("mutations.ys");
     let script = format!(
         "{}mutate -list {count} -seed {seed} -o {}\n",
@@ -217,7 +217,7 @@ pub fn draw_memories(d: &DesignDir, per_file: usize, seed: u64) -> Result<Vec<Ch
 
 /// Copies the files of directory `from` into `to` (subdirectories too), both existing.
 fn copy_tree(from: &Path, to: &Path) -> Result<()> {
-    crate::disk::create_dir_all(&to)?;
+    crate::disk::create_dir_all(to)?;
     for e in std::fs::read_dir(from)? {
         let e = e?;
         let (src, dst) = (e.path(), to.join(e.file_name()));

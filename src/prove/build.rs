@@ -127,7 +127,7 @@ fn shared(
     include: &Path,
     strings: &[(String, String)],
 ) -> Result<PathBuf> {
-    crate::disk::create_dir_all(&mdir)?;
+    crate::disk::create_dir_all(mdir)?;
     let lib = format!("lib{prefix}.so");
     let mut cmd = verilator::shared(top, prefix, mdir, &lib, files, harness, include, strings);
     let ran = run_logged(&mut cmd, &mdir.join("verilator.log"))?;
