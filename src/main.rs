@@ -121,13 +121,17 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     }
 }
 
-/// Parses the command line. Negative numbers are taken as values (`--grad-bits -1`), so
-/// they reach the flags' range checks. Help and version print as usual and exit 0; any
-/// other error is one line, the essential one of clap's message.
+/// Parses the command line. Negative numbers are taken as values (`--grad-bits -1`), and so
+/// is anything else starting with '-' and a digit or '.' after a flag that takes a value
+/// (`--shard -1/2`, `--crop -1:5,0:3,0:3`, `--freq -5MHz`), so they reach the flags' own
+/// checks, which name the flag, instead of clap's `unexpected argument '-1' found`. Help and
+/// version print as usual and exit 0; any other error is one line, the essential one of
+/// clap's message.
 fn parse() -> Result<Cli, ExitCode> {
     let cmd = Cli::command().mut_subcommands(|s| s.allow_negative_numbers(true));
+    let args = number_like_values(&cmd, std::env::args_os().collect());
     let parsed = cmd
-        .try_get_matches()
+        .try_get_matches_from(args)
         .and_then(|mut m| Cli::from_arg_matches_mut(&mut m));
     parsed.map_err(|e| {
         use clap::error::ErrorKind;
@@ -142,6 +146,67 @@ fn parse() -> Result<Cli, ExitCode> {
             }
         }
     })
+}
+
+/// `--flag -1/2` as `--flag=-1/2` where `--flag` takes a value in the command given and the
+/// value starts with '-' and a digit or '.': the `=` form is always a value to clap. Other
+/// values starting with '-' (`--out --force`) stay flags.
+fn number_like_values(
+    cmd: &clap::Command,
+    args: Vec<std::ffi::OsString>,
+) -> Vec<std::ffi::OsString> {
+    // Built, so every argument's number of values is known.
+    let mut cmd = cmd.clone();
+    cmd.build();
+    let Some(sub) = args
+        .get(1)
+        .and_then(|a| a.to_str())
+        .and_then(|name| cmd.find_subcommand(name))
+    else {
+        return args;
+    };
+    let takes_value = |flag: &str| {
+        sub.get_arguments().any(|a| {
+            a.get_long() == Some(flag) && a.get_num_args().is_some_and(|n| n.min_values() > 0)
+        })
+    };
+    let number_like = |v: &std::ffi::OsString| {
+        let b = v.as_encoded_bytes();
+        b.len() > 1 && b[0] == b'-' && (b[1].is_ascii_digit() || b[1] == b'.')
+    };
+    let mut out = Vec::with_capacity(args.len());
+    let mut it = args.into_iter();
+    while let Some(a) = it.next() {
+        if a == "--" {
+            out.push(a);
+            out.extend(it);
+            break;
+        }
+        let flag = a
+            .to_str()
+            .and_then(|t| t.strip_prefix("--"))
+            .map(str::to_string);
+        match flag {
+            Some(f) if !f.contains('=') && takes_value(&f) => {
+                let next = it.next();
+                match next {
+                    Some(v) if number_like(&v) => {
+                        let mut joined = a;
+                        joined.push("=");
+                        joined.push(v);
+                        out.push(joined);
+                    }
+                    Some(v) => {
+                        out.push(a);
+                        out.push(v);
+                    }
+                    None => out.push(a),
+                }
+            }
+            _ => out.push(a),
+        }
+    }
+    out
 }
 
 /// The essential line of a clap error: its first line without the `error: ` prefix, with

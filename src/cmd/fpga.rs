@@ -71,6 +71,9 @@ pub fn run(a: &FpgaArgs) -> Result<()> {
         !a.ooc || a.family == Family::Ecp5,
         "--ooc (out-of-context place and route) is for --family ecp5 only; nextpnr-ice40 has no such mode"
     );
+    if let Some(d) = &a.dir {
+        crate::design_dir::DesignDir::open(d)?;
+    }
     let logs = StagedDir::new(
         &a.logs,
         &a.force.policy(&[a.dir.as_deref(), a.cfg.config.as_deref()]),

@@ -71,6 +71,14 @@ fn values_starting_with_a_minus_name_their_flag() {
             vec!["mutants", s(&d), "--only", "-3,4"],
             "--only -3: not a mutant number (m29 or 29)",
         ),
+        (
+            vec!["generate", "--grad-bits", "-1/2", "--out", s(&out)],
+            "--grad-bits must be in 8..=16, not '-1/2'",
+        ),
+        (
+            vec!["fpga", "--freq", "-5MHz", "--logs", s(&out)],
+            "--freq must be a positive number, not -5MHz",
+        ),
     ];
     for (args, want) in cases {
         let o = run(&args);
@@ -151,4 +159,74 @@ fn a_failed_fpga_names_a_log_that_exists() {
         logs.canonicalize().unwrap().join("yosys.log")
     );
     assert_eq!(helpers::entries(t.path()), ["g", "logs"]);
+}
+
+/// Every flag of every command that takes a value, given a value starting with '-' and a
+/// digit that is no number (`-1/2,3`): the value reaches the flag (its error names the flag
+/// or the value, or it is taken as the path it could be), never clap's `unexpected argument
+/// '-1' found`. Flags are read from each command's --help; every run ends in `--help`, so
+/// nothing runs, in a fresh directory that stays empty.
+#[test]
+fn every_value_flag_takes_a_value_starting_with_a_minus() {
+    let t = tempdir();
+    let commands = [
+        "generate",
+        "roms",
+        "maps",
+        "render",
+        "vectors",
+        "volume",
+        "compare",
+        "stress",
+        "bench",
+        "fpga",
+        "fit",
+        "sim",
+        "synth",
+        "prove-mult",
+        "lint",
+        "prove",
+        "mutants",
+    ];
+    let mut checked = 0;
+    for c in commands {
+        let help = String::from_utf8(run(&[c, "--help"]).stdout).unwrap();
+        let flags: Vec<&str> = help
+            .lines()
+            .filter_map(|l| {
+                let l = l.trim_start();
+                let l = l.strip_prefix("-h, ").unwrap_or(l);
+                let (flag, rest) = l.split_once(' ')?;
+                (flag.starts_with("--") && rest.starts_with('<')).then_some(flag)
+            })
+            .collect();
+        for flag in flags {
+            // `--help` with the value first: the value is parsed, nothing runs.
+            let o = helpers::rmapgen()
+                .current_dir(t.path())
+                .args([c, flag, "-1/2,3", "--help"])
+                .output()
+                .unwrap();
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert!(
+                !err.contains("unexpected argument"),
+                "{c} {flag} -1/2,3: {err}"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 150, "only {checked} flags found in the help");
+    assert_eq!(helpers::entries(t.path()), Vec::<String>::new());
+}
+
+/// `fpga --dir` of something that is no design is bad input: refused before the log
+/// directory is made (it was left behind, empty).
+#[test]
+fn fpga_of_no_design_writes_nothing() {
+    let t = tempdir();
+    let logs = t.path().join("build").join("fpga");
+    let missing = t.path().join("missing");
+    let o = run(&["fpga", "--dir", s(&missing), "--logs", s(&logs)]);
+    assert_error(&o, &format!("design directory {}", missing.display()));
+    assert_eq!(helpers::entries(t.path()), Vec::<String>::new());
 }
