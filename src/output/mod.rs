@@ -153,23 +153,10 @@ impl StagedDir {
     /// [`StagedDir::commit_with`] for work that failed with `e`: the error to report (the
     /// commit's own, if it fails).
     pub fn commit_failed(self, e: anyhow::Error) -> anyhow::Error {
-        let staging_name = self
-            .staging
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned());
-        let target_name = self
-            .target
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned());
-        if let Err(c) = self.commit() {
-            return c;
-        }
-        match (staging_name, target_name) {
-            _ if console::is_stdout_closed(&e) => e,
-            (Some(from), Some(to)) if format!("{e:#}").contains(&from) => {
-                anyhow::anyhow!("{}", format!("{e:#}").replace(&from, &to))
-            }
-            _ => e,
+        let (staging, target) = (self.staging.clone(), self.target.clone());
+        match self.commit() {
+            Ok(_) => named_as_target(e, &staging, &target),
+            Err(c) => c,
         }
     }
 
@@ -289,6 +276,12 @@ impl StagedFile {
         &self.partial
     }
 
+    /// `e` (of writing [`StagedFile::path`]) naming the target where it named the partial
+    /// file, which is gone once the command ends.
+    pub fn name_target(&self, e: anyhow::Error) -> anyhow::Error {
+        named_as_target(e, &self.partial, &self.target)
+    }
+
     /// Renames the finished file over the target (checked again first).
     pub fn commit(mut self) -> Result<PathBuf> {
         self.policy.check_file(&self.target, self.ours)?;
@@ -346,6 +339,21 @@ impl Drop for Scratch {
             t.release();
         }
     }
+}
+
+/// `e` with the hidden name `staged` (a staging directory or partial file, in whatever
+/// spelling of its path) replaced by the name of `target` beside it. A closed standard
+/// output, and an error that does not name it, stay as they are.
+fn named_as_target(e: anyhow::Error, staged: &Path, target: &Path) -> anyhow::Error {
+    let (Some(from), Some(to)) = (staged.file_name(), target.file_name()) else {
+        return e;
+    };
+    let (from, to) = (from.to_string_lossy(), to.to_string_lossy());
+    let msg = format!("{e:#}");
+    if console::is_stdout_closed(&e) || !msg.contains(from.as_ref()) {
+        return e;
+    }
+    anyhow::anyhow!("{}", msg.replace(from.as_ref(), &to))
 }
 
 /// The directory an output goes into ("." for a bare name).
@@ -513,6 +521,24 @@ mod tests {
         // Two long names that differ only at the end get different prefixes.
         let (a, b) = ("x".repeat(254) + "a", "x".repeat(254) + "b");
         assert_ne!(hidden_prefix(&a, "staging"), hidden_prefix(&b, "staging"));
+    }
+
+    /// An error naming a staging directory or partial file names the target instead, in
+    /// any spelling of the path; a closed standard output stays what it is.
+    #[test]
+    fn errors_name_the_target_not_the_hidden_name() {
+        let staged = Path::new("/a/b/.out.partial-123");
+        let target = Path::new("/a/b/out");
+        let e =
+            anyhow::anyhow!("No space left on device").context("cannot write b/.out.partial-123");
+        assert_eq!(
+            format!("{:#}", named_as_target(e, staged, target)),
+            "cannot write b/out: No space left on device"
+        );
+        let e = anyhow::Error::new(console::StdoutClosed).context("x .out.partial-123");
+        assert!(console::is_stdout_closed(&named_as_target(
+            e, staged, target
+        )));
     }
 
     /// A parent that exists as a file is still an error (only a directory made meanwhile is

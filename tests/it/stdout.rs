@@ -110,3 +110,63 @@ fn help_to_a_closed_pipe_and_to_a_full_device_is_no_panic() {
         }
     }
 }
+
+#[test]
+fn volume_and_lint_to_a_closed_pipe_and_to_a_full_device() {
+    let d = tempdir();
+    let v = d.path().join("v");
+    let volume = [
+        "volume",
+        "--synthetic",
+        "--dims",
+        "16,16,16",
+        "--size",
+        "16",
+        "--force",
+        "--out",
+        s(&v),
+    ];
+    closed_pipe_is_quiet(&volume);
+    full_device_is_one_line(&volume);
+    if !crate::hdl::require("verilator") {
+        return;
+    }
+    let g = d.path().join("g");
+    let flags = crate::hdl::narrowest_flags();
+    let mut args = vec!["generate", "--vectors", "10", "--out", s(&g)];
+    args.extend(crate::hdl::strs(&flags));
+    assert!(helpers::run(&args).status.success());
+    let lint = ["lint", s(&g)];
+    closed_pipe_is_quiet(&lint);
+    full_device_is_one_line(&lint);
+}
+
+/// Messages on standard error are best effort: a standard error on a full device is no
+/// panic, and the command's result stands.
+#[test]
+fn a_full_standard_error_is_no_panic() {
+    let d = tempdir();
+    let g = d.path().join("g");
+    let full = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/full")
+        .expect("/dev/full (Linux)");
+    let o = helpers::rmapgen()
+        .args(["generate", "--vectors", "10", "--out", s(&g)])
+        .stderr(Stdio::from(full))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0));
+    assert!(helpers::nonempty(&g));
+    // A failing command still fails with exit 2 (its one line lost).
+    let full = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/full")
+        .unwrap();
+    let o = helpers::rmapgen()
+        .args(["generate", "--grad-bits", "99", "--out", s(&g)])
+        .stderr(Stdio::from(full))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+}
