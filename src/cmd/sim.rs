@@ -174,8 +174,7 @@ fn simulate(design: &DesignDir, a: &SimArgs, opts: &Options) -> Result<Outcome> 
         }
     });
     printed?;
-    staged.commit()?;
-    let outcome = result?;
+    let (_, outcome) = staged.commit_with(result)?;
     crate::out!("{}", outcome.summary(design))?;
     Ok(outcome)
 }
