@@ -122,7 +122,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
 }
 
 /// Parses the command line. Negative numbers are taken as values (`--grad-bits -1`), and so
-/// is anything else starting with '-' and a digit or '.' after a flag that takes a value
+/// is anything else starting with '-' and a digit or '.' after a flag that takes one value
 /// (`--shard -1/2`, `--crop -1:5,0:3,0:3`, `--freq -5MHz`), so they reach the flags' own
 /// checks, which name the flag, instead of clap's `unexpected argument '-1' found`. Help and
 /// version print as usual and exit 0; any other error is one line, the essential one of
@@ -150,7 +150,8 @@ fn parse() -> Result<Cli, ExitCode> {
 
 /// `--flag -1/2` as `--flag=-1/2` where `--flag` takes a value in the command given and the
 /// value starts with '-' and a digit or '.': the `=` form is always a value to clap. Other
-/// values starting with '-' (`--out --force`) stay flags.
+/// values starting with '-' (`--out --force`) stay flags. A flag of several values
+/// (`prove --merge A -1/2`) has each of its values so.
 fn number_like_values(
     cmd: &clap::Command,
     args: Vec<std::ffi::OsString>,
@@ -165,17 +166,26 @@ fn number_like_values(
     else {
         return args;
     };
-    let takes_value = |flag: &str| {
-        sub.get_arguments().any(|a| {
-            a.get_long() == Some(flag) && a.get_num_args().is_some_and(|n| n.min_values() > 0)
-        })
+    // How many values a flag takes at one occurrence: None for no value, else the most.
+    let values = |flag: &str| {
+        sub.get_arguments()
+            .find(|a| a.get_long() == Some(flag))
+            .and_then(|a| a.get_num_args())
+            .filter(|n| n.min_values() > 0)
+            .map(|n| n.max_values())
     };
     let number_like = |v: &std::ffi::OsString| {
         let b = v.as_encoded_bytes();
         b.len() > 1 && b[0] == b'-' && (b[1].is_ascii_digit() || b[1] == b'.')
     };
+    let joined = |flag: &std::ffi::OsString, v: std::ffi::OsString| {
+        let mut j = flag.clone();
+        j.push("=");
+        j.push(v);
+        j
+    };
     let mut out = Vec::with_capacity(args.len());
-    let mut it = args.into_iter();
+    let mut it = args.into_iter().peekable();
     while let Some(a) = it.next() {
         if a == "--" {
             out.push(a);
@@ -185,22 +195,26 @@ fn number_like_values(
         let flag = a
             .to_str()
             .and_then(|t| t.strip_prefix("--"))
+            .filter(|f| !f.contains('='))
             .map(str::to_string);
-        match flag {
-            Some(f) if !f.contains('=') && takes_value(&f) => {
-                let next = it.next();
-                match next {
-                    Some(v) if number_like(&v) => {
-                        let mut joined = a;
-                        joined.push("=");
-                        joined.push(v);
-                        out.push(joined);
-                    }
-                    Some(v) => {
-                        out.push(a);
-                        out.push(v);
-                    }
-                    None => out.push(a),
+        match flag.and_then(|f| values(&f)) {
+            // One value: `--flag=VALUE` if it looks like a negative number.
+            Some(1) => match it.next() {
+                Some(v) if number_like(&v) => out.push(joined(&a, v)),
+                Some(v) => out.extend([a, v]),
+                None => out.push(a),
+            },
+            // Several (`prove --merge A B ...`): each value clap would take, and those that
+            // look like negative numbers, as `--flag=VALUE` (the flag's values accumulate).
+            Some(_) => {
+                let before = out.len();
+                while let Some(v) =
+                    it.next_if(|v| number_like(v) || !v.as_encoded_bytes().starts_with(b"-"))
+                {
+                    out.push(joined(&a, v));
+                }
+                if out.len() == before {
+                    out.push(a);
                 }
             }
             _ => out.push(a),

@@ -79,6 +79,11 @@ fn values_starting_with_a_minus_name_their_flag() {
             vec!["fpga", "--freq", "-5MHz", "--logs", s(&out)],
             "--freq must be a positive number, not -5MHz",
         ),
+        // A flag of several values keeps them all (a negative number among them too).
+        (
+            vec!["prove", "--merge", "-1", "x.json"],
+            "cannot read -1: No such file",
+        ),
     ];
     for (args, want) in cases {
         let o = run(&args);
