@@ -41,3 +41,14 @@ pub fn check_space(dir: &Path, need: u64, what: &str) -> Result<()> {
     }
     Ok(())
 }
+
+/// `std::fs::write` whose error names the file (a bare `Read-only file system (os error
+/// 30)` says nothing of where).
+pub fn write(path: &Path, bytes: impl AsRef<[u8]>) -> Result<()> {
+    std::fs::write(path, bytes).with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// `std::fs::create_dir_all` whose error names the directory.
+pub fn create_dir_all(path: &Path) -> Result<()> {
+    std::fs::create_dir_all(path).with_context(|| format!("cannot create {}", path.display()))
+}

@@ -36,6 +36,10 @@ enum Command {
     Volume(cmd::volume::VolumeArgs),
     /// Measure one image against another (PNG, same size and kind): largest, mean and RMS
     /// error in LSBs, PSNR and where the worst sample is.
+    ///
+    /// Memory: the images are compared row by row as they are decoded, about 1 MB whatever
+    /// their size; an interlaced (Adam7) PNG is decoded whole first, its decoded size (at
+    /// most 1 GiB each, 16384 pixels a side).
     Compare(cmd::compare::CompareArgs),
     /// Run the model over every gradient (--exhaustive) or a sample sweeping every magnitude,
     /// and report the worst angular and intensity errors per magnitude class.
@@ -117,13 +121,17 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     }
 }
 
-/// Parses the command line. Negative numbers are taken as values (`--grad-bits -1`), so
-/// they reach the flags' range checks. Help and version print as usual and exit 0; any
-/// other error is one line, the essential one of clap's message.
+/// Parses the command line. Negative numbers are taken as values (`--grad-bits -1`), and so
+/// is anything else starting with '-' and a digit or '.' after a flag that takes one value
+/// (`--shard -1/2`, `--crop -1:5,0:3,0:3`, `--freq -5MHz`), so they reach the flags' own
+/// checks, which name the flag, instead of clap's `unexpected argument '-1' found`. Help and
+/// version print as usual and exit 0; any other error is one line, the essential one of
+/// clap's message.
 fn parse() -> Result<Cli, ExitCode> {
     let cmd = Cli::command().mut_subcommands(|s| s.allow_negative_numbers(true));
+    let args = number_like_values(&cmd, std::env::args_os().collect());
     let parsed = cmd
-        .try_get_matches()
+        .try_get_matches_from(args)
         .and_then(|mut m| Cli::from_arg_matches_mut(&mut m));
     parsed.map_err(|e| {
         use clap::error::ErrorKind;
@@ -133,11 +141,86 @@ fn parse() -> Result<Cli, ExitCode> {
                 ExitCode::SUCCESS
             }
             _ => {
-                eprintln!("rmapgen: error: {}", usage_line(&e));
+                rmapgen::errln!("rmapgen: error: {}", usage_line(&e));
                 ExitCode::from(2)
             }
         }
     })
+}
+
+/// `--flag -1/2` as `--flag=-1/2` where `--flag` takes a value in the command given and the
+/// value starts with '-' and a digit or '.': the `=` form is always a value to clap. Other
+/// values starting with '-' (`--out --force`) stay flags. A flag of several values
+/// (`prove --merge A -1/2`) has each of its values so.
+fn number_like_values(
+    cmd: &clap::Command,
+    args: Vec<std::ffi::OsString>,
+) -> Vec<std::ffi::OsString> {
+    // Built, so every argument's number of values is known.
+    let mut cmd = cmd.clone();
+    cmd.build();
+    let Some(sub) = args
+        .get(1)
+        .and_then(|a| a.to_str())
+        .and_then(|name| cmd.find_subcommand(name))
+    else {
+        return args;
+    };
+    // How many values a flag takes at one occurrence: None for no value, else the most.
+    let values = |flag: &str| {
+        sub.get_arguments()
+            .find(|a| a.get_long() == Some(flag))
+            .and_then(|a| a.get_num_args())
+            .filter(|n| n.min_values() > 0)
+            .map(|n| n.max_values())
+    };
+    let number_like = |v: &std::ffi::OsString| {
+        let b = v.as_encoded_bytes();
+        b.len() > 1 && b[0] == b'-' && (b[1].is_ascii_digit() || b[1] == b'.')
+    };
+    let joined = |flag: &std::ffi::OsString, v: std::ffi::OsString| {
+        let mut j = flag.clone();
+        j.push("=");
+        j.push(v);
+        j
+    };
+    let mut out = Vec::with_capacity(args.len());
+    let mut it = args.into_iter().peekable();
+    while let Some(a) = it.next() {
+        if a == "--" {
+            out.push(a);
+            out.extend(it);
+            break;
+        }
+        let flag = a
+            .to_str()
+            .and_then(|t| t.strip_prefix("--"))
+            .filter(|f| !f.contains('='))
+            .map(str::to_string);
+        match flag.and_then(|f| values(&f)) {
+            // One value: `--flag=VALUE` if it looks like a negative number.
+            Some(1) => match it.next() {
+                Some(v) if number_like(&v) => out.push(joined(&a, v)),
+                Some(v) => out.extend([a, v]),
+                None => out.push(a),
+            },
+            // Several (`prove --merge A B ...`): each value clap would take, and those that
+            // look like negative numbers, as `--flag=VALUE` (the flag's values accumulate).
+            Some(_) => {
+                let before = out.len();
+                while let Some(v) =
+                    it.next_if(|v| number_like(v) || !v.as_encoded_bytes().starts_with(b"-"))
+                {
+                    out.push(joined(&a, v));
+                }
+                if out.len() == before {
+                    out.push(a);
+                }
+            }
+            _ => out.push(a),
+        }
+    }
+    out
 }
 
 /// The essential line of a clap error: its first line without the `error: ` prefix, with
@@ -211,10 +294,13 @@ fn main() -> ExitCode {
     };
     match run(cli) {
         Ok(code) => code,
+        // The reader of standard output closed it: it wants no more, so the command has
+        // stopped quietly (src/output/console.rs).
+        Err(e) if rmapgen::output::console::is_stdout_closed(&e) => ExitCode::SUCCESS,
         Err(e) => {
             // One line, the whole cause chain.
             let msg = format!("{e:#}").replace(['\n', '\r'], " ");
-            eprintln!("rmapgen: error: {msg}");
+            rmapgen::errln!("rmapgen: error: {msg}");
             ExitCode::from(2)
         }
     }

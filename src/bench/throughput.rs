@@ -201,10 +201,9 @@ fn configuration(
                 "{name}: more port bits than pins; placing out of context"
             ));
             let (stem, ext) = split(crate::toolchain::nextpnr::LOG);
-            std::fs::rename(
-                logs.join(crate::toolchain::nextpnr::LOG),
-                logs.join(format!("{stem}_in_context.{ext}")),
-            )?;
+            let to = logs.join(format!("{stem}_in_context.{ext}"));
+            std::fs::rename(logs.join(crate::toolchain::nextpnr::LOG), &to)
+                .with_context(|| format!("cannot write {}", to.display()))?;
             opts.out_of_context = true;
             row.out_of_context = true;
             placed = fpga::place(&syn, &opts);
@@ -229,7 +228,9 @@ fn configuration(
             crate::toolchain::nextpnr::REPORT,
         ] {
             let (stem, ext) = split(f);
-            std::fs::rename(logs.join(f), logs.join(format!("{stem}_seed{seed}.{ext}")))?;
+            let to = logs.join(format!("{stem}_seed{seed}.{ext}"));
+            std::fs::rename(logs.join(f), &to)
+                .with_context(|| format!("cannot write {}", to.display()))?;
         }
     }
     let fmaxes: Vec<f64> = reports.iter().map(|r| r.fmax_mhz).collect();

@@ -54,7 +54,7 @@ pub struct BenchArgs {
     /// Lane counts of the throughput sweep [default: 1,2,4,8]; without --throughput, the one
     /// lane count each configuration is placed with (its FPGA columns then add samples/s =
     /// lanes x Fmax) [1..=8, default 1].
-    #[arg(long, value_delimiter = ',', value_parser = super::parse::field("lanes"))]
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, value_parser = super::parse::field("lanes"))]
     pub lanes: Vec<u32>,
     /// Families of the throughput sweep [default: ice40,ecp5]; without --throughput, the one
     /// family each configuration is placed on (its default part: iCE40 HX8K, ECP5-85F)
@@ -126,8 +126,8 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let rows = rows?;
     bench::write(&rows, &out)?;
     let p = out.commit()?;
-    print!("{}", bench::table::markdown(&rows));
-    eprintln!(
+    crate::out!("{}", bench::table::markdown(&rows))?;
+    crate::errln!(
         "rmapgen: wrote bench.md, bench.csv, bench.json and plots to {}",
         p.display()
     );
@@ -172,19 +172,19 @@ fn throughput(a: &BenchArgs) -> Result<()> {
     once("--family", &sweep.families)?;
     once("--mult", &sweep.mults)?;
     let out = StagedDir::new(&a.out, &a.force.policy(&[]))?;
-    let result = throughput::run(&sweep, &out, &|m| eprintln!("rmapgen: throughput: {m}"));
+    let result = throughput::run(&sweep, &out, &|m| crate::errln!("rmapgen: throughput: {m}"));
     // The logs are kept also when a configuration fails, so that they can be read.
     let rows = match result {
         Ok(rows) => rows,
         Err(e) => {
-            let p = out.commit()?;
-            return Err(e.context(format!("logs in {}", p.display())));
+            let shown = a.out.display().to_string();
+            return Err(out.commit_failed(e).context(format!("logs in {shown}")));
         }
     };
     throughput::write(&rows, &out)?;
     let p = out.commit()?;
-    print!("{}", throughput::markdown(&rows));
-    eprintln!(
+    crate::out!("{}", throughput::markdown(&rows))?;
+    crate::errln!(
         "rmapgen: wrote throughput.md, throughput.csv, throughput.json and the logs to {}",
         p.display()
     );

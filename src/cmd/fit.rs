@@ -177,7 +177,7 @@ pub fn run(a: &FitArgs) -> Result<()> {
         &[("fit.json".to_string(), json)],
         generate::Keep::Nothing,
     )?;
-    println!(
+    crate::outln!(
         "fit: {} ({}), {}x{} sphere ({} pixels), maps {}; target {}; cost {}",
         scene_file,
         d.scene_terms,
@@ -193,29 +193,29 @@ pub fn run(a: &FitArgs) -> Result<()> {
                 f => format!("Yosys cells ({} synthesis)", f.title()),
             },
         }
-    );
+    )?;
     match d.cost {
-        CostKind::Bits => println!(
+        CostKind::Bits => crate::outln!(
             "fit: {} configurations, {} measured in {:.1} s; every one cheaper than the choice ({}) measured and rejected",
             d.space, d.measured, d.seconds, d.cheaper_rejected
-        ),
-        CostKind::Cells => println!(
+        )?,
+        CostKind::Cells => crate::outln!(
             "fit: {} configurations, {} measured in {:.1} s; the {} cheaper in bits than the cheapest passing one measured and rejected; cells of the {} synthesised (per combination of compensation and interpolation, its cheapest passing configurations in bits)",
             d.space,
             d.measured,
             d.seconds,
             d.cheaper_rejected,
             d.synthesised
-        ),
+        )?,
     }
-    print!("{}", d.table());
+    crate::out!("{}", d.table())?;
     let modules: Vec<&str> = manifest.modules.iter().map(|m| m.name.as_str()).collect();
-    println!(
+    crate::outln!(
         "fit: wrote {} ({} memory bits; modules {}) to {}",
         cfg.summary(),
         manifest.memory_bits,
         modules.join(" "),
         p.display()
-    );
+    )?;
     Ok(())
 }

@@ -80,11 +80,11 @@ pub fn run(a: &FpgaArgs) -> Result<()> {
         &a.logs,
         &a.force.policy(&[a.dir.as_deref(), a.cfg.config.as_deref()]),
     )?;
+    // The logs are committed also when the flow fails; its error names them there.
     let result = flow(a, logs.path());
-    let dir = logs.commit()?;
-    let report = result?;
+    let (dir, report) = logs.commit_with(result)?;
     let path = dir.join("report.json");
-    println!(
+    crate::outln!(
         "fpga: {} ({:.2} MHz, {} logic cells, {} block RAMs, {} DSP blocks); report {}",
         if report.timing_met {
             "timing met"
@@ -96,7 +96,7 @@ pub fn run(a: &FpgaArgs) -> Result<()> {
         report.block_rams,
         report.dsps,
         path.display()
-    );
+    )?;
     anyhow::ensure!(
         report.timing_met || !a.require_timing,
         "post-route Fmax {:.2} MHz is below the {} MHz target (--require-timing); critical path {}",
@@ -136,7 +136,7 @@ fn flow(a: &FpgaArgs, logs: &Path) -> Result<fpga::FpgaReport> {
             (cfg.summary(), fpga::report(&cfg, &opts)?)
         }
     };
-    print!("fpga: {what}\n{}", report.summary());
+    crate::out!("fpga: {what}\n{}", report.summary())?;
     let json = serde_json::to_string_pretty(&report)?;
     let path = logs.join("report.json");
     std::fs::write(&path, json + "\n")

@@ -57,7 +57,7 @@ pub fn run(a: &GenerateArgs) -> Result<()> {
         Some(old) if old != cfg => format!(", replacing its {} design", old.summary_full()),
         _ => String::new(),
     };
-    eprintln!(
+    crate::errln!(
         "rmapgen: wrote {} ({} modules, latency {}, {} memory bits) to {}{replaced}",
         cfg.summary_full(),
         manifest.modules.len(),

@@ -30,11 +30,11 @@ pub fn run(a: &LintArgs) -> Result<ExitCode> {
     let ran = toolchain::capture(&mut cmd)?;
     let shown = a.dir.display();
     if ran.success() && ran.output.trim().is_empty() {
-        println!("lint: {shown} is clean (verilator -Wall, no warnings)");
+        crate::outln!("lint: {shown} is clean (verilator -Wall, no warnings)")?;
         return Ok(ExitCode::SUCCESS);
     }
-    eprint!("{}", ran.output);
-    eprintln!(
+    crate::err!("{}", ran.output);
+    crate::errln!(
         "lint: {shown}: verilator -Wall is not silent ({}; {})",
         ran.exit(),
         toolchain::shell_line(&cmd)

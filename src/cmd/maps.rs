@@ -7,7 +7,7 @@ use super::map_args::MapArgs;
 use crate::design::Design;
 use crate::map_stream::{self, Format};
 use crate::output::StagedFile;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -47,10 +47,9 @@ pub fn run(a: &MapsArgs) -> Result<()> {
     // The design's own maps (buffer 0, what map_<axis>.hex and the bank init files hold).
     let design = Design::for_scene(&cfg, &scene)?;
     let bytes = map_stream::encode(&cfg, &scene, &design.maps.scene, a.format);
-    std::fs::write(out.path(), &bytes)
-        .with_context(|| format!("cannot write {}", a.out.display()))?;
+    out.write(&bytes)?;
     let p = out.commit()?;
-    eprintln!(
+    crate::errln!(
         "rmapgen: wrote {} host writes ({}, scene {}, map_fit {}) to {}",
         3 * cfg.map_entries(),
         cfg.summary(),

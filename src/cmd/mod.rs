@@ -97,5 +97,8 @@ mod limits_in_help {
         assert_eq!(crate::volume::load::MAX_HEADER_BYTES, 1 << 20);
         assert_eq!(crate::vectors::MAX_STAGE_VECTORS, 1_000_000);
         assert_eq!(crate::vectors::MAX_STREAM_VECTORS, 10_000_000_000);
+        // compare's help (src/main.rs): "at most 1 GiB each, 16384 pixels a side".
+        assert_eq!(crate::cmd::compare::MAX_ALLOC, 1 << 30);
+        assert_eq!(crate::cmd::compare::MAX_SIDE, 16384);
     }
 }

@@ -35,7 +35,7 @@ pub struct MutantsArgs {
     pub method: Vec<Method>,
     /// Judge only these mutants of the draw (their numbers, as printed: `m29` or `29`; the
     /// null mutant always runs).
-    #[arg(long, value_name = "ID", value_delimiter = ',', value_parser = parse_id)]
+    #[arg(long, value_name = "ID", value_delimiter = ',', allow_hyphen_values = true, value_parser = super::parse::named(parse_id))]
     pub only: Vec<usize>,
     /// Run the ground truth only on the mutants the factored proof passes (enough to show it
     /// sound: the bounded sample of `make test`).
@@ -111,7 +111,7 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
         timeout: Duration::from_secs(a.timeout),
         sim_stream: a.sim_stream,
     };
-    println!(
+    crate::outln!(
         "mutants of {} ({}): the null mutant, {} Verilog (Yosys mutate, seed {}), {} memory; ground truth prove --direct{}; {} at a time",
         design.path().display(),
         design.config.summary(),
@@ -120,13 +120,13 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
         list.iter().filter(|m| matches!(m.change, Change::Memory { .. })).count(),
         if a.quick { " on the mutants prove passes" } else { "" },
         a.jobs
-    );
+    )?;
     let t0 = Instant::now();
     let next = AtomicUsize::new(0);
     let results: Mutex<Vec<Result<Outcome>>> = Mutex::new(Vec::new());
     // The null mutant first, alone: if the flow changes the design, nothing else means much.
     let null = mutants::judge(&design, &list[0], &plan, &work)?;
-    print_outcome(&null, n);
+    print_outcome(&null, n)?;
     let broken: Vec<String> = null
         .verdicts
         .iter()
@@ -147,10 +147,9 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
             s.spawn(|| loop {
                 let k = next.fetch_add(1, Ordering::SeqCst);
                 let Some(m) = list.get(k) else { break };
-                let r = mutants::judge(&design, m, &plan, &work);
-                if let Ok(o) = &r {
-                    print_outcome(o, n);
-                }
+                // A line that cannot be printed is the mutant's error.
+                let r = mutants::judge(&design, m, &plan, &work)
+                    .and_then(|o| print_outcome(&o, n).map(|()| o));
                 results.lock().unwrap_or_else(|e| e.into_inner()).push(r);
             });
         }
@@ -166,7 +165,7 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
     } else {
         methods.extend(&a.method);
     }
-    println!(
+    crate::outln!(
         "{:<8} {:>7} {:>11} {:>15} {:>7} {:>9} {:>17}",
         "method",
         "judged",
@@ -175,13 +174,13 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
         "killed",
         "survived",
         "killed unclassed"
-    );
+    )?;
     let tallies: Vec<_> = methods
         .iter()
         .map(|&m| mutants::tally(m, &outcomes))
         .collect();
     for t in &tallies {
-        println!(
+        crate::outln!(
             "{:<8} {:>7} {:>11} {:>15} {:>7} {:>9} {:>17}",
             t.method,
             t.judged,
@@ -190,16 +189,16 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
             t.killed,
             t.survived,
             t.killed_unclassed
-        );
+        )?;
     }
     let unsound: Vec<&Outcome> = outcomes.iter().filter(|o| o.unsound()).collect();
     for o in &unsound {
-        println!(
+        crate::outln!(
             "SURVIVED (outputs differ under prove --direct, passed by prove): {}",
             o.mutant.describe()
-        );
+        )?;
     }
-    println!(
+    crate::outln!(
         "{}: {} mutants in {:.0} s",
         if unsound.is_empty() {
             "SOUND"
@@ -208,7 +207,7 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
         },
         outcomes.len() - 1,
         t0.elapsed().as_secs_f64()
-    );
+    )?;
     staged.commit()?;
     if let Some(f) = out {
         let json = serde_json::json!({
@@ -220,7 +219,7 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
             "tallies": tallies,
             "outcomes": outcomes,
         });
-        std::fs::write(f.path(), serde_json::to_string_pretty(&json)? + "\n")?;
+        f.write(serde_json::to_string_pretty(&json)? + "\n")?;
         f.commit()?;
     }
     Ok(if unsound.is_empty() {
@@ -233,21 +232,21 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
 fn parse_id(text: &str) -> Result<usize, String> {
     text.trim_start_matches('m')
         .parse()
-        .map_err(|_| format!("{text:?} is not a mutant number (m29 or 29)"))
+        .map_err(|_| "not a mutant number (m29 or 29)".to_string())
 }
 
-fn print_outcome(o: &Outcome, n: usize) {
+fn print_outcome(o: &Outcome, n: usize) -> Result<()> {
     let verdicts: Vec<String> = o
         .verdicts
         .iter()
         .map(|(m, v)| format!("{} {}", m.name(), format!("{v:?}").to_lowercase()))
         .collect();
-    println!(
+    crate::outln!(
         "  [{}/{}] {:>6.1} s  {}: {}",
         o.mutant.id,
         n - 1,
         o.seconds,
         verdicts.join(", "),
         o.mutant.describe()
-    );
+    )
 }

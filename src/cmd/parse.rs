@@ -227,3 +227,31 @@ impl TypedValueParser for Real {
         }
     }
 }
+
+/// A value read by a function whose error says what is wrong with it (without the flag):
+/// the error is one line naming the flag and the value, `--shard -1/2: K is not a whole
+/// number`. Give such a flag `allow_hyphen_values`, so a value starting with '-' (`-1/2`,
+/// `-1:5,0:3,0:3`) reaches the function instead of clap's "unexpected argument '-1'".
+#[derive(Clone)]
+pub struct Named<T>(fn(&str) -> Result<T, String>);
+
+pub fn named<T>(read: fn(&str) -> Result<T, String>) -> Named<T> {
+    Named(read)
+}
+
+impl<T: Clone + Send + Sync + 'static> TypedValueParser for Named<T> {
+    type Value = T;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &OsStr,
+    ) -> Result<T, clap::Error> {
+        let name = flag_name(arg);
+        let s = value
+            .to_str()
+            .ok_or_else(|| fail(cmd, format!("{name} {value:?} is not UTF-8")))?;
+        (self.0)(s).map_err(|why| fail(cmd, format!("{name} {s}: {why}")))
+    }
+}

@@ -24,7 +24,7 @@ pub struct ProveArgs {
     pub dir: Option<PathBuf>,
     /// Run shard K of N: each part's inputs split into N contiguous ranges, this run the
     /// K-th; merge the N reports with --merge [N in 1..=1048576].
-    #[arg(long, value_name = "K/N", value_parser = Shard::parse)]
+    #[arg(long, value_name = "K/N", allow_hyphen_values = true, value_parser = super::parse::named(Shard::parse))]
     pub shard: Option<Shard>,
     /// Every gradient through the top instead of the factored proof (grad_bits <= 9).
     #[arg(long)]
@@ -55,7 +55,7 @@ pub struct ProveArgs {
 pub fn run(a: &ProveArgs) -> Result<ExitCode> {
     if !a.merge.is_empty() {
         let m = report::merge(&a.merge)?;
-        print!("{}", m.text);
+        crate::out!("{}", m.text)?;
         return Ok(if m.passed {
             ExitCode::SUCCESS
         } else {
@@ -92,11 +92,10 @@ pub fn run(a: &ProveArgs) -> Result<ExitCode> {
     );
     let result = prove::run(&design, &build, &opts, &|n| bar.inc(n));
     bar.finish_and_clear();
-    staged.commit()?;
-    let r = result?;
-    print!("{}", r.summary());
+    let (_, r) = staged.commit_with(result)?;
+    crate::out!("{}", r.summary())?;
     if let Some(f) = out {
-        std::fs::write(f.path(), serde_json::to_string_pretty(&r)? + "\n")?;
+        f.write(serde_json::to_string_pretty(&r)? + "\n")?;
         f.commit()?;
     }
     Ok(if r.passed {

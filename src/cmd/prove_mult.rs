@@ -86,8 +86,8 @@ pub fn run(a: &ProveMultArgs) -> Result<ExitCode> {
             a.engine,
             &a.tree,
         )?;
-        print!("{}", proof.stdout);
-        eprint!("{}", proof.stderr);
+        crate::out!("{}", proof.stdout)?;
+        crate::err!("{}", proof.stderr);
         !proof.passed
     };
     Ok(if failed {
@@ -198,8 +198,8 @@ fn prove(
         .current_dir(&dir);
     let ran = toolchain::capture(&mut cmd);
     let log_text = std::fs::read_to_string(dir.join(yosys::LOG)).unwrap_or_default();
-    let shown_logs = absolute(&staged.commit()?);
-    let ran = ran?;
+    let (shown_logs, ran) = staged.commit_with(ran)?;
+    let shown_logs = absolute(&shown_logs);
     let mut results = mult_proof::results(&jobs, &log_text);
     let log = shown_logs.join(yosys::LOG);
     let start = Instant::now();
@@ -301,14 +301,15 @@ fn matrix(a: &ProveMultArgs, rows: &[GridRow]) -> Result<bool> {
                     a.engine,
                     &a.tree,
                 );
-                if let Ok(p) = &proof {
-                    // One row's lines together, under its name.
+                // One row's lines together, under its name; a failed print is the row's error.
+                let proof = proof.and_then(|p| {
                     let mut all =
                         format!("==== {}: {} ({})\n", r.name, r.config.summary(), r.covers);
                     all += &p.stdout;
-                    print!("{all}");
-                    eprint!("{}", p.stderr);
-                }
+                    crate::out!("{all}")?;
+                    crate::err!("{}", p.stderr);
+                    Ok(p)
+                });
                 out.lock().expect("no worker panics")[i] = Some(proof);
             });
         }
@@ -325,7 +326,7 @@ fn matrix(a: &ProveMultArgs, rows: &[GridRow]) -> Result<bool> {
         }
     }
     if failed.is_empty() {
-        println!(
+        crate::outln!(
             "prove-mult: every row proved ({} row{}, {cases} SAT cases, {} inputs evaluated, {:.0} s of Yosys and evaluation in {:.0} s on {workers} job{})",
             rows.len(),
             if rows.len() == 1 { "" } else { "s" },
@@ -333,9 +334,9 @@ fn matrix(a: &ProveMultArgs, rows: &[GridRow]) -> Result<bool> {
             cpu,
             start.elapsed().as_secs_f64(),
             if workers == 1 { "" } else { "s" }
-        );
+        )?;
     } else {
-        println!("prove-mult: FAILED: {}", failed.join(" "));
+        crate::outln!("prove-mult: FAILED: {}", failed.join(" "))?;
     }
     Ok(!failed.is_empty())
 }

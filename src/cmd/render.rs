@@ -63,6 +63,6 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     }
     r.write(&out)?;
     let p = out.commit()?;
-    println!("{} -> {}", r.summary(), p.display());
+    crate::outln!("{} -> {}", r.summary(), p.display())?;
     Ok(())
 }

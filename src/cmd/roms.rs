@@ -48,7 +48,7 @@ pub fn run(a: &RomsArgs) -> Result<()> {
         out.write_text(&name, &text)?;
     }
     let p = out.commit()?;
-    eprintln!("rmapgen: wrote ROM and map hex files to {}", p.display());
+    crate::errln!("rmapgen: wrote ROM and map hex files to {}", p.display());
     Ok(())
 }
 
@@ -99,7 +99,7 @@ fn update(a: &RomsArgs, dir: &Path) -> Result<()> {
     if changed.len() > SHOWN {
         list.push(format!("and {} more", changed.len() - SHOWN));
     }
-    eprintln!(
+    crate::errln!(
         "rmapgen: updated {} ({}) to the maps of scene {} (map_fit {}): {} files changed{}",
         p.display(),
         cfg.summary_full(),

@@ -167,12 +167,16 @@ fn simulate(design: &DesignDir, a: &SimArgs, opts: &Options) -> Result<Outcome> 
             target.display()
         ),
     )?;
+    // The first line that cannot be printed stops nothing of the run, but is its error.
+    let mut printed = Ok(());
     let result = sim::run(design, &build, &absolute(&target), opts, &mut |l| {
-        println!("{l}")
+        if printed.is_ok() {
+            printed = crate::outln!("{l}");
+        }
     });
-    staged.commit()?;
-    let outcome = result?;
-    print!("{}", outcome.summary(design));
+    printed?;
+    let (_, outcome) = staged.commit_with(result)?;
+    crate::out!("{}", outcome.summary(design))?;
     Ok(outcome)
 }
 
@@ -182,16 +186,16 @@ fn matrix(a: &SimArgs, opts: &Options, rows: &[GridRow]) -> Result<bool> {
     let root = a.dir.clone().unwrap_or_else(|| "build/matrix".into());
     let mut failed = Vec::new();
     for r in rows {
-        println!("==== {}: {} ({})", r.name, r.config.summary(), r.covers);
+        crate::outln!("==== {}: {} ({})", r.name, r.config.summary(), r.covers)?;
         let design = generate_row(r, &root.join(r.name), &a.force.policy(&[]))?;
         if !simulate(&design, a, opts)?.failed.is_empty() {
             failed.push(r.name);
         }
     }
     if failed.is_empty() {
-        println!("sim: every configuration passed ({} rows)", rows.len());
+        crate::outln!("sim: every configuration passed ({} rows)", rows.len())?;
     } else {
-        println!("sim: FAILED: {}", failed.join(" "));
+        crate::outln!("sim: FAILED: {}", failed.join(" "))?;
     }
     Ok(!failed.is_empty())
 }

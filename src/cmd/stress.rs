@@ -5,7 +5,7 @@ use super::config_args::ConfigArgs;
 use super::map_args::MapArgs;
 use crate::output::StagedFile;
 use crate::stress::{self, exhaustive, Report, Setup};
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
@@ -75,11 +75,10 @@ pub fn run(a: &StressArgs) -> Result<()> {
         bar.finish_and_clear();
         r
     };
-    print!("{}", summary(&report));
+    crate::out!("{}", summary(&report))?;
     if let Some(out) = json {
         let text = serde_json::to_string_pretty(&report)?;
-        std::fs::write(out.path(), text + "\n")
-            .with_context(|| format!("cannot write {}", out.path().display()))?;
+        out.write(text + "\n")?;
         out.commit()?;
     }
     anyhow::ensure!(

@@ -45,27 +45,31 @@ pub fn run(a: &SynthArgs) -> Result<ExitCode> {
     let staged = StagedDir::new(&a.logs, &a.force.policy(&[Some(design.path())]))?;
     let logs = absolute(staged.path());
     let result = yosys::check(design.path(), &design.top, design.file_names(), &logs, flow);
-    let logs_shown = absolute(&staged.commit()?);
-    let check = result?;
+    let (logs_shown, check) = staged.commit_with(result)?;
+    let logs_shown = absolute(&logs_shown);
     let log = logs_shown.join(yosys::LOG);
     let what = format!("{} in {}", design.top, a.dir.display());
     if !check.passed {
         for p in &check.problems {
-            eprintln!("{p}");
+            crate::errln!("{p}");
         }
-        eprintln!("synth: {what}: FAILED (log: {})", log.display());
+        crate::errln!("synth: {what}: FAILED (log: {})", log.display());
         return Ok(ExitCode::FAILURE);
     }
-    print!("{}", check.cells_report);
+    crate::out!("{}", check.cells_report)?;
     match flow {
-        Flow::Ice40 => println!(
+        Flow::Ice40 => crate::outln!(
             "synth: {what}: no latches, {} cells, {} memory bits, {} SB_RAM40_4K",
-            check.cells, check.memory_bits, check.memories
-        ),
-        Flow::Generic => println!(
+            check.cells,
+            check.memory_bits,
+            check.memories
+        )?,
+        Flow::Generic => crate::outln!(
             "synth: {what} (generic): no latches, {} cells, {} memory bits in {} memories",
-            check.cells, check.memory_bits, check.memories
-        ),
+            check.cells,
+            check.memory_bits,
+            check.memories
+        )?,
     }
     Ok(ExitCode::SUCCESS)
 }

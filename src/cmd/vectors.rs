@@ -76,9 +76,9 @@ pub fn run(a: &VectorsArgs) -> Result<()> {
             bar.inc(k)
         });
     bar.finish_and_clear();
-    let n = written?;
+    let n = written.map_err(|e| out.name_target(e))?;
     out.commit()?;
-    eprintln!(
+    crate::errln!(
         "rmapgen: wrote {n} top vectors ({}) to {}",
         cfg.summary(),
         a.out.display()

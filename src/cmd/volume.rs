@@ -84,8 +84,8 @@ pub struct VolumeArgs {
     )]
     pub zoom: f64,
     /// Render only the voxels X0..=X1, Y0..=Y1, Z0..=Z1 (framed as the whole volume is).
-    #[arg(long, value_name = "X0:X1,Y0:Y1,Z0:Z1")]
-    pub crop: Option<String>,
+    #[arg(long, value_name = "X0:X1,Y0:Y1,Z0:Z1", allow_hyphen_values = true, value_parser = super::parse::named(crop_box))]
+    pub crop: Option<([usize; 3], [usize; 3])>,
     /// Render with the model only: no float reference, no error image or statistics.
     #[arg(long, conflicts_with = "rtl")]
     pub model_only: bool,
@@ -231,11 +231,11 @@ fn transfer(a: &VolumeArgs, scene: &mut Scene, vol: &Volume) -> Result<Option<St
     Ok(Some(text))
 }
 
-/// Parses `--crop X0:X1,Y0:Y1,Z0:Z1`.
-fn crop_box(s: &str) -> Result<([usize; 3], [usize; 3])> {
+/// Parses `--crop X0:X1,Y0:Y1,Z0:Z1` (the flag's parser names it in the error).
+fn crop_box(s: &str) -> std::result::Result<([usize; 3], [usize; 3]), String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     if parts.len() != 3 {
-        bail!("--crop {s}: give three ranges X0:X1,Y0:Y1,Z0:Z1 (voxel indices)");
+        return Err("give three ranges X0:X1,Y0:Y1,Z0:Z1 (voxel indices)".into());
     }
     let (mut lo, mut hi) = ([0; 3], [0; 3]);
     for (a, p) in parts.iter().enumerate() {
@@ -246,7 +246,7 @@ fn crop_box(s: &str) -> Result<([usize; 3], [usize; 3])> {
             ))
         });
         let Some((l, h)) = r else {
-            bail!("--crop {s}: '{p}' is not first:last (voxel indices >= 0)");
+            return Err(format!("'{p}' is not first:last (voxel indices >= 0)"));
         };
         (lo[a], hi[a]) = (l, h);
     }
@@ -310,12 +310,9 @@ fn volume(a: &VolumeArgs) -> Result<Volume> {
 
 /// The volume cropped to --crop, if given.
 fn crop(a: &VolumeArgs, v: Volume) -> Result<Volume> {
-    match &a.crop {
+    match a.crop {
         None => Ok(v),
-        Some(s) => {
-            let (lo, hi) = crop_box(s)?;
-            v.crop(lo, hi)
-        }
+        Some((lo, hi)) => v.crop(lo, hi),
     }
 }
 
@@ -552,7 +549,7 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
     let mut r = r;
     r.format = a.png;
     if let Some(text) = &chosen {
-        println!("{text}");
+        crate::outln!("{text}")?;
     }
     report::check_covered(&r, &vol)?;
     if let Some(n) = r.rtl_mismatches() {
@@ -571,21 +568,21 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
         None
     };
     let dir = out.commit()?;
-    println!("{} -> {}", r.summary(), dir.display());
+    crate::outln!("{} -> {}", r.summary(), dir.display())?;
     let float = r
         .reference_ms
         .map_or(String::new(), |t| format!(", float render {t:.1} ms"));
-    println!(
+    crate::outln!(
         "  {}: load {load_ms:.1} ms, gradients and bricks {prepare_ms:.1} ms, model render {:.1} ms{float} (skipping {})",
         vol.info.source,
         r.model_ms,
         if opts.skip { "on" } else { "off" }
-    );
+    )?;
     if let Some(text) = timing {
-        println!(
+        crate::outln!(
             "  timing, {} threads:\n{text}",
             rayon::current_num_threads()
-        );
+        )?;
     }
     Ok(())
 }

@@ -110,7 +110,7 @@ fn best(
             .collect();
         if std::env::var_os("FIT_DEBUG").is_some() {
             for (i, e) in &got {
-                eprintln!(
+                crate::errln!(
                     "DBG {} {} {} {:.4} {}",
                     i,
                     e.pixels_seen,

@@ -142,7 +142,7 @@ pub fn draw_verilog(d: &DesignDir, count: usize, seed: u64, work: &Path) -> Resu
     if count == 0 {
         return Ok(Vec::new());
     }
-    std::fs::create_dir_all(work)?;
+    crate::disk::create_dir_all(work)?;
     let list = work.join("mutations.ys");
     let script = format!(
         "{}mutate -list {count} -seed {seed} -o {}\n",
@@ -217,7 +217,7 @@ pub fn draw_memories(d: &DesignDir, per_file: usize, seed: u64) -> Result<Vec<Ch
 
 /// Copies the files of directory `from` into `to` (subdirectories too), both existing.
 fn copy_tree(from: &Path, to: &Path) -> Result<()> {
-    std::fs::create_dir_all(to)?;
+    crate::disk::create_dir_all(to)?;
     for e in std::fs::read_dir(from)? {
         let e = e?;
         let (src, dst) = (e.path(), to.join(e.file_name()));
@@ -286,7 +286,7 @@ pub fn materialise(d: &DesignDir, m: &Mutant, to: &Path) -> Result<()> {
                     format!("{v:0w$x}", w = t.len())
                 })
                 .collect();
-            std::fs::write(&p, out.join("\n") + "\n")?;
+            crate::disk::write(&p, out.join("\n") + "\n")?;
         }
         Change::Null | Change::Verilog { .. } => {
             let cfg = &to_config(d);
@@ -323,7 +323,7 @@ pub fn materialise(d: &DesignDir, m: &Mutant, to: &Path) -> Result<()> {
                 &top_text[..header_end],
                 &top_text[header_end..]
             );
-            std::fs::write(to.join(TOP.file(cfg)), top_file)?;
+            crate::disk::write(&to.join(TOP.file(cfg)), top_file)?;
             let changed = m.module();
             for u in FRONT {
                 if changed.as_deref() == Some(u.module(cfg).as_str()) {
@@ -331,7 +331,7 @@ pub fn materialise(d: &DesignDir, m: &Mutant, to: &Path) -> Result<()> {
                         .iter()
                         .find(|(n, _)| *n == u.module(cfg))
                         .with_context(|| format!("Yosys wrote no module {}", u.module(cfg)))?;
-                    std::fs::write(to.join(u.file(cfg)), format!("{YOSYS_WAIVERS}{t}"))?;
+                    crate::disk::write(&to.join(u.file(cfg)), format!("{YOSYS_WAIVERS}{t}"))?;
                 }
             }
             std::fs::remove_file(to.join("mutant.v")).ok();
@@ -505,7 +505,7 @@ pub fn judge(d: &DesignDir, m: &Mutant, plan: &Plan, work: &Path) -> Result<Outc
         dir.display()
     );
     let design = dir.join("design");
-    std::fs::create_dir_all(&design)?;
+    crate::disk::create_dir_all(&design)?;
     materialise(d, m, &design)?;
     let mut verdicts = Vec::new();
     let mut run = |method: Method| -> Result<Verdict> {

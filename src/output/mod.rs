@@ -8,6 +8,7 @@
 //! it holds none of the command's inputs. [`signals`] removes staged output on SIGINT,
 //! SIGTERM and SIGHUP.
 
+pub mod console;
 mod policy;
 pub mod signals;
 pub mod stamp;
@@ -20,6 +21,32 @@ use std::path::{Path, PathBuf};
 
 /// Marks a staging directory as rmapgen's while it is being written; removed before commit.
 const STAGING_MARK: &str = ".rmapgen-staging";
+
+/// The longest name of a directory entry (Linux's NAME_MAX, in bytes).
+const NAME_MAX: usize = 255;
+
+/// The hidden names made beside a target named `name`: `.BASE.staging-PID` (and
+/// `.BASE.staging-PID.old`, the previous output moved aside) or `.BASE.partial-PID`, with
+/// `kind` "staging" or "partial". BASE is `name` when every such name fits [`NAME_MAX`];
+/// a longer name is cut (at a character boundary) and ends in `~` and 16 hex digits of its
+/// SHA-256, so the names stay within the limit, stay rmapgen's (`.`, `.staging-`/
+/// `.partial-`, the process id), and are the same for the same target in every run, which
+/// is how [`remove_stale`] finds a killed run's leftovers.
+pub fn hidden_prefix(name: &str, kind: &str) -> String {
+    // "." + ".KIND-" + a u32 process id + ".old".
+    let room = NAME_MAX - (1 + 1 + kind.len() + 1 + u32::MAX.to_string().len() + ".old".len());
+    if name.len() <= room {
+        return format!(".{name}.{kind}-");
+    }
+    use sha2::{Digest, Sha256};
+    let hash = Sha256::digest(name.as_bytes());
+    let tag: String = hash[..8].iter().map(|b| format!("{b:02x}")).collect();
+    let mut cut = room - 1 - tag.len();
+    while !name.is_char_boundary(cut) {
+        cut -= 1;
+    }
+    format!(".{}~{tag}.{kind}-", &name[..cut])
+}
 
 pub struct StagedDir {
     target: PathBuf,
@@ -42,8 +69,9 @@ impl StagedDir {
         let parent = parent_of(target);
         let created = CreatedParents::make(&parent)
             .with_context(|| format!("cannot write output directory {}", target.display()))?;
-        remove_stale(&parent, &format!(".{name}.staging-"));
-        let staging = parent.join(format!(".{name}.staging-{}", std::process::id()));
+        let prefix = hidden_prefix(&name, "staging");
+        remove_stale(&parent, &prefix);
+        let staging = parent.join(format!("{prefix}{}", std::process::id()));
         let token = signals::register(Undo::Remove(staging.clone()));
         let made = std::fs::create_dir(&staging)
             .and_then(|()| std::fs::write(staging.join(STAGING_MARK), b""));
@@ -72,15 +100,23 @@ impl StagedDir {
         self.write_bytes(rel, t.as_bytes())
     }
 
+    /// Writes one file (relative path; parents created). A failure names the file where it
+    /// will be (`out/model.png`), not in the hidden staging directory.
     pub fn write_bytes(&self, rel: &str, bytes: &[u8]) -> Result<()> {
         let p = self.staging.join(rel);
+        let shown = self.target.join(rel);
         // Held so an interrupt cannot remove the staging directory under a half-made file
         // (create_dir_all would bring it back after the cleanup).
         let _held = signals::hold();
         if let Some(d) = p.parent() {
-            std::fs::create_dir_all(d).with_context(|| format!("cannot create {}", d.display()))?;
+            std::fs::create_dir_all(d).with_context(|| {
+                format!(
+                    "cannot create {}",
+                    shown.parent().unwrap_or(&shown).display()
+                )
+            })?;
         }
-        std::fs::write(&p, bytes).with_context(|| format!("cannot write {}", p.display()))
+        std::fs::write(&p, bytes).with_context(|| format!("cannot write {}", shown.display()))
     }
 
     /// Copies into the staging directory every file of the existing target that this run
@@ -102,6 +138,28 @@ impl StagedDir {
         Ok(())
     }
 
+    /// Commits the output also when `result` (the work that wrote it) failed, so its logs can
+    /// be read, and returns `result` with the committed directory: a failure that names a
+    /// path in the staging directory, which is gone once the command ends, names the same
+    /// path in the committed one instead (in whatever spelling, relative or absolute, since
+    /// only the staging directory's own name is replaced).
+    pub fn commit_with<T>(self, result: Result<T>) -> Result<(PathBuf, T)> {
+        match result {
+            Ok(v) => Ok((self.commit()?, v)),
+            Err(e) => Err(self.commit_failed(e)),
+        }
+    }
+
+    /// [`StagedDir::commit_with`] for work that failed with `e`: the error to report (the
+    /// commit's own, if it fails).
+    pub fn commit_failed(self, e: anyhow::Error) -> anyhow::Error {
+        let (staging, target) = (self.staging.clone(), self.target.clone());
+        match self.commit() {
+            Ok(_) => named_as_target(e, &staging, &target),
+            Err(c) => c,
+        }
+    }
+
     /// Replaces the target with the staging directory, stamped with what it holds. The
     /// target is checked again first: files may have appeared in it since [`StagedDir::new`].
     pub fn commit(mut self) -> Result<PathBuf> {
@@ -110,7 +168,11 @@ impl StagedDir {
         std::fs::remove_file(self.staging.join(STAGING_MARK))
             .with_context(|| format!("cannot finish {shown}"))?;
         stamp::write(&self.staging).with_context(|| format!("cannot finish {shown}"))?;
-        let old = self.staging.with_extension("old");
+        // Not with_extension: the staging name's extension is `staging-PID`, and the old
+        // output must be found by remove_stale as `<staging>.old`.
+        let mut old = self.staging.clone().into_os_string();
+        old.push(".old");
+        let old = PathBuf::from(old);
         let token = self.token.take().expect("registered until commit");
         {
             // Both renames under one hold: an interrupt sees the old output or the new one.
@@ -181,22 +243,43 @@ impl StagedFile {
         let parent = parent_of(target);
         let created = CreatedParents::make(&parent)
             .with_context(|| format!("cannot write {}", target.display()))?;
-        remove_stale(&parent, &format!(".{name}.partial-"));
-        let partial = parent.join(format!(".{name}.partial-{}", std::process::id()));
+        let prefix = hidden_prefix(&name, "partial");
+        remove_stale(&parent, &prefix);
+        let partial = parent.join(format!("{prefix}{}", std::process::id()));
         let token = signals::register(Undo::Remove(partial.clone()));
-        Ok(StagedFile {
+        let file = StagedFile {
             target: target.to_path_buf(),
             partial,
             policy: policy.clone(),
             ours,
             token: Some(token),
             created,
-        })
+        };
+        // Made now, empty: a place that cannot be written (a read-only file system) fails
+        // at once, naming the target, not after the command's work.
+        {
+            let _held = signals::hold();
+            std::fs::File::create(&file.partial)
+                .with_context(|| format!("cannot write {}", target.display()))?;
+        }
+        Ok(file)
+    }
+
+    /// Writes the whole file; a failure names the target.
+    pub fn write(&self, bytes: impl AsRef<[u8]>) -> Result<()> {
+        std::fs::write(&self.partial, bytes)
+            .with_context(|| format!("cannot write {}", self.target.display()))
     }
 
     /// Where to write the file now.
     pub fn path(&self) -> &Path {
         &self.partial
+    }
+
+    /// `e` (of writing [`StagedFile::path`]) naming the target where it named the partial
+    /// file, which is gone once the command ends.
+    pub fn name_target(&self, e: anyhow::Error) -> anyhow::Error {
+        named_as_target(e, &self.partial, &self.target)
     }
 
     /// Renames the finished file over the target (checked again first).
@@ -256,6 +339,21 @@ impl Drop for Scratch {
             t.release();
         }
     }
+}
+
+/// `e` with the hidden name `staged` (a staging directory or partial file, in whatever
+/// spelling of its path) replaced by the name of `target` beside it. A closed standard
+/// output, and an error that does not name it, stay as they are.
+fn named_as_target(e: anyhow::Error, staged: &Path, target: &Path) -> anyhow::Error {
+    let (Some(from), Some(to)) = (staged.file_name(), target.file_name()) else {
+        return e;
+    };
+    let (from, to) = (from.to_string_lossy(), to.to_string_lossy());
+    let msg = format!("{e:#}");
+    if console::is_stdout_closed(&e) || !msg.contains(from.as_ref()) {
+        return e;
+    }
+    anyhow::anyhow!("{}", msg.replace(from.as_ref(), &to))
 }
 
 /// The directory an output goes into ("." for a bare name).
@@ -393,6 +491,54 @@ mod tests {
                 assert!(parent.join(format!("row{i}")).is_dir());
             }
         }
+    }
+
+    /// Staging and partial names (and the old output's) fit NAME_MAX for every target name
+    /// that fits it, keep rmapgen's marks, and are the same for the same target.
+    #[test]
+    fn hidden_names_fit_the_name_limit() {
+        for bytes in [1, 200, 230, 231, 232, 250, 254, 255] {
+            // One-byte characters, and two-byte ones (plus one byte when odd), so a cut
+            // may fall inside a character.
+            let wide = "é".repeat(bytes / 2) + &"a".repeat(bytes % 2);
+            for name in ["a".repeat(bytes), wide] {
+                assert_eq!(name.len(), bytes);
+                for kind in ["staging", "partial"] {
+                    let p = hidden_prefix(&name, kind);
+                    let longest = format!("{p}{}.old", u32::MAX);
+                    assert!(
+                        longest.len() <= NAME_MAX,
+                        "{} bytes: {longest}",
+                        longest.len()
+                    );
+                    assert!(p.starts_with('.') && p.ends_with(&format!(".{kind}-")));
+                    assert_eq!(p, hidden_prefix(&name, kind));
+                    // Up to 231 bytes the name is kept whole, as before.
+                    assert_eq!(p == format!(".{name}.{kind}-"), bytes <= 231, "{p}");
+                }
+            }
+        }
+        // Two long names that differ only at the end get different prefixes.
+        let (a, b) = ("x".repeat(254) + "a", "x".repeat(254) + "b");
+        assert_ne!(hidden_prefix(&a, "staging"), hidden_prefix(&b, "staging"));
+    }
+
+    /// An error naming a staging directory or partial file names the target instead, in
+    /// any spelling of the path; a closed standard output stays what it is.
+    #[test]
+    fn errors_name_the_target_not_the_hidden_name() {
+        let staged = Path::new("/a/b/.out.partial-123");
+        let target = Path::new("/a/b/out");
+        let e =
+            anyhow::anyhow!("No space left on device").context("cannot write b/.out.partial-123");
+        assert_eq!(
+            format!("{:#}", named_as_target(e, staged, target)),
+            "cannot write b/out: No space left on device"
+        );
+        let e = anyhow::Error::new(console::StdoutClosed).context("x .out.partial-123");
+        assert!(console::is_stdout_closed(&named_as_target(
+            e, staged, target
+        )));
     }
 
     /// A parent that exists as a file is still an error (only a directory made meanwhile is

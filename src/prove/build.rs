@@ -127,7 +127,7 @@ fn shared(
     include: &Path,
     strings: &[(String, String)],
 ) -> Result<PathBuf> {
-    std::fs::create_dir_all(mdir)?;
+    crate::disk::create_dir_all(mdir)?;
     let lib = format!("lib{prefix}.so");
     let mut cmd = verilator::shared(top, prefix, mdir, &lib, files, harness, include, strings);
     let ran = run_logged(&mut cmd, &mdir.join("verilator.log"))?;
@@ -150,12 +150,12 @@ fn shared(
 /// The front's shared object, built in `build/front`.
 pub fn front(d: &DesignDir, build: &Path) -> Result<PathBuf> {
     let dir = build.join("front");
-    std::fs::create_dir_all(&dir)?;
+    crate::disk::create_dir_all(&dir)?;
     let wrapper = dir.join(format!("{FRONT_MODULE}.v"));
-    std::fs::write(&wrapper, front_wrapper(d, FRONT_LANES, true))?;
+    crate::disk::write(&wrapper, front_wrapper(d, FRONT_LANES, true))?;
     let harness = dir.join("prove_front.cpp");
-    std::fs::write(&harness, FRONT_HARNESS)?;
-    std::fs::write(dir.join("prove_front_lanes.h"), front_lanes_header())?;
+    crate::disk::write(&harness, FRONT_HARNESS)?;
+    crate::disk::write(&dir.join("prove_front_lanes.h"), front_lanes_header())?;
     let mut files: Vec<PathBuf> = FRONT
         .iter()
         .map(|u| d.path().join(u.file(&d.config)))
@@ -176,9 +176,9 @@ pub fn front(d: &DesignDir, build: &Path) -> Result<PathBuf> {
 /// built in `build/top`, its memories read from the design directory by absolute path.
 pub fn top(d: &DesignDir, build: &Path) -> Result<PathBuf> {
     let dir = build.join("top");
-    std::fs::create_dir_all(&dir)?;
+    crate::disk::create_dir_all(&dir)?;
     let harness = dir.join("prove_top.cpp");
-    std::fs::write(&harness, TOP_HARNESS)?;
+    crate::disk::write(&harness, TOP_HARNESS)?;
     shared(
         &TOP.module(&d.config),
         "Vrmap_top",

@@ -78,14 +78,14 @@ fn role(name: &str, bit: u32) -> Option<Role> {
 /// log and the graph).
 pub fn build(d: &DesignDir, build: &Path) -> Result<GateFront> {
     let dir = build.join("gates");
-    std::fs::create_dir_all(&dir)?;
+    crate::disk::create_dir_all(&dir)?;
     for u in FRONT {
         no_undefined_literal(&d.path().join(u.file(&d.config)))?;
     }
     let wrapper = dir.join(format!("{}.v", build::FRONT_MODULE));
-    std::fs::write(&wrapper, build::front_wrapper(d, 1, false))?;
+    crate::disk::write(&wrapper, build::front_wrapper(d, 1, false))?;
     let transparent = dir.join(crate::rtl::mult_proof::TRANSPARENT_FILE);
-    std::fs::write(&transparent, crate::rtl::mult_proof::TRANSPARENT)?;
+    crate::disk::write(&transparent, crate::rtl::mult_proof::TRANSPARENT)?;
     let mut files: Vec<String> = FRONT
         .iter()
         .map(|u| crate::toolchain::quoted(&d.path().join(u.file(&d.config)).to_string_lossy()))

@@ -57,20 +57,20 @@ impl Shard {
     pub fn parse(text: &str) -> Result<Shard, String> {
         let (k, n) = text
             .split_once('/')
-            .ok_or_else(|| format!("a shard is K/N (such as 1/4), not {text:?}"))?;
+            .ok_or_else(|| "a shard is K/N (such as 1/4)".to_string())?;
         let k: u64 = k
             .trim()
             .parse()
-            .map_err(|_| format!("shard {text:?}: K is not a whole number"))?;
+            .map_err(|_| "K is not a whole number".to_string())?;
         let n: u64 = n
             .trim()
             .parse()
-            .map_err(|_| format!("shard {text:?}: N is not a whole number"))?;
+            .map_err(|_| "N is not a whole number".to_string())?;
         if n == 0 || n > MAX_SHARDS {
-            return Err(format!("shard {text:?}: N must be in 1..={MAX_SHARDS}"));
+            return Err(format!("N must be in 1..={MAX_SHARDS}"));
         }
         if k == 0 || k > n {
-            return Err(format!("shard {text:?}: K must be in 1..={n}"));
+            return Err(format!("K must be in 1..={n}"));
         }
         Ok(Shard { index: k, count: n })
     }

@@ -27,36 +27,71 @@ pub struct Metrics {
 /// the largest value of the output range.
 pub fn metrics(a: &[u32], b: &[u32], peak: u32) -> Metrics {
     assert_eq!(a.len(), b.len(), "metrics of lists of different lengths");
-    let mut hist: Vec<usize> = vec![0];
-    let (mut sum, mut sum_abs, mut sum_sq) = (0i64, 0u64, 0u64);
-    let mut worst: Option<(usize, u32)> = None;
-    for (i, (&x, &y)) in a.iter().zip(b).enumerate() {
-        let e = x as i64 - y as i64;
-        let ae = e.unsigned_abs() as u32;
-        sum += e;
-        sum_abs += ae as u64;
-        sum_sq += ae as u64 * ae as u64;
-        if ae as usize >= hist.len() {
-            hist.resize(ae as usize + 1, 0);
-        }
-        hist[ae as usize] += 1;
-        if worst.map_or(true, |(_, w)| ae > w) {
-            worst = Some((i, ae));
+    let mut acc = Accumulator::new(peak);
+    for (&x, &y) in a.iter().zip(b) {
+        acc.add(x, y);
+    }
+    acc.finish()
+}
+
+/// [`metrics`] one sample pair at a time, for images too large to hold as value lists
+/// (`rmapgen compare` streams rows): the same figures in the same order of samples.
+#[derive(Clone, Debug)]
+pub struct Accumulator {
+    peak: u32,
+    n: usize,
+    hist: Vec<usize>,
+    sum: i64,
+    sum_abs: u64,
+    sum_sq: u64,
+    worst: Option<(usize, u32)>,
+}
+
+impl Accumulator {
+    pub fn new(peak: u32) -> Accumulator {
+        Accumulator {
+            peak,
+            n: 0,
+            hist: vec![0],
+            sum: 0,
+            sum_abs: 0,
+            sum_sq: 0,
+            worst: None,
         }
     }
-    let n = a.len();
-    let mean = |s: f64| if n == 0 { 0.0 } else { s / n as f64 };
-    let rmse = mean(sum_sq as f64).sqrt();
-    Metrics {
-        pixels: n,
-        peak,
-        max_abs_error: worst.map_or(0, |w| w.1),
-        mean_abs_error: mean(sum_abs as f64),
-        mean_error: mean(sum as f64),
-        rmse,
-        psnr_db: (rmse > 0.0).then(|| 20.0 * (peak as f64 / rmse).log10()),
-        abs_error_histogram: if n == 0 { Vec::new() } else { hist },
-        worst_index: worst.map(|w| w.0),
+
+    /// The next sample: `x` under test, `y` the reference.
+    pub fn add(&mut self, x: u32, y: u32) {
+        let e = x as i64 - y as i64;
+        let ae = e.unsigned_abs() as u32;
+        self.sum += e;
+        self.sum_abs += ae as u64;
+        self.sum_sq += ae as u64 * ae as u64;
+        if ae as usize >= self.hist.len() {
+            self.hist.resize(ae as usize + 1, 0);
+        }
+        self.hist[ae as usize] += 1;
+        if self.worst.map_or(true, |(_, w)| ae > w) {
+            self.worst = Some((self.n, ae));
+        }
+        self.n += 1;
+    }
+
+    pub fn finish(self) -> Metrics {
+        let n = self.n;
+        let mean = |s: f64| if n == 0 { 0.0 } else { s / n as f64 };
+        let rmse = mean(self.sum_sq as f64).sqrt();
+        Metrics {
+            pixels: n,
+            peak: self.peak,
+            max_abs_error: self.worst.map_or(0, |w| w.1),
+            mean_abs_error: mean(self.sum_abs as f64),
+            mean_error: mean(self.sum as f64),
+            rmse,
+            psnr_db: (rmse > 0.0).then(|| 20.0 * (self.peak as f64 / rmse).log10()),
+            abs_error_histogram: if n == 0 { Vec::new() } else { self.hist },
+            worst_index: self.worst.map(|w| w.0),
+        }
     }
 }
 

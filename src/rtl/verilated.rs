@@ -34,7 +34,7 @@ impl VerilatedTop {
         crate::rtl::tb::write_all(&d, &staged)?;
         staged.commit()?;
         let harness = dir.path().join("top_apply.cpp");
-        std::fs::write(&harness, HARNESS)?;
+        crate::disk::write(&harness, HARNESS)?;
         let mut sources: Vec<PathBuf> = std::fs::read_dir(&design)?
             .filter_map(|e| e.ok().map(|e| e.path()))
             .filter(|p| p.extension().is_some_and(|x| x == "v"))
@@ -86,7 +86,7 @@ impl VerilatedTop {
         }
         let input = self._dir.path().join("input.hex");
         let output = self._dir.path().join("output.hex");
-        std::fs::write(&input, text)?;
+        crate::disk::write(&input, text)?;
         run_tool(
             Command::new(&self.exe)
                 .arg(&input)

@@ -351,7 +351,7 @@ pub fn structure(
     files: &[String],
     logs: &Path,
 ) -> Result<(PathBuf, PathBuf)> {
-    std::fs::create_dir_all(logs)?;
+    crate::disk::create_dir_all(logs)?;
     let hier = logs.join("hier.json");
     let flat = logs.join("flat.json");
     let script = format!(
@@ -389,7 +389,7 @@ pub fn aig(
     transparent: &str,
     logs: &Path,
 ) -> Result<(PathBuf, PathBuf)> {
-    std::fs::create_dir_all(logs)?;
+    crate::disk::create_dir_all(logs)?;
     let (aag, map) = ("front.aag", "front.map");
     let script = format!(
         "read_verilog {}; hierarchy -check -top {top}; proc; opt_expr -mux_undef; flatten; \

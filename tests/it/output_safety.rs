@@ -484,3 +484,35 @@ fn an_interrupted_generate_leaves_nothing_and_keeps_the_old_design() {
         );
     }
 }
+
+/// A target at the file system's name limit (issue 32 §5): `generate --out` a 250-byte name
+/// and `maps --out` a 254-byte one work, twice (the second replaces the first, moving it
+/// aside beside it), leaving nothing else; the hidden names beside them stay within NAME_MAX
+/// (they were `.NAME.staging-PID`, `File name too long`), and a killed run's leftovers under
+/// the shortened names are still recognised and removed.
+#[test]
+fn outputs_at_the_name_limit() {
+    let t = tempdir();
+    let dir_name = "d".repeat(250);
+    let file_name = "m".repeat(254);
+    // Leftovers of a killed run (pid 4000000 is above Linux's pid_max): a marked staging
+    // directory, a moved-aside old output and a partial file.
+    let staging = rmapgen::output::hidden_prefix(&dir_name, "staging");
+    let stale = t.path().join(format!("{staging}4000000"));
+    std::fs::create_dir(&stale).unwrap();
+    std::fs::write(stale.join(".rmapgen-staging"), "").unwrap();
+    let stale_old = t.path().join(format!("{staging}4000000.old"));
+    std::fs::create_dir(&stale_old).unwrap();
+    std::fs::write(stale_old.join(".rmapgen-staging"), "").unwrap();
+    let partial = rmapgen::output::hidden_prefix(&file_name, "partial");
+    std::fs::write(t.path().join(format!("{partial}4000000")), "x").unwrap();
+    for _ in 0..2 {
+        ok(&run_in(
+            t.path(),
+            &["generate", "--vectors", "10", "--out", &dir_name],
+        ));
+        ok(&run_in(t.path(), &["maps", "--out", &file_name]));
+        only(t.path(), &[&dir_name, &file_name]);
+    }
+    assert!(helpers::nonempty(&t.path().join(&dir_name)));
+}
