@@ -45,13 +45,30 @@ fn absolute(p: String) -> String {
     p
 }
 
-/// The project venv's directory of programs, relative to the directory rmapgen runs in (the
-/// repository root for `make` and `cargo test`).
+/// The project venv's directory of programs, relative to a checkout of rmapgen (`make venv`
+/// makes it there).
 pub const VENV_BIN: &str = ".venv/bin";
+
+/// Where the project venv's programs may be, in order: `RMAPGEN_VENV/bin` when that variable
+/// is set; [`VENV_BIN`] under the directory rmapgen runs in; under each directory above the
+/// running rmapgen executable (`target/release/rmapgen` of a checkout finds the checkout's
+/// venv from any directory); and under the checkout it was built from.
+pub fn venv_dirs() -> Vec<PathBuf> {
+    let mut dirs = Vec::new();
+    if let Some(v) = std::env::var_os("RMAPGEN_VENV").filter(|v| !v.is_empty()) {
+        dirs.push(PathBuf::from(v).join("bin"));
+    }
+    dirs.push(PathBuf::from(VENV_BIN));
+    if let Ok(exe) = std::env::current_exe() {
+        dirs.extend(exe.ancestors().skip(1).map(|d| d.join(VENV_BIN)));
+    }
+    dirs.push(Path::new(env!("CARGO_MANIFEST_DIR")).join(VENV_BIN));
+    dirs
+}
 
 /// The program for a tool that the project venv holds (`make venv`: the YoWASP builds of Yosys
 /// and nextpnr-ecp5): the environment variable `var` when set and not empty, else `name` when
-/// it is on PATH, else [`VENV_BIN`]`/name` (absolute) when that file exists, else `name` (and
+/// it is on PATH, else the first of [`venv_dirs`] that holds it (absolute), else `name` (and
 /// starting it fails with a message saying how to install it).
 pub fn venv_program(var: &str, name: &str) -> String {
     if let Some(v) = std::env::var(var).ok().filter(|v| !v.is_empty()) {
@@ -60,11 +77,11 @@ pub fn venv_program(var: &str, name: &str) -> String {
     if installed(name) {
         return name.to_string();
     }
-    let venv = Path::new(VENV_BIN).join(name);
-    match venv.canonicalize() {
-        Ok(p) if p.is_file() => p.to_string_lossy().into_owned(),
-        _ => name.to_string(),
-    }
+    venv_dirs()
+        .into_iter()
+        .filter_map(|d| d.join(name).canonicalize().ok())
+        .find(|p| p.is_file())
+        .map_or_else(|| name.to_string(), |p| p.to_string_lossy().into_owned())
 }
 
 /// `to` relative to the directory `from` (both absolute and canonical), as `..` steps and the
@@ -161,9 +178,16 @@ fn start_error(cmd: &Command, e: std::io::Error) -> anyhow::Error {
     let program = cmd.get_program().to_string_lossy();
     // The YoWASP tools come from the project venv, the others from Debian.
     let setup = if program.contains("yowasp") {
-        "make venv"
+        format!(
+            "make venv in the rmapgen checkout, or set RMAPGEN_VENV to a venv that holds it; looked on PATH and in {}",
+            venv_dirs()
+                .iter()
+                .map(|d| d.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
     } else {
-        "make tools"
+        "make tools".to_string()
     };
     anyhow::anyhow!("cannot run {program}: {e}; is it installed? ({setup})")
 }
@@ -304,6 +328,17 @@ mod tests {
         );
         assert_eq!(absolute("yosys".into()), "yosys");
         assert_eq!(absolute("/usr/bin/yosys".into()), "/usr/bin/yosys");
+    }
+
+    #[test]
+    fn the_venv_is_found_from_the_executable_and_the_checkout() {
+        let dirs = venv_dirs();
+        let checkout = Path::new(env!("CARGO_MANIFEST_DIR")).join(VENV_BIN);
+        assert_eq!(dirs.last(), Some(&checkout));
+        // The test executable lives under the checkout's target/: one of the directories
+        // above it is the checkout, whichever directory the test runs in.
+        assert!(dirs[..dirs.len() - 1].contains(&checkout), "{dirs:?}");
+        assert_eq!(dirs.iter().filter(|d| d.is_relative()).count(), 1);
     }
 
     #[test]
