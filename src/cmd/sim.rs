@@ -135,7 +135,16 @@ fn need_tools(opts: &Options) -> Result<()> {
 }
 
 /// `--only MODULE` names a testbench of the design, and the top's with `--gate`.
+/// `--stream` drives one rmap_top: refused for a lanes design, whose rmap_tops share ROMs.
 fn check_only(design: &DesignDir, opts: &Options) -> Result<()> {
+    let cfg = &design.config;
+    anyhow::ensure!(
+        opts.stream == 0 || cfg.lanes == 1,
+        "--stream drives one rmap_top through the C++ harness; {} has lanes = {} ({}, ROMs shared between lanes): stream its lanes testbench with --verilator --tb-stream N",
+        design.path().display(),
+        cfg.lanes,
+        crate::stages::top(cfg).module(cfg)
+    );
     if let Some(m) = opts.only.as_deref() {
         anyhow::ensure!(
             design.testbench(m).is_file(),

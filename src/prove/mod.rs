@@ -147,6 +147,14 @@ pub fn check_design(d: &DesignDir, direct: bool) -> Result<()> {
 /// allocation and loop of a run or a merge).
 pub fn check_limits(cfg: &Config, direct: bool) -> Result<()> {
     let g = cfg.grad_bits;
+    // The proof drives one rmap_top; in a lanes design the lanes' rmap_tops share ROMs
+    // through ports of their own, so no single rmap_top of it stands alone.
+    ensure!(
+        cfg.lanes == 1,
+        "rmapgen prove proves one rmap_top; this design has lanes = {} (rmap_lanes, ROMs shared between lanes): prove the single-lane design of the same configuration (generate without --lanes), and check the lanes with `rmapgen sim --icarus --verilator --only {}`",
+        cfg.lanes,
+        crate::stages::top(cfg).module(cfg)
+    );
     if direct {
         ensure!(
             g <= MAX_DIRECT_BITS,

@@ -5,6 +5,7 @@ mod bench;
 mod cmd_render;
 mod cmd_sim;
 mod compare;
+mod design_matrix;
 mod design_reads;
 mod ecp5;
 mod errors;
