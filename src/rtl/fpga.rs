@@ -196,10 +196,10 @@ impl FpgaReport {
 pub fn tools_available(opts: &Options) -> bool {
     let yosys = match opts.family {
         Family::Ice40 => yosys::available(),
-        Family::Ecp5 => std::process::Command::new(yosys::yosys_ecp5())
-            .arg("-V")
-            .output()
-            .is_ok_and(|o| o.status.success()),
+        Family::Ecp5 => {
+            toolchain::capture(std::process::Command::new(yosys::yosys_ecp5()).arg("-V"))
+                .is_ok_and(|r| r.success())
+        }
     };
     yosys && nextpnr::available(opts.family)
 }

@@ -2,6 +2,7 @@
 
 mod alloc;
 mod bench;
+mod children;
 mod cmd_render;
 mod cmd_sim;
 mod compare;

@@ -261,7 +261,10 @@ fn a_small_design_is_proven_in_two_shards_and_every_part_catches_a_planted_fault
     assert_fails(
         &o,
         "states",
-        &["states (buffer 0 as loaded): samples 0..=", "the top lost or added a result"],
+        &[
+            "states (buffer 0 as loaded): samples 0..=",
+            "the top lost or added a result",
+        ],
     );
 
     // An undefined literal in the front: the gates would take it as "any value", so the
