@@ -2,7 +2,7 @@
 
 mod alloc;
 mod bench;
-mod children;
+
 mod cmd_render;
 mod cmd_sim;
 mod compare;
@@ -24,6 +24,7 @@ mod map_flags;
 mod map_stream;
 mod model_stages;
 mod mult_proof;
+mod nothing_left;
 mod output_safety;
 mod prefix;
 mod prove;

@@ -5,6 +5,9 @@
 //!
 //! Each run is started in a session of its own (setsid), so every process of its tree, even
 //! one that was re-parented when its parent died, is found by its session id in /proc.
+//!
+//! Bad input to a command that makes a build or log directory (`fpga`, `prove`, `sim`,
+//! `synth`, `prove-mult`, `mutants`) is refused before the directory is made.
 
 use crate::{hdl, helpers};
 use rmapgen::grid;
@@ -256,4 +259,112 @@ fn a_sigkill_to_synth_ends_yosys() {
     let mut child = start(&["synth", s(&dir)], &tmp);
     wait_for(&mut child, &["yosys"], Duration::from_secs(60));
     kill_and_check(child, libc::SIGKILL, &tmp, "synth");
+}
+
+/// Runs rmapgen in `cwd` and checks a one-line refusal naming `needle`, exit 2, and that
+/// `cwd` holds nothing but what it held before.
+fn refused_leaving_nothing(cwd: &Path, args: &[&str], needle: &str) {
+    let before = helpers::entries(cwd);
+    let o = helpers::rmapgen()
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .unwrap();
+    helpers::assert_error(&o, needle);
+    assert_eq!(
+        helpers::entries(cwd),
+        before,
+        "rmapgen {args:?} left something behind"
+    );
+}
+
+/// `fpga` with a bad --device, --package, --dir or configuration makes no --logs directory.
+#[test]
+fn fpga_bad_input_leaves_no_log_directory() {
+    if !hdl::require("nextpnr-ice40") {
+        return;
+    }
+    let work = helpers::tempdir();
+    let w = work.path();
+    hdl::generate_config(&w.join("n"), &grid::narrowest(), 5);
+    for (args, needle) in [
+        (vec!["fpga", "--device", "hx9k", "--logs", "L/x"], "--hx9k"),
+        (vec!["fpga", "--package", "zz999", "--logs", "L"], "zz999"),
+        (
+            vec!["fpga", "--dir", "nope", "--logs", "L"],
+            "no manifest.json in nope",
+        ),
+        (
+            vec!["fpga", "--dir", "n", "--device", "hx9k", "--logs", "L"],
+            "--hx9k",
+        ),
+        (
+            vec!["fpga", "--dir", "n", "--package", "zz999", "--logs", "L"],
+            "zz999",
+        ),
+        (vec!["fpga", "--red-bits", "13", "--logs", "L"], "red"),
+    ] {
+        refused_leaving_nothing(w, &args, needle);
+    }
+}
+
+/// `prove --part bogus` makes neither B/<design>-1of1 nor B, nor the --report file.
+#[test]
+fn prove_bad_part_leaves_no_build_directory() {
+    let work = helpers::tempdir();
+    let w = work.path();
+    hdl::generate_config(&w.join("n"), &grid::narrowest(), 5);
+    refused_leaving_nothing(
+        w,
+        &["prove", "--part", "bogus", "--build", "B", "n"],
+        "--part bogus",
+    );
+    refused_leaving_nothing(
+        w,
+        &[
+            "prove", "--direct", "--part", "states", "--report", "r.json", "--build", "B", "n",
+        ],
+        "--part states",
+    );
+}
+
+/// The other commands that make a build or log directory refuse their bad input first.
+#[test]
+fn other_commands_bad_input_leaves_no_directory() {
+    let work = helpers::tempdir();
+    let w = work.path();
+    hdl::generate_config(&w.join("n"), &grid::narrowest(), 5);
+    for (args, needle) in [
+        (
+            vec!["sim", "--icarus", "--only", "nope", "--build", "B", "n"],
+            "--only nope",
+        ),
+        (
+            vec!["sim", "--icarus", "--build", "B", "missing"],
+            "missing",
+        ),
+        (vec!["synth", "--logs", "L", "missing"], "missing"),
+        (vec!["prove-mult", "--logs", "L", "missing"], "missing"),
+        (
+            vec![
+                "mutants",
+                "--only",
+                "99",
+                "--count",
+                "1",
+                "--memories",
+                "0",
+                "--build",
+                "B",
+                "n",
+            ],
+            "--only m99",
+        ),
+        (
+            vec!["mutants", "--timeout", "0", "--build", "B", "n"],
+            "--timeout 0",
+        ),
+    ] {
+        refused_leaving_nothing(w, &args, needle);
+    }
 }
