@@ -76,7 +76,7 @@ pub fn run(a: &ProveArgs) -> Result<ExitCode> {
     let policy = a.force.policy(&[Some(design.path())]);
     // Claimed before the run, so a refused path fails at once rather than after it.
     let out = match &a.report {
-        Some(p) => Some(StagedFile::new(p, &policy, report::is_report)?),
+        Some(p) => Some(StagedFile::new(p, &policy)?),
         None => None,
     };
     let target = a.build.join(format!(
