@@ -261,6 +261,38 @@ fn a_sigkill_to_synth_ends_yosys() {
     kill_and_check(child, libc::SIGKILL, &tmp, "synth");
 }
 
+/// `prove` killed (SIGKILL) while its Verilator build compiles, and `fpga` (SIGTERM) while
+/// nextpnr places: nothing of either is left running, no scratch file is left.
+#[test]
+fn a_signal_to_prove_or_fpga_ends_their_tools() {
+    if !hdl::require("verilator") || !hdl::require("nextpnr-ice40") {
+        return;
+    }
+    let work = helpers::tempdir();
+    let dir = work.path().join("n");
+    hdl::generate_config(&dir, &grid::narrowest(), 5);
+    let b = work.path().join("B");
+    for (args, tools, sig) in [
+        (
+            vec!["prove", "--build", s(&b), s(&dir)],
+            &["cc1plus", "cc1"][..],
+            libc::SIGKILL,
+        ),
+        (
+            vec!["fpga", "--dir", s(&dir), "--logs", s(&b)],
+            &["nextpnr-ice40"][..],
+            libc::SIGTERM,
+        ),
+    ] {
+        let tmp = work.path().join(format!("tmp-{}", args[0]));
+        std::fs::create_dir(&tmp).unwrap();
+        let mut child = start(&args, &tmp);
+        wait_for(&mut child, tools, Duration::from_secs(300));
+        kill_and_check(child, sig, &tmp, args[0]);
+        assert!(!b.exists(), "{}: no build or log directory", args[0]);
+    }
+}
+
 /// Runs rmapgen in `cwd` and checks a one-line refusal naming `needle`, exit 2, and that
 /// `cwd` holds nothing but what it held before.
 fn refused_leaving_nothing(cwd: &Path, args: &[&str], needle: &str) {
