@@ -152,3 +152,60 @@ pub fn output(cmd: &mut Command) -> Result<Output> {
         .stderr(Stdio::piped());
     spawn(cmd)?.wait_with_output()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The state letter of process `pid` (None when it is gone).
+    fn state(pid: &str) -> Option<char> {
+        let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+        stat[stat.rfind(')')? + 2..].chars().next()
+    }
+
+    #[test]
+    fn a_child_has_its_own_tmpdir_removed_when_it_ends() {
+        let mut c = Command::new("sh");
+        c.args([
+            "-c",
+            "echo \"$TMPDIR\"; : > \"$TMPDIR/ccX.s\"; ls \"$TMPDIR\"",
+        ]);
+        let out = output(&mut c).unwrap();
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        let mut lines = text.lines();
+        let tmp = lines.next().unwrap();
+        assert!(tmp.contains("rmapgen-"), "{text}");
+        assert_eq!(lines.next(), Some("ccX.s"), "{text}");
+        assert!(!std::path::Path::new(tmp).exists(), "{tmp} removed");
+    }
+
+    #[test]
+    fn what_a_child_leaves_running_in_its_group_is_killed_when_it_ends() {
+        let mut c = Command::new("sh");
+        c.args(["-c", "sleep 100 >/dev/null 2>&1 & echo $!"]);
+        let out = output(&mut c).unwrap();
+        let pid = String::from_utf8_lossy(&out.stdout).trim().to_string();
+        let start = Instant::now();
+        while state(&pid).is_some_and(|s| s != 'Z') && start.elapsed() < Duration::from_secs(3) {
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        assert!(
+            state(&pid).is_none_or(|s| s == 'Z'),
+            "sleep {pid} still running"
+        );
+    }
+
+    #[test]
+    fn a_timed_out_child_is_killed_with_its_group() {
+        let mut c = Command::new("sh");
+        c.args(["-c", "sleep 100 & sleep 100"])
+            .stdout(Stdio::null());
+        let start = Instant::now();
+        let r = spawn(&mut c)
+            .unwrap()
+            .wait_timeout(Duration::from_millis(200))
+            .unwrap();
+        assert!(r.is_none(), "timed out");
+        assert!(start.elapsed() < Duration::from_secs(5));
+    }
+}
