@@ -190,7 +190,7 @@ mod tests {
             std::thread::sleep(Duration::from_millis(10));
         }
         assert!(
-            state(&pid).is_none_or(|s| s == 'Z'),
+            !matches!(state(&pid), Some(s) if s != 'Z'),
             "sleep {pid} still running"
         );
     }
