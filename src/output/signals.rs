@@ -287,11 +287,22 @@ fn decode(line: &str) -> Option<(u64, Undo)> {
     Some((id, undo))
 }
 
-/// The guardian: reads registrations (`+`), releases (`-ID`) and `clear` from stdin until it
+/// The guardian (refused unless started by rmapgen, its parent's pid given after
+/// [`GUARDIAN_ARG`]): reads registrations (`+`), releases (`-ID`) and `clear` from stdin until it
 /// closes (rmapgen has ended), then undoes what is still registered, last first, and returns.
 /// Process groups it kills are waited for (a bounded time), so a directory their tools were
 /// writing into is removed after they stop.
 pub fn guardian_main() {
+    // Only as rmapgen started it: its parent's pid as the argument after GUARDIAN_ARG.
+    let parent = std::env::args().nth(2).and_then(|p| p.parse::<i32>().ok());
+    // SAFETY: getppid has no preconditions.
+    let ours = parent == Some(unsafe { libc::getppid() })
+        // rmapgen died before this line ran: its registrations still wait on the pipe.
+        || parent.is_some_and(|p| !Path::new(&format!("/proc/{p}")).exists() && stdin_is_pipe());
+    if !ours {
+        eprintln!("rmapgen: error: {GUARDIAN_ARG} is started by rmapgen itself, not by hand");
+        std::process::exit(2);
+    }
     // SAFETY: setting a signal's disposition to ignore touches no memory of ours.
     unsafe {
         libc::signal(libc::SIGINT, libc::SIG_IGN);
@@ -326,6 +337,11 @@ pub fn guardian_main() {
             wait_group_gone(g);
         }
     }
+}
+
+fn stdin_is_pipe() -> bool {
+    use std::os::unix::fs::FileTypeExt;
+    std::fs::metadata("/proc/self/fd/0").is_ok_and(|m| m.file_type().is_fifo())
 }
 
 /// Waits (at most [`SETTLE`]) until no process is left running in group `pgid`. Zombies do

@@ -467,6 +467,21 @@ fn an_interrupted_vectors_run_leaves_nothing_and_keeps_the_old_file() {
     );
     assert_eq!(st.signal(), Some(15), "ended by SIGTERM: {st:?}");
     only(t.path(), &[".v.hex.rmapgen-sha256", "v.hex"]);
+    // SIGKILL, which rmapgen cannot catch: its guardian removes the partial file and the
+    // parents the run made, within a few seconds, with no later run needed.
+    let st = interrupt(
+        t.path(),
+        &["vectors", "--count", "500000000", "--out", "new/sub/v.hex"],
+        "-KILL",
+        || staged(&sub, ".v.hex.partial-"),
+    );
+    assert_eq!(st.signal(), Some(9), "ended by SIGKILL: {st:?}");
+    let t0 = Instant::now();
+    while t.path().join("new").exists() && t0.elapsed() < Duration::from_secs(5) {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    only(t.path(), &[".v.hex.rmapgen-sha256", "v.hex"]);
+    assert_eq!(std::fs::read(t.path().join("v.hex")).unwrap(), old);
 }
 
 #[test]
