@@ -97,6 +97,8 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     // Staged output is removed on Ctrl-C, SIGTERM and SIGHUP (src/output/signals.rs).
     rmapgen::output::signals::install()
         .map_err(|e| anyhow::anyhow!("cannot install the signal handler: {e}"))?;
+    // ... and, with every child process, when rmapgen is killed outright (SIGKILL).
+    rmapgen::output::signals::install_guardian();
     // Commands that check a design exit 1 when the design fails the check; the others have
     // only success and bad input.
     let done = |r: anyhow::Result<()>| r.map(|()| ExitCode::SUCCESS);
@@ -288,6 +290,15 @@ fn usage_line(e: &clap::Error) -> String {
 }
 
 fn main() -> ExitCode {
+    use rmapgen::output::signals;
+    // This binary started as a run's guardian (src/output/signals.rs), not by a user.
+    if std::env::args_os()
+        .nth(1)
+        .is_some_and(|a| a == signals::GUARDIAN_ARG)
+    {
+        signals::guardian_main();
+        return ExitCode::SUCCESS;
+    }
     let cli = match parse() {
         Ok(c) => c,
         Err(code) => return code,

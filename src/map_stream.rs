@@ -255,36 +255,6 @@ pub fn decode(format: Format, bytes: &[u8]) -> Result<Vec<Write>> {
     }
 }
 
-/// Writes every configuration's stream starts with: the smallest map's, 2^(3 + 2 * the
-/// smallest index_bits) entries of axis 0 at addresses 0, 1, ...
-fn smallest_map() -> usize {
-    let (min_index, _) = crate::config::range_of("index_bits").expect("index_bits has a range");
-    1 << (3 + 2 * min_index)
-}
-
-/// Whether `head` (a file's first bytes) is a stream rmapgen wrote in `format`, which `maps`
-/// may replace without `--force`. Hex and C carry the header's first line; a binary stream has
-/// no header, and is recognised by its first records, which are (0, k, entry) for every k
-/// of the smallest map.
-pub fn is_ours(format: Format, head: &[u8]) -> bool {
-    match format {
-        Format::Hex => head.starts_with(format!("//{MARK}").as_bytes()),
-        Format::C => head.starts_with(format!("/*{MARK}").as_bytes()),
-        Format::Bin => {
-            let n = smallest_map();
-            head.len() >= n * RECORD_BYTES
-                && decode_bin(&head[..n * RECORD_BYTES]).is_ok_and(|ws| {
-                    ws.iter().enumerate().all(|(k, w)| {
-                        w.axis == 0
-                            && w.addr == k as u32
-                            && w.data
-                                < 1 << crate::config::range_of("map_bits").expect("map_bits").1
-                    })
-                })
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -309,7 +279,6 @@ mod tests {
                 let ws = decode(format, &bytes).unwrap();
                 assert_eq!(ws, writes(&cfg, &maps), "{format:?} {}", cfg.summary());
                 assert_eq!(to_maps(&cfg, &ws).unwrap(), maps);
-                assert!(is_ours(format, &bytes), "{format:?}");
             }
         }
     }
@@ -390,10 +359,6 @@ mod tests {
 
     #[test]
     fn foreign_files_and_bad_streams_are_refused() {
-        for f in [Format::Hex, Format::Bin, Format::C] {
-            assert!(!is_ours(f, b"my notes\n"));
-            assert!(!is_ours(f, &[0u8; 4096]));
-        }
         let cfg = Config::default();
         let maps = Scene::standard().maps(&cfg);
         let mut ws = writes(&cfg, &maps);

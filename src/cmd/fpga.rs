@@ -9,7 +9,7 @@ use crate::output::StagedDir;
 use crate::rtl::fpga::{self, Family, Options};
 use anyhow::{Context, Result};
 use clap::Args;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct FpgaArgs {
@@ -71,17 +71,36 @@ pub fn run(a: &FpgaArgs) -> Result<()> {
         !a.ooc || a.family == Family::Ecp5,
         "--ooc (out-of-context place and route) is for --family ecp5 only; nextpnr-ice40 has no such mode"
     );
-    // A design given: its configuration, which the flags may only agree with.
-    if let Some(d) = &a.dir {
-        a.cfg
-            .for_design(&crate::design_dir::DesignDir::open(d)?.config, d)?;
-    }
+    let opts = options(a);
+    // The design (its directory's manifest, or the flags' configuration) and the part are
+    // checked before the log directory is made too.
+    let cfg = match &a.dir {
+        // A design given: its configuration, which the flags may only agree with.
+        Some(d) => {
+            a.cfg
+                .for_design(&crate::design_dir::DesignDir::open(d)?.config, d)?;
+            None
+        }
+        None => {
+            let cfg = a.cfg.resolve()?.for_target(crate::config::Target::Ice40);
+            cfg.validate()?;
+            Some(cfg)
+        }
+    };
+    fpga::check(a.dir.as_deref(), &opts)?;
     let logs = StagedDir::new(
         &a.logs,
         &a.force.policy(&[a.dir.as_deref(), a.cfg.config.as_deref()]),
     )?;
     // The logs are committed also when the flow fails; its error names them there.
-    let result = flow(a, logs.path());
+    let result = flow(
+        a,
+        cfg.as_ref(),
+        &Options {
+            logs: Some(logs.path().to_path_buf()),
+            ..opts
+        },
+    );
     let (dir, report) = logs.commit_with(result)?;
     let path = dir.join("report.json");
     crate::outln!(
@@ -110,10 +129,10 @@ pub fn run(a: &FpgaArgs) -> Result<()> {
     Ok(())
 }
 
-/// Runs the flow with its logs in `logs` and writes report.json there.
-fn flow(a: &FpgaArgs, logs: &Path) -> Result<fpga::FpgaReport> {
+/// The flow's options from the flags (no log directory yet).
+fn options(a: &FpgaArgs) -> Options {
     let f = a.family;
-    let opts = Options {
+    Options {
         family: f,
         device: a
             .device
@@ -125,16 +144,24 @@ fn flow(a: &FpgaArgs, logs: &Path) -> Result<fpga::FpgaReport> {
             .unwrap_or_else(|| f.default_package().into()),
         freq_mhz: a.freq,
         seed: a.seed,
-        logs: Some(logs.to_path_buf()),
+        logs: None,
         out_of_context: a.ooc,
-    };
-    let (what, report) = match &a.dir {
-        Some(d) => (d.display().to_string(), fpga::run_dir(d, &opts)?),
-        None => {
-            // Both flows build the design with --target ice40 whatever --target says.
-            let cfg = a.cfg.resolve()?.for_target(crate::config::Target::Ice40);
-            (cfg.summary(), fpga::report(&cfg, &opts)?)
-        }
+    }
+}
+
+/// Runs the flow (on `--dir`, else on `cfg`'s design) with its logs in `opts.logs` and
+/// writes report.json there.
+fn flow(
+    a: &FpgaArgs,
+    cfg: Option<&crate::config::Config>,
+    opts: &Options,
+) -> Result<fpga::FpgaReport> {
+    let logs = opts.logs.as_deref().expect("a log directory");
+    let (what, report) = match (&a.dir, cfg) {
+        (Some(d), _) => (d.display().to_string(), fpga::run_dir(d, opts)?),
+        // Both flows build the design with --target ice40 whatever --target says.
+        (None, Some(cfg)) => (cfg.summary(), fpga::report(cfg, opts)?),
+        (None, None) => unreachable!("a configuration when there is no --dir"),
     };
     crate::out!("fpga: {what}\n{}", report.summary())?;
     let json = serde_json::to_string_pretty(&report)?;

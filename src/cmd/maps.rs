@@ -29,21 +29,11 @@ pub struct MapsArgs {
     pub force: super::force::ForceArg,
 }
 
-/// The recognisers of [`map_stream::is_ours`], one per format (a file rmapgen wrote in the
-/// format may be replaced without --force).
-fn ours(format: Format) -> fn(&[u8]) -> bool {
-    match format {
-        Format::Hex => |h| map_stream::is_ours(Format::Hex, h),
-        Format::Bin => |h| map_stream::is_ours(Format::Bin, h),
-        Format::C => |h| map_stream::is_ours(Format::C, h),
-    }
-}
-
 pub fn run(a: &MapsArgs) -> Result<()> {
     let cfg = a.cfg.resolve()?;
     let scene = a.map.scene()?;
     let policy = a.force.policy(&[a.cfg.config.as_deref(), a.map.input()]);
-    let out = StagedFile::new(&a.out, &policy, ours(a.format))?;
+    let out = StagedFile::new(&a.out, &policy)?;
     // The design's own maps (buffer 0, what map_<axis>.hex and the bank init files hold).
     let design = Design::for_scene(&cfg, &scene)?;
     let bytes = map_stream::encode(&cfg, &scene, &design.maps.scene, a.format);

@@ -60,11 +60,6 @@ pub struct MutantsArgs {
     pub force: ForceArg,
 }
 
-fn is_report(bytes: &[u8]) -> bool {
-    serde_json::from_slice::<serde_json::Value>(bytes)
-        .is_ok_and(|v| v["format"].as_str() == Some("rmapgen-mutants-1"))
-}
-
 pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
     let design = DesignDir::open(&a.dir)?;
     if let Err(e) = crate::prove::check_design(&design, true) {
@@ -81,7 +76,7 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
     }
     let policy = a.force.policy(&[Some(design.path())]);
     let out = match &a.report {
-        Some(p) => Some(StagedFile::new(p, &policy, is_report)?),
+        Some(p) => Some(StagedFile::new(p, &policy)?),
         None => None,
     };
     let staged = StagedDir::new(&mutants::work_dir(&a.build, &design), &policy)?;

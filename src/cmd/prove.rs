@@ -71,10 +71,12 @@ pub fn run(a: &ProveArgs) -> Result<ExitCode> {
         parts: a.part.clone(),
     };
     prove::check_design(&design, opts.direct)?;
+    // Refused before the build directory or the report is claimed: bad input makes nothing.
+    prove::check_options(&opts)?;
     let policy = a.force.policy(&[Some(design.path())]);
     // Claimed before the run, so a refused path fails at once rather than after it.
     let out = match &a.report {
-        Some(p) => Some(StagedFile::new(p, &policy, report::is_report)?),
+        Some(p) => Some(StagedFile::new(p, &policy)?),
         None => None,
     };
     let target = a.build.join(format!(

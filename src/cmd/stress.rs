@@ -45,7 +45,6 @@ pub fn run(a: &StressArgs) -> Result<()> {
         Some(p) => Some(StagedFile::new(
             p,
             &a.force.policy(&[a.cfg.config.as_deref(), a.map.input()]),
-            stress::is_report_json,
         )?),
         None => None,
     };

@@ -54,7 +54,7 @@ pub fn run(a: &VectorsArgs) -> Result<()> {
     let policy = a
         .force
         .policy(&[a.cfg.config.as_deref(), a.map.input(), a.maps.as_deref()]);
-    let out = StagedFile::new(&a.out, &policy, vectors::is_vector_stream)?;
+    let out = StagedFile::new(&a.out, &policy)?;
     // The whole file must fit before the first byte is written (its size is exact: every
     // line has the same length).
     let need = vectors::top_stream_bytes(&cfg, a.count as u64);

@@ -22,14 +22,12 @@
 //! an interrupt takes down.
 
 use crate::design_dir::DesignDir;
-use crate::output::signals::{self, Undo};
 use crate::prove::front::FRONT;
 use crate::rng::SplitMix64;
 use crate::stages::unit::file_params;
 use crate::stages::TOP;
 use anyhow::{bail, ensure, Context, Result};
 use serde::Serialize;
-use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -420,7 +418,15 @@ pub fn check(
     timeout: Duration,
     sim_stream: u64,
 ) -> Result<Verdict> {
-    let exe = std::env::current_exe().context("cannot find the rmapgen binary")?;
+    // The running binary itself (Linux's /proc/self/exe), not its path: a campaign of an
+    // hour judges every mutant with the rmapgen it started with, even if a build replaces
+    // target/release/rmapgen meanwhile (which once stopped one with "cannot start").
+    let own = Path::new("/proc/self/exe");
+    let exe = if own.exists() {
+        own.to_path_buf()
+    } else {
+        std::env::current_exe().context("cannot find the rmapgen binary")?
+    };
     let out =
         std::fs::File::create(log).with_context(|| format!("cannot write {}", log.display()))?;
     let err = out.try_clone()?;
@@ -431,25 +437,10 @@ pub fn check(
         .arg(dir)
         .stdin(Stdio::null())
         .stdout(out)
-        .stderr(err)
-        .process_group(0);
-    let mut child = c
-        .spawn()
-        .with_context(|| format!("cannot start rmapgen {}", method.name()))?;
-    let token = signals::register(Undo::KillGroup(child.id()));
-    let start = Instant::now();
-    let status = loop {
-        if let Some(s) = child.try_wait()? {
-            break Some(s);
-        }
-        if start.elapsed() > timeout {
-            Undo::KillGroup(child.id()).run_now();
-            child.wait()?;
-            break None;
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    };
-    token.release();
+        .stderr(err);
+    let status = crate::toolchain::child::spawn(&mut c)
+        .with_context(|| format!("cannot start rmapgen {}", method.name()))?
+        .wait_timeout(timeout)?;
     Ok(match status.and_then(|s| s.code()) {
         None if status.is_none() => Verdict::Timeout,
         Some(0) => Verdict::Passed,

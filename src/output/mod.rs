@@ -35,8 +35,14 @@ const NAME_MAX: usize = 255;
 pub fn hidden_prefix(name: &str, kind: &str) -> String {
     // "." + ".KIND-" + a u32 process id + ".old".
     let room = NAME_MAX - (1 + 1 + kind.len() + 1 + u32::MAX.to_string().len() + ".old".len());
+    format!(".{}.{kind}-", shortened(name, room))
+}
+
+/// `name` if it has at most `room` bytes, else its first bytes, `~` and 16 hex digits of its
+/// SHA-256, `room` bytes in all: the same for the same name in every run.
+pub fn shortened(name: &str, room: usize) -> String {
     if name.len() <= room {
-        return format!(".{name}.{kind}-");
+        return name.to_string();
     }
     use sha2::{Digest, Sha256};
     let hash = Sha256::digest(name.as_bytes());
@@ -45,7 +51,7 @@ pub fn hidden_prefix(name: &str, kind: &str) -> String {
     while !name.is_char_boundary(cut) {
         cut -= 1;
     }
-    format!(".{}~{tag}.{kind}-", &name[..cut])
+    format!("{}~{tag}", &name[..cut])
 }
 
 pub struct StagedDir {
@@ -219,22 +225,24 @@ impl Drop for StagedDir {
     }
 }
 
-/// One output file that appears whole or not at all: written as `.NAME.partial-PID` beside
-/// the target and renamed over it on [`StagedFile::commit`].
+/// One output file that appears whole or not at all: written as `NAME` inside a staging
+/// directory `.NAME.partial-PID` beside the target (marked as rmapgen's like a directory's
+/// staging, so a leftover is told from a user's file of that name), and renamed over the
+/// target on [`StagedFile::commit`], with its record ([`stamp::record_path`]) beside it.
 pub struct StagedFile {
     target: PathBuf,
+    dir: PathBuf,
     partial: PathBuf,
     policy: Policy,
-    ours: fn(&[u8]) -> bool,
     token: Option<Token>,
     created: CreatedParents,
 }
 
 impl StagedFile {
-    /// Starts writing file `target` under `policy`; `ours` recognises (from its first bytes)
-    /// a file of this kind that rmapgen wrote, which may be replaced without `--force`.
-    pub fn new(target: &Path, policy: &Policy, ours: fn(&[u8]) -> bool) -> Result<StagedFile> {
-        policy.check_file(target, ours)?;
+    /// Starts writing file `target` under `policy`: a file already there is replaced only if
+    /// rmapgen wrote it and it is unchanged since (or with `--force`).
+    pub fn new(target: &Path, policy: &Policy) -> Result<StagedFile> {
+        policy.check_file(target)?;
         let name = target
             .file_name()
             .with_context(|| format!("output path {} has no file name", target.display()))?
@@ -245,16 +253,19 @@ impl StagedFile {
             .with_context(|| format!("cannot write {}", target.display()))?;
         let prefix = hidden_prefix(&name, "partial");
         remove_stale(&parent, &prefix);
-        let partial = parent.join(format!("{prefix}{}", std::process::id()));
-        let token = signals::register(Undo::Remove(partial.clone()));
+        let dir = parent.join(format!("{prefix}{}", std::process::id()));
+        let token = signals::register(Undo::Remove(dir.clone()));
+        let made =
+            std::fs::create_dir(&dir).and_then(|()| std::fs::write(dir.join(STAGING_MARK), b""));
         let file = StagedFile {
             target: target.to_path_buf(),
-            partial,
+            partial: dir.join(&name),
+            dir,
             policy: policy.clone(),
-            ours,
             token: Some(token),
             created,
         };
+        made.with_context(|| format!("cannot write {}", target.display()))?;
         // Made now, empty: a place that cannot be written (a read-only file system) fails
         // at once, naming the target, not after the command's work.
         {
@@ -282,13 +293,27 @@ impl StagedFile {
         named_as_target(e, &self.partial, &self.target)
     }
 
-    /// Renames the finished file over the target (checked again first).
+    /// Renames the finished file over the target (checked again first) and records its
+    /// SHA-256 beside it.
     pub fn commit(mut self) -> Result<PathBuf> {
-        self.policy.check_file(&self.target, self.ours)?;
+        self.policy.check_file(&self.target)?;
+        let shown = self.target.display().to_string();
+        let name = self.target.file_name().expect("checked").to_string_lossy();
+        let hash = stamp::digest(&self.partial)?;
+        let record = stamp::record_path(&self.target).expect("a file name");
+        let staged_record = self.dir.join(".record");
+        std::fs::write(&staged_record, stamp::record_text(&name, &hash))
+            .with_context(|| format!("cannot write {}", record.display()))?;
         {
+            // Both renames under one hold: an interrupt sees the old file and record, or the
+            // new ones. (Killed outright in between, the new file and the old record
+            // disagree: the file is kept until --force, never lost.)
             let _held = signals::hold();
             std::fs::rename(&self.partial, &self.target)
-                .with_context(|| format!("cannot write {}", self.target.display()))?;
+                .with_context(|| format!("cannot write {shown}"))?;
+            std::fs::rename(&staged_record, &record)
+                .with_context(|| format!("cannot write {}", record.display()))?;
+            std::fs::remove_dir_all(&self.dir).ok();
         }
         if let Some(t) = self.token.take() {
             t.release();
@@ -301,7 +326,7 @@ impl StagedFile {
 impl Drop for StagedFile {
     fn drop(&mut self) {
         if let Some(token) = self.token.take() {
-            std::fs::remove_file(&self.partial).ok();
+            std::fs::remove_dir_all(&self.dir).ok();
             token.release();
         }
     }
@@ -415,9 +440,9 @@ impl Drop for CreatedParents {
     }
 }
 
-/// Removes leftovers of runs that were killed outright (SIGKILL, power loss): entries of
-/// `parent` named `<prefix><pid>` (or `<prefix><pid>.old`) whose process no longer exists.
-/// A staging directory counts only if it still carries rmapgen's staging mark.
+/// Removes leftovers of runs that were killed outright (SIGKILL, power loss): directories of
+/// `parent` named `<prefix><pid>` (or `<prefix><pid>.old`) whose process no longer exists and
+/// that carry rmapgen's staging mark (or, a moved-aside old output, its stamp).
 fn remove_stale(parent: &Path, prefix: &str) {
     let Ok(entries) = std::fs::read_dir(parent) else {
         return;
@@ -432,12 +457,11 @@ fn remove_stale(parent: &Path, prefix: &str) {
             continue;
         }
         let p = e.path();
+        // Only a directory with rmapgen's mark: a file (a user's `.v.hex.partial-999999`)
+        // or an unmarked directory is never rmapgen's to remove.
         match std::fs::symlink_metadata(&p) {
             Ok(m) if m.is_dir() && stamp_or_mark(&p) => {
                 std::fs::remove_dir_all(&p).ok();
-            }
-            Ok(m) if m.is_file() => {
-                std::fs::remove_file(&p).ok();
             }
             _ => {}
         }

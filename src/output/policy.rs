@@ -2,8 +2,9 @@
 //! what rmapgen wrote there (its stamp lists the file and the bytes are unchanged), or the user
 //! said `--force`. Never, not even forced, does it replace the current directory or one of its
 //! ancestors, or a directory holding one of the command's inputs that rmapgen did not write.
-//! A single output file replaces only a file of the same kind that rmapgen wrote (recognised
-//! by its contents), unless forced, and never an input.
+//! A single output file follows the same rule: it replaces only a file that rmapgen wrote and
+//! nobody changed since (its record beside it, [`stamp::record_path`], names it with its
+//! SHA-256), unless forced, and never an input.
 
 use super::stamp::{self, Stamp};
 use anyhow::{bail, Context, Result};
@@ -115,9 +116,9 @@ impl Policy {
         }
     }
 
-    /// Checks that file `target` may be replaced: `ours` recognises, from its first bytes, a
-    /// file of this kind that rmapgen wrote.
-    pub fn check_file(&self, target: &Path, ours: fn(&[u8]) -> bool) -> Result<()> {
+    /// Checks that file `target` may be replaced (or created): it is absent, or rmapgen wrote
+    /// it and it is unchanged since (its record holds its SHA-256), or the user forced it.
+    pub fn check_file(&self, target: &Path) -> Result<()> {
         let shown = target.display();
         let ends_in_slash = target.as_os_str().to_string_lossy().ends_with('/');
         if ends_in_slash || target.is_dir() {
@@ -126,7 +127,17 @@ impl Policy {
         if target.file_name().is_none() {
             bail!("output path {shown} has no file name");
         }
+        let record = stamp::record_path(target).expect("a file name");
+        let recorded = stamp::read_record(target);
         let Ok(meta) = std::fs::symlink_metadata(target) else {
+            // Nothing to replace; but the record's name must not be someone else's file.
+            if matches!(recorded, Some(None)) && !self.force {
+                bail!(
+                    "will not replace {}: it is not rmapgen's record of {shown}; nothing was \
+                     changed (move it, or use --force to replace it)",
+                    record.display()
+                );
+            }
             return Ok(());
         };
         if meta.file_type().is_symlink() {
@@ -144,11 +155,17 @@ impl Policy {
         if self.force {
             return Ok(());
         }
-        let head = read_head(target, 64 << 10).with_context(|| format!("cannot read {shown}"))?;
-        if !ours(&head) {
+        let Some(Some(hash)) = recorded else {
             bail!(
-                "will not replace {shown}: it exists and was not written by rmapgen; nothing \
-                 was changed (choose another name, or use --force)"
+                "will not replace {shown}: it exists and was not written by rmapgen (no record \
+                 {}); nothing was changed (choose another name, or use --force to replace it)",
+                record.display()
+            );
+        };
+        if stamp::digest(target)? != hash {
+            bail!(
+                "will not replace {shown}: it was changed since rmapgen wrote it; nothing was \
+                 changed (choose another name, or use --force to replace it)"
             );
         }
         Ok(())
@@ -240,11 +257,4 @@ fn slash_path(rel: &Path) -> String {
         .map(|c| c.as_os_str().to_string_lossy())
         .collect::<Vec<_>>()
         .join("/")
-}
-
-fn read_head(p: &Path, max: u64) -> std::io::Result<Vec<u8>> {
-    use std::io::Read;
-    let mut v = Vec::new();
-    std::fs::File::open(p)?.take(max).read_to_end(&mut v)?;
-    Ok(v)
 }

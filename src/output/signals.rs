@@ -6,14 +6,23 @@
 //! Writers that change the registered paths hold [`hold`] while they do, so the watcher never
 //! removes a directory half-way through a file being created in it, and never sees a target
 //! between the two renames that replace it.
+//!
+//! A signal that cannot be caught (SIGKILL, the OOM killer) ends rmapgen before the watcher
+//! can run. For that, the `rmapgen` binary starts a guardian ([`install_guardian`]): a copy
+//! of itself in a process group of its own, started at the first registration, to which every
+//! registration and release is sent over a pipe. When rmapgen ends, however it ends, the
+//! pipe closes; the guardian then undoes whatever is still registered (kills the children's
+//! process groups, removes staging and scratch directories) and exits.
 
-use std::path::PathBuf;
+use std::io::Write;
+use std::os::unix::ffi::{OsStrExt, OsStringExt};
+use std::path::{Path, PathBuf};
 use std::sync::{Mutex, MutexGuard, Once};
+use std::time::{Duration, Instant};
 
-extern "C" {
-    fn kill(pid: i32, sig: i32) -> i32;
-}
-const SIGKILL: i32 = 9;
+/// How long an undo waits for processes it killed to go, or retries removing a directory
+/// they were still writing into.
+const SETTLE: Duration = Duration::from_secs(3);
 
 /// What to undo for one registered path.
 #[derive(Debug, Clone)]
@@ -39,12 +48,20 @@ impl Undo {
     fn run(&self) {
         match self {
             Undo::Remove(p) => {
-                let removed = match std::fs::symlink_metadata(p) {
-                    Ok(m) if m.is_dir() => std::fs::remove_dir_all(p),
-                    Ok(_) => std::fs::remove_file(p),
-                    Err(_) => Ok(()),
-                };
-                removed.ok();
+                // A killed child may still be writing into a directory for a moment (SIGKILL
+                // is delivered, not awaited): try again until it is gone.
+                let start = Instant::now();
+                loop {
+                    match std::fs::symlink_metadata(p) {
+                        Ok(m) if m.is_dir() => std::fs::remove_dir_all(p).ok(),
+                        Ok(_) => std::fs::remove_file(p).ok(),
+                        Err(_) => break,
+                    };
+                    if std::fs::symlink_metadata(p).is_err() || start.elapsed() > SETTLE {
+                        break;
+                    }
+                    std::thread::sleep(Duration::from_millis(20));
+                }
             }
             Undo::RemoveIfEmpty(p) => {
                 std::fs::remove_dir(p).ok();
@@ -53,7 +70,7 @@ impl Undo {
                 // SAFETY: kill(2) with a negative pid signals the process group; no memory
                 // is touched.
                 unsafe {
-                    kill(-(*pgid as i32), SIGKILL);
+                    libc::kill(-(*pgid as i32), libc::SIGKILL);
                 }
             }
             Undo::Restore { from, to } => {
@@ -70,12 +87,40 @@ impl Undo {
 struct Registry {
     next: u64,
     live: Vec<(u64, Undo)>,
+    guardian: Guardian,
+}
+
+/// The guardian's state, as seen from rmapgen.
+enum Guardian {
+    /// Not asked for (a library user, a unit test): nothing outlives an uncatchable signal.
+    Off,
+    /// Asked for; started at the first registration.
+    Wanted,
+    /// Running: every registration and release is written here.
+    Running(std::process::ChildStdin),
+    /// Could not be started, or its pipe broke: the watcher still works.
+    Failed,
 }
 
 static REGISTRY: Mutex<Registry> = Mutex::new(Registry {
     next: 0,
     live: Vec::new(),
+    guardian: Guardian::Off,
 });
+
+impl Registry {
+    /// Tells the guardian one line (starting it if it is wanted and not yet running).
+    fn tell(&mut self, line: &str) {
+        if matches!(self.guardian, Guardian::Wanted) {
+            self.guardian = start_guardian();
+        }
+        if let Guardian::Running(pipe) = &mut self.guardian {
+            if pipe.write_all(line.as_bytes()).is_err() {
+                self.guardian = Guardian::Failed;
+            }
+        }
+    }
+}
 
 /// A registration; dropping it does not undo anything, [`Token::release`] forgets it.
 #[derive(Debug)]
@@ -92,25 +137,38 @@ pub fn hold() -> Held {
 impl Held {
     /// Replaces what `token` undoes, as part of the change this hold covers.
     pub fn replace(&mut self, token: &Token, undo: Undo) {
+        let line = encode(token.0, &undo);
         if let Some(e) = self.0.live.iter_mut().find(|(i, _)| *i == token.0) {
             e.1 = undo;
+            self.0.tell(&line);
         }
     }
 }
 
 /// Registers `undo`, to be run if a signal ends the process before it is released.
 pub fn register(undo: Undo) -> Token {
-    let mut h = hold();
-    h.0.next += 1;
-    let id = h.0.next;
-    h.0.live.push((id, undo));
-    Token(id)
+    hold().register(undo)
+}
+
+impl Held {
+    /// Registers `undo` as part of the change this hold covers (a child started and
+    /// registered with no interrupt in between).
+    pub fn register(&mut self, undo: Undo) -> Token {
+        self.0.next += 1;
+        let id = self.0.next;
+        let line = encode(id, &undo);
+        self.0.live.push((id, undo));
+        self.0.tell(&line);
+        Token(id)
+    }
 }
 
 impl Token {
     /// Forgets the registration: the path is finished or already cleaned up.
     pub fn release(self) {
-        hold().0.live.retain(|(i, _)| *i != self.0);
+        let mut h = hold();
+        h.0.live.retain(|(i, _)| *i != self.0);
+        h.0.tell(&format!("-{}\n", self.0));
     }
 }
 
@@ -129,6 +187,8 @@ pub fn install() -> std::io::Result<()> {
                     for (_, undo) in h.0.live.drain(..).rev() {
                         undo.run();
                     }
+                    // Done here: the guardian has nothing left to undo.
+                    h.0.tell("clear\n");
                     signal_hook::low_level::emulate_default_handler(sig).ok();
                     std::process::exit(128 + sig);
                 }
@@ -136,4 +196,211 @@ pub fn install() -> std::io::Result<()> {
         });
     });
     result
+}
+
+/// The argument that makes the `rmapgen` binary the guardian ([`guardian_main`]).
+pub const GUARDIAN_ARG: &str = "--rmapgen-guardian";
+
+/// Asks for the guardian: from the first registration on, a copy of this binary (run with
+/// [`GUARDIAN_ARG`], which its `main` must hand to [`guardian_main`]) undoes what is still
+/// registered when this process ends by a signal it cannot catch.
+pub fn install_guardian() {
+    let mut h = hold();
+    if matches!(h.0.guardian, Guardian::Off) {
+        h.0.guardian = Guardian::Wanted;
+    }
+}
+
+/// Starts the guardian: this very binary (through `/proc/self/exe` if it was removed
+/// meanwhile) in a process group of its own (a Ctrl-C to the terminal's group
+/// leaves it to see the cleanup through), reading the registrations on its stdin. It is the
+/// one child not started through [`crate::toolchain::child`]: it must outlive rmapgen, and
+/// it exits by itself when rmapgen's end closes the pipe.
+fn start_guardian() -> Guardian {
+    use std::os::unix::process::CommandExt;
+    use std::process::{Command, Stdio};
+    // The binary by name (as `ps` shows it), else through /proc when it was removed.
+    let exe = std::env::current_exe()
+        .ok()
+        .filter(|p| p.is_file())
+        .unwrap_or_else(|| PathBuf::from("/proc/self/exe"));
+    let started = Command::new(exe)
+        .arg(GUARDIAN_ARG)
+        .arg(std::process::id().to_string())
+        .stdin(Stdio::piped())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .current_dir("/")
+        .process_group(0)
+        .spawn();
+    match started.map(|mut c| c.stdin.take()) {
+        Ok(Some(pipe)) => Guardian::Running(pipe),
+        _ => Guardian::Failed,
+    }
+}
+
+/// One registration as the guardian reads it: `+ID KIND HEX [HEX]`, paths absolute and in
+/// hex (any byte may be in a path).
+fn encode(id: u64, undo: &Undo) -> String {
+    let hex = |p: &Path| -> String {
+        let abs = std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+        abs.as_os_str()
+            .as_bytes()
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect()
+    };
+    match undo {
+        Undo::Remove(p) => format!("+{id} R {}\n", hex(p)),
+        Undo::RemoveIfEmpty(p) => format!("+{id} E {}\n", hex(p)),
+        Undo::Restore { from, to } => format!("+{id} S {} {}\n", hex(from), hex(to)),
+        Undo::KillGroup(g) => format!("+{id} K {g}\n"),
+    }
+}
+
+/// The registration `line` holds ([`encode`]'s `+` lines), or None when it is not one.
+fn decode(line: &str) -> Option<(u64, Undo)> {
+    let mut w = line.strip_prefix('+')?.split(' ');
+    let id = w.next()?.parse().ok()?;
+    let kind = w.next()?;
+    let mut path = || -> Option<PathBuf> {
+        let h = w.next()?.as_bytes();
+        if h.len() % 2 != 0 || h.is_empty() {
+            return None;
+        }
+        let bytes: Option<Vec<u8>> = h
+            .chunks(2)
+            .map(|c| u8::from_str_radix(std::str::from_utf8(c).ok()?, 16).ok())
+            .collect();
+        Some(PathBuf::from(std::ffi::OsString::from_vec(bytes?)))
+    };
+    let undo = match kind {
+        "R" => Undo::Remove(path()?),
+        "E" => Undo::RemoveIfEmpty(path()?),
+        "S" => {
+            let from = path()?;
+            Undo::Restore { from, to: path()? }
+        }
+        "K" => Undo::KillGroup(w.next()?.parse().ok()?),
+        _ => return None,
+    };
+    Some((id, undo))
+}
+
+/// The guardian (refused unless started by rmapgen, its parent's pid given after
+/// [`GUARDIAN_ARG`]): reads registrations (`+`), releases (`-ID`) and `clear` from stdin until it
+/// closes (rmapgen has ended), then undoes what is still registered, last first, and returns.
+/// Process groups it kills are waited for (a bounded time), so a directory their tools were
+/// writing into is removed after they stop.
+pub fn guardian_main() {
+    // Only as rmapgen started it: its parent's pid as the argument after GUARDIAN_ARG.
+    let parent = std::env::args().nth(2).and_then(|p| p.parse::<i32>().ok());
+    // SAFETY: getppid has no preconditions.
+    let ours = parent == Some(unsafe { libc::getppid() })
+        // rmapgen died before this line ran: its registrations still wait on the pipe.
+        || parent.is_some_and(|p| !Path::new(&format!("/proc/{p}")).exists() && stdin_is_pipe());
+    if !ours {
+        eprintln!("rmapgen: error: {GUARDIAN_ARG} is started by rmapgen itself, not by hand");
+        std::process::exit(2);
+    }
+    // SAFETY: setting a signal's disposition to ignore touches no memory of ours.
+    unsafe {
+        libc::signal(libc::SIGINT, libc::SIG_IGN);
+        libc::signal(libc::SIGHUP, libc::SIG_IGN);
+        libc::signal(libc::SIGPIPE, libc::SIG_IGN);
+    }
+    let mut live: Vec<(u64, Undo)> = Vec::new();
+    let mut input = std::io::stdin().lock();
+    let mut line = Vec::new();
+    loop {
+        line.clear();
+        match std::io::BufRead::read_until(&mut input, b'\n', &mut line) {
+            Ok(0) | Err(_) => break,
+            Ok(_) => {}
+        }
+        let text = String::from_utf8_lossy(&line);
+        let text = text.trim_end();
+        if text == "clear" {
+            live.clear();
+        } else if let Some(id) = text.strip_prefix('-').and_then(|i| i.parse::<u64>().ok()) {
+            live.retain(|(i, _)| *i != id);
+        } else if let Some((id, undo)) = decode(text) {
+            match live.iter_mut().find(|(i, _)| *i == id) {
+                Some(e) => e.1 = undo,
+                None => live.push((id, undo)),
+            }
+        }
+    }
+    for (_, undo) in live.into_iter().rev() {
+        undo.run();
+        if let Undo::KillGroup(g) = undo {
+            wait_group_gone(g);
+        }
+    }
+}
+
+fn stdin_is_pipe() -> bool {
+    use std::os::unix::fs::FileTypeExt;
+    std::fs::metadata("/proc/self/fd/0").is_ok_and(|m| m.file_type().is_fifo())
+}
+
+/// Waits (at most [`SETTLE`]) until no process is left running in group `pgid`. Zombies do
+/// not count: they write nothing, and their reaping (by init, once rmapgen is gone) can take
+/// a while.
+fn wait_group_gone(pgid: u32) {
+    let start = Instant::now();
+    while group_running(pgid) && start.elapsed() < SETTLE {
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+/// Whether a process of group `pgid` that is not a zombie exists (if /proc cannot tell,
+/// whether any process of the group exists).
+fn group_running(pgid: u32) -> bool {
+    // SAFETY: kill(2) with signal 0 only checks that the group exists.
+    if unsafe { libc::kill(-(pgid as i32), 0) } != 0 {
+        return false;
+    }
+    let Ok(entries) = std::fs::read_dir("/proc") else {
+        return true;
+    };
+    entries.flatten().any(|e| {
+        let Ok(stat) = std::fs::read_to_string(e.path().join("stat")) else {
+            return false;
+        };
+        // pid (comm) state ppid pgrp ...; comm may hold spaces and parentheses.
+        let Some(close) = stat.rfind(')') else {
+            return false;
+        };
+        let mut w = stat[close + 1..].split_whitespace();
+        let state = w.next();
+        let pgrp = w.nth(1);
+        state != Some("Z") && pgrp == Some(&*pgid.to_string())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn registrations_reach_the_guardian_as_they_were() {
+        let odd = PathBuf::from("/tmp/a b\nc/\u{e9}");
+        for undo in [
+            Undo::Remove(odd.clone()),
+            Undo::RemoveIfEmpty(PathBuf::from("/x")),
+            Undo::Restore {
+                from: PathBuf::from("/a/.o.old"),
+                to: odd.clone(),
+            },
+            Undo::KillGroup(4242),
+        ] {
+            let line = encode(7, &undo);
+            let (id, back) = decode(line.trim_end()).expect("decodes");
+            assert_eq!(id, 7);
+            assert_eq!(format!("{back:?}"), format!("{undo:?}"));
+        }
+        assert!(decode("+1 R 6").is_none());
+        assert!(decode("+1 Q 00").is_none());
+    }
 }

@@ -4,6 +4,11 @@
 //!
 //! The format is `sha256sum`'s (`<hex digest>  <relative path>`, one file a line, sorted), so a
 //! user can check a design with `sha256sum -c .rmapgen-files` inside it.
+//!
+//! A single output file (`maps --out`, `vectors --out`, `prove --report`, ...) has its record
+//! beside it: `.NAME.rmapgen-sha256`, one line in the same format (`sha256sum -c` checks it in
+//! that directory). It is what lets a later run replace the file: only a file whose record
+//! names it with its current SHA-256 is rmapgen's, unchanged.
 
 use anyhow::{Context, Result};
 use sha2::{Digest, Sha256};
@@ -20,6 +25,40 @@ const MAX_BYTES: u64 = 16 << 20;
 
 /// Relative path ('/'-separated) to hex SHA-256.
 pub type Stamp = BTreeMap<String, String>;
+
+/// The record of the single output file `target` ([`record_path`]'s name).
+const RECORD_SUFFIX: &str = ".rmapgen-sha256";
+
+/// Where the record of single output file `target` is: `.NAME.rmapgen-sha256` beside it.
+pub fn record_path(target: &Path) -> Option<std::path::PathBuf> {
+    let name = target.file_name()?.to_string_lossy();
+    // Within the file system's name limit, as the staging names are.
+    let room = super::NAME_MAX - 1 - RECORD_SUFFIX.len();
+    let name = super::shortened(&name, room);
+    Some(target.with_file_name(format!(".{name}{RECORD_SUFFIX}")))
+}
+
+/// The record's text for a file named `name` with digest `hash`.
+pub fn record_text(name: &str, hash: &str) -> String {
+    format!("{hash}  {name}\n")
+}
+
+/// What the record of `target` holds: Some(Some(hash)) when it is a well-formed record of
+/// that file, Some(None) when something else has the record's name, None when nothing has.
+pub fn read_record(target: &Path) -> Option<Option<String>> {
+    let p = record_path(target)?;
+    let meta = std::fs::symlink_metadata(&p).ok()?;
+    let name = target.file_name()?.to_string_lossy().into_owned();
+    if !meta.is_file() || meta.len() > 4096 {
+        return Some(None);
+    }
+    let text = std::fs::read_to_string(&p).ok();
+    Some(text.and_then(|t| {
+        let (hash, rest) = t.strip_suffix('\n')?.split_once("  ")?;
+        let ok = hash.len() == 64 && hash.bytes().all(|b| b.is_ascii_hexdigit()) && rest == name;
+        ok.then(|| hash.to_string())
+    }))
+}
 
 /// The SHA-256 of a file, as lower-case hex.
 pub fn digest(path: &Path) -> Result<String> {

@@ -327,9 +327,8 @@ pub const FACTORED: [&str; 4] = ["structure", "states", "zero", "front"];
 /// The parts of a `--direct` run.
 pub const DIRECT: [&str; 2] = ["structure", "direct"];
 
-/// Runs one shard on design `d`, building in `build` (a directory rmapgen owns).
-pub fn run(d: &DesignDir, build: &Path, opts: &Options, progress: &Progress) -> Result<Report> {
-    check_design(d, opts.direct)?;
+/// Checks the options of a run (the parts named exist), before anything is made.
+pub fn check_options(opts: &Options) -> Result<()> {
     let names: &[&str] = if opts.direct { &DIRECT } else { &FACTORED };
     for p in &opts.parts {
         if !names.contains(&p.as_str()) {
@@ -340,6 +339,14 @@ pub fn run(d: &DesignDir, build: &Path, opts: &Options, progress: &Progress) -> 
             );
         }
     }
+    Ok(())
+}
+
+/// Runs one shard on design `d`, building in `build` (a directory rmapgen owns).
+pub fn run(d: &DesignDir, build: &Path, opts: &Options, progress: &Progress) -> Result<Report> {
+    check_design(d, opts.direct)?;
+    check_options(opts)?;
+    let names: &[&str] = if opts.direct { &DIRECT } else { &FACTORED };
     let wanted = |name: &str| opts.parts.is_empty() || opts.parts.iter().any(|p| p == name);
     let start = Instant::now();
     // What is proven is the files as they are now: hashed before the run and again after it,

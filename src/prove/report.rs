@@ -260,12 +260,6 @@ impl Report {
     }
 }
 
-/// Whether `bytes` is a report this command wrote (so `--report` may replace it).
-pub fn is_report(bytes: &[u8]) -> bool {
-    serde_json::from_slice::<serde_json::Value>(bytes)
-        .is_ok_and(|v| v["format"].as_str() == Some(FORMAT))
-}
-
 /// The verdict of a whole run.
 pub struct Merged {
     pub passed: bool,

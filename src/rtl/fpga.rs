@@ -196,10 +196,10 @@ impl FpgaReport {
 pub fn tools_available(opts: &Options) -> bool {
     let yosys = match opts.family {
         Family::Ice40 => yosys::available(),
-        Family::Ecp5 => std::process::Command::new(yosys::yosys_ecp5())
-            .arg("-V")
-            .output()
-            .is_ok_and(|o| o.status.success()),
+        Family::Ecp5 => {
+            toolchain::capture(std::process::Command::new(yosys::yosys_ecp5()).arg("-V"))
+                .is_ok_and(|r| r.success())
+        }
     };
     yosys && nextpnr::available(opts.family)
 }
@@ -313,10 +313,18 @@ fn target(opts: &Options) -> nextpnr::Target<'_> {
     }
 }
 
-/// Checks the options and the part, then synthesises the design of `dir` for `opts.family`
-/// (the seed and target frequency are [`place`]'s): every memory of the manifest must be in
-/// block RAM.
-pub fn synthesise(dir: &Path, opts: &Options) -> Result<Synthesis> {
+/// Checks what the flow is given, before anything is made: the options, the manifest of the
+/// design directory `dir` (when one is given) and the part (nextpnr without a design). What
+/// `rmapgen fpga` refuses before it makes its log directory.
+pub fn check(dir: Option<&Path>, opts: &Options) -> Result<()> {
+    check_options(opts)?;
+    if let Some(d) = dir {
+        read_manifest(d)?;
+    }
+    check_part(opts)
+}
+
+fn check_options(opts: &Options) -> Result<()> {
     anyhow::ensure!(
         opts.freq_mhz > 0.0 && opts.freq_mhz <= 1000.0,
         "target frequency {} MHz is out of range; allowed (0, 1000]",
@@ -327,6 +335,11 @@ pub fn synthesise(dir: &Path, opts: &Options) -> Result<Synthesis> {
         !opts.out_of_context || opts.family == Family::Ecp5,
         "out-of-context place and route (--ooc) is for --family ecp5 only; nextpnr-ice40 has no such mode"
     );
+    Ok(())
+}
+
+/// The manifest of design directory `dir`, parsed.
+fn read_manifest(dir: &Path) -> Result<serde_json::Value> {
     let text = std::fs::read_to_string(dir.join(manifest::FILE)).with_context(|| {
         format!(
             "no {} in {}: generate the design first (rmapgen generate --out {})",
@@ -335,8 +348,26 @@ pub fn synthesise(dir: &Path, opts: &Options) -> Result<Synthesis> {
             dir.display()
         )
     })?;
-    let m: serde_json::Value = serde_json::from_str(&text)
-        .with_context(|| format!("{} in {} is not JSON", manifest::FILE, dir.display()))?;
+    serde_json::from_str(&text)
+        .with_context(|| format!("{} in {} is not JSON", manifest::FILE, dir.display()))
+}
+
+/// nextpnr checks the device and package without a design, in milliseconds: a name it does
+/// not know fails here, before the synthesis.
+fn check_part(opts: &Options) -> Result<()> {
+    let check = toolchain::capture(&mut nextpnr::check_part(&target(opts)))?;
+    if !check.success() {
+        bail!("{}: {}", part_of(opts), complaint(&check.output));
+    }
+    Ok(())
+}
+
+/// Checks the options and the part, then synthesises the design of `dir` for `opts.family`
+/// (the seed and target frequency are [`place`]'s): every memory of the manifest must be in
+/// block RAM.
+pub fn synthesise(dir: &Path, opts: &Options) -> Result<Synthesis> {
+    check_options(opts)?;
+    let m = read_manifest(dir)?;
     let files: Vec<String> = m["modules"]
         .as_array()
         .context("the manifest lists no modules")?
@@ -360,13 +391,8 @@ pub fn synthesise(dir: &Path, opts: &Options) -> Result<Synthesis> {
         })
         .collect();
 
-    // nextpnr checks the device and package without a design, in milliseconds: a name it
-    // does not know fails here, before the synthesis.
     let family = opts.family;
-    let check = toolchain::capture(&mut nextpnr::check_part(&target(opts)))?;
-    if !check.success() {
-        bail!("{}: {}", part_of(opts), complaint(&check.output));
-    }
+    check_part(opts)?;
 
     let mut scratch = None;
     let logs = match &opts.logs {

@@ -170,13 +170,6 @@ pub struct Report {
     pub seconds: f64,
 }
 
-/// Whether `head` (the first bytes of a file) looks like a report `stress --json` wrote, so a
-/// later run may replace it.
-pub fn is_report_json(head: &[u8]) -> bool {
-    let text = String::from_utf8_lossy(head);
-    text.starts_with("{\n  \"mode\": ") && text.contains("\"overflow_checks\": ")
-}
-
 impl Report {
     /// The largest |model - reference| in LSBs (0 when no input was compared).
     pub fn max_abs_error(&self) -> u64 {

@@ -10,6 +10,7 @@
 //! and quotes the tail of its output), [`capture`] and [`run_logged`] for one whose output the
 //! caller judges (a testbench's verdict line, a lint's silence).
 
+pub mod child;
 pub mod icarus;
 pub mod nextpnr;
 pub mod verilator;
@@ -174,7 +175,7 @@ impl Ran {
     }
 }
 
-fn start_error(cmd: &Command, e: std::io::Error) -> anyhow::Error {
+pub(crate) fn start_error(cmd: &Command, e: std::io::Error) -> anyhow::Error {
     let program = cmd.get_program().to_string_lossy();
     // The YoWASP tools come from the project venv, the others from Debian.
     let setup = if program.contains("yowasp") {
@@ -195,10 +196,7 @@ fn start_error(cmd: &Command, e: std::io::Error) -> anyhow::Error {
 /// Runs `cmd` to the end with its output captured.
 pub fn capture(cmd: &mut Command) -> Result<Ran> {
     let t0 = Instant::now();
-    let out = cmd
-        .stdin(Stdio::null())
-        .output()
-        .map_err(|e| start_error(cmd, e))?;
+    let out = child::output(cmd)?;
     let mut output = String::from_utf8_lossy(&out.stdout).into_owned();
     if !output.is_empty() && !output.ends_with('\n') && !out.stderr.is_empty() {
         output.push('\n');
@@ -220,12 +218,8 @@ pub fn run_logged(cmd: &mut Command, log: &Path) -> Result<Ran> {
         .try_clone()
         .with_context(|| format!("cannot write {}", log.display()))?;
     let t0 = Instant::now();
-    let status = cmd
-        .stdin(Stdio::null())
-        .stdout(file)
-        .stderr(err)
-        .status()
-        .map_err(|e| start_error(cmd, e))?;
+    cmd.stdin(Stdio::null()).stdout(file).stderr(err);
+    let status = child::spawn(cmd)?.wait()?;
     let seconds = t0.elapsed().as_secs_f64();
     let bytes = std::fs::read(log).with_context(|| format!("cannot read {}", log.display()))?;
     Ok(Ran {

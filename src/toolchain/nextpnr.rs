@@ -117,10 +117,7 @@ pub fn nextpnr(family: Family) -> String {
 
 /// Whether `family`'s nextpnr runs (`--version`).
 pub fn available(family: Family) -> bool {
-    Command::new(nextpnr(family))
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| o.status.success())
+    super::capture(Command::new(nextpnr(family)).arg("--version")).is_ok_and(|r| r.success())
 }
 
 /// The part and what the placer aims at.

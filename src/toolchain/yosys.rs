@@ -20,10 +20,7 @@ pub fn yosys() -> String {
 
 /// Whether Yosys runs (`yosys -V`).
 pub fn available() -> bool {
-    Command::new(yosys())
-        .arg("-V")
-        .output()
-        .is_ok_and(|o| o.status.success())
+    super::capture(Command::new(yosys()).arg("-V")).is_ok_and(|r| r.success())
 }
 
 /// `yosys -q -l LOGS/yosys.log -p SCRIPT`, run from `dir`.
@@ -154,9 +151,7 @@ pub fn ice40_cell_models() -> Result<PathBuf> {
     let mut tried = Vec::new();
     let env = std::env::var_os("YOSYS_DATDIR").filter(|v| !v.is_empty());
     let config = || {
-        Command::new("yosys-config")
-            .arg("--datdir")
-            .output()
+        super::child::output(Command::new("yosys-config").arg("--datdir"))
             .ok()
             .filter(|o| o.status.success())
             .map(|o| PathBuf::from(String::from_utf8_lossy(&o.stdout).trim()))

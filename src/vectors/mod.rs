@@ -97,26 +97,6 @@ pub fn format_line(fields: &[Field], values: &[u64], line: &mut String) {
     line.push('\n');
 }
 
-/// Whether `head` (the first bytes of a file) looks like a vector stream rmapgen wrote: lines
-/// of space-separated lower-case hex fields, so `rmapgen vectors` may replace the file.
-pub fn is_vector_stream(head: &[u8]) -> bool {
-    let Ok(text) =
-        std::str::from_utf8(head).or_else(|e| std::str::from_utf8(&head[..e.valid_up_to()]))
-    else {
-        return false;
-    };
-    // The last line may be cut where the head ends.
-    let complete = match text.rfind('\n') {
-        Some(i) => &text[..i],
-        None => return text.is_empty(),
-    };
-    complete.lines().all(|l| {
-        !l.is_empty()
-            && l.bytes()
-                .all(|b| matches!(b, b'0'..=b'9' | b'a'..=b'f' | b' '))
-    })
-}
-
 /// Parses one line back into field values, checking the count and every width.
 pub fn parse_line(fields: &[Field], line: &str) -> Result<Vec<u64>> {
     let parts: Vec<&str> = line.trim_end_matches('\n').split(' ').collect();

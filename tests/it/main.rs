@@ -2,6 +2,7 @@
 
 mod alloc;
 mod bench;
+
 mod cmd_render;
 mod cmd_sim;
 mod compare;
@@ -26,6 +27,7 @@ mod map_flags;
 mod map_stream;
 mod model_stages;
 mod mult_proof;
+mod nothing_left;
 mod output_safety;
 mod prefix;
 mod prove;

@@ -330,7 +330,15 @@ fn single_output_files_replace_only_their_own_kind() {
     }
     only(
         t.path(),
-        &["notes.txt", "s.json", "s.toml", "some_dir", "v.hex"],
+        &[
+            ".s.json.rmapgen-sha256",
+            ".v.hex.rmapgen-sha256",
+            "notes.txt",
+            "s.json",
+            "s.toml",
+            "some_dir",
+            "v.hex",
+        ],
     );
     assert!(!helpers::nonempty(&t.path().join("some_dir")));
 }
@@ -431,12 +439,13 @@ fn an_interrupted_vectors_run_leaves_nothing_and_keeps_the_old_file() {
         &["vectors", "--count", "100", "--out", "v.hex"],
     ));
     let old = std::fs::read(t.path().join("v.hex")).unwrap();
+    // The file grows inside its staging directory, `.v.hex.partial-PID/v.hex`.
     let partial_grew = || {
         std::fs::read_dir(t.path()).unwrap().flatten().any(|e| {
             e.file_name()
                 .to_string_lossy()
                 .starts_with(".v.hex.partial-")
-                && e.metadata().is_ok_and(|m| m.len() > 1 << 20)
+                && std::fs::metadata(e.path().join("v.hex")).is_ok_and(|m| m.len() > 1 << 20)
         })
     };
     let st = interrupt(
@@ -446,7 +455,7 @@ fn an_interrupted_vectors_run_leaves_nothing_and_keeps_the_old_file() {
         partial_grew,
     );
     assert_eq!(st.signal(), Some(2), "ended by SIGINT: {st:?}");
-    only(t.path(), &["v.hex"]);
+    only(t.path(), &[".v.hex.rmapgen-sha256", "v.hex"]);
     assert_eq!(std::fs::read(t.path().join("v.hex")).unwrap(), old);
     // Parent directories it made for the output go too.
     let sub = t.path().join("new/sub");
@@ -457,7 +466,22 @@ fn an_interrupted_vectors_run_leaves_nothing_and_keeps_the_old_file() {
         || staged(&sub, ".v.hex.partial-"),
     );
     assert_eq!(st.signal(), Some(15), "ended by SIGTERM: {st:?}");
-    only(t.path(), &["v.hex"]);
+    only(t.path(), &[".v.hex.rmapgen-sha256", "v.hex"]);
+    // SIGKILL, which rmapgen cannot catch: its guardian removes the partial file and the
+    // parents the run made, within a few seconds, with no later run needed.
+    let st = interrupt(
+        t.path(),
+        &["vectors", "--count", "500000000", "--out", "new/sub/v.hex"],
+        "-KILL",
+        || staged(&sub, ".v.hex.partial-"),
+    );
+    assert_eq!(st.signal(), Some(9), "ended by SIGKILL: {st:?}");
+    let t0 = Instant::now();
+    while t.path().join("new").exists() && t0.elapsed() < Duration::from_secs(5) {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    only(t.path(), &[".v.hex.rmapgen-sha256", "v.hex"]);
+    assert_eq!(std::fs::read(t.path().join("v.hex")).unwrap(), old);
 }
 
 #[test]
@@ -505,14 +529,175 @@ fn outputs_at_the_name_limit() {
     std::fs::create_dir(&stale_old).unwrap();
     std::fs::write(stale_old.join(".rmapgen-staging"), "").unwrap();
     let partial = rmapgen::output::hidden_prefix(&file_name, "partial");
-    std::fs::write(t.path().join(format!("{partial}4000000")), "x").unwrap();
+    let stale_partial = t.path().join(format!("{partial}4000000"));
+    std::fs::create_dir(&stale_partial).unwrap();
+    std::fs::write(stale_partial.join(".rmapgen-staging"), "").unwrap();
+    // The single file's record beside it, its name within the limit too.
+    let record = rmapgen::output::stamp::record_path(&t.path().join(&file_name)).unwrap();
+    let record = record.file_name().unwrap().to_string_lossy().into_owned();
+    assert!(record.len() <= 255, "{record}");
     for _ in 0..2 {
         ok(&run_in(
             t.path(),
             &["generate", "--vectors", "10", "--out", &dir_name],
         ));
         ok(&run_in(t.path(), &["maps", "--out", &file_name]));
-        only(t.path(), &[&dir_name, &file_name]);
+        only(t.path(), &[&dir_name, &file_name, &record]);
     }
     assert!(helpers::nonempty(&t.path().join(&dir_name)));
+}
+
+/// Issue 32 §4: a single output file is replaced only if rmapgen wrote it and nobody changed
+/// it since (its record `.NAME.rmapgen-sha256`), as a directory is by `.rmapgen-files`.
+#[test]
+fn maps_keeps_a_users_bin_stream_and_an_edited_hex_file() {
+    let t = tempdir();
+    let d = t.path();
+    // A user's own binary stream: the very bytes rmapgen writes, but not written there by it.
+    ok(&run_in(
+        d,
+        &["maps", "--format", "bin", "--out", "ours.bin"],
+    ));
+    let stream = std::fs::read(d.join("ours.bin")).unwrap();
+    let mut mine = stream.clone();
+    mine[4] ^= 1;
+    std::fs::write(d.join("f.bin"), &mine).unwrap();
+    let o = run_in(d, &["maps", "--format", "bin", "--out", "f.bin"]);
+    assert_error(
+        &o,
+        "will not replace f.bin: it exists and was not written by rmapgen",
+    );
+    assert_error(&o, "--force");
+    assert_eq!(std::fs::read(d.join("f.bin")).unwrap(), mine);
+    // rmapgen's own, unchanged: replaced without --force (in any format).
+    ok(&run_in(
+        d,
+        &["maps", "--format", "bin", "--out", "ours.bin"],
+    ));
+    ok(&run_in(
+        d,
+        &["maps", "--format", "hex", "--out", "ours.bin"],
+    ));
+    // An rmapgen hex file the user edited is kept.
+    ok(&run_in(d, &["maps", "--out", "f.hex"]));
+    let mut edited = std::fs::read_to_string(d.join("f.hex")).unwrap();
+    edited.push_str("// my note\n");
+    std::fs::write(d.join("f.hex"), &edited).unwrap();
+    let o = run_in(d, &["maps", "--out", "f.hex"]);
+    assert_error(
+        &o,
+        "will not replace f.hex: it was changed since rmapgen wrote it; nothing was changed \
+         (choose another name, or use --force to replace it)",
+    );
+    assert_eq!(std::fs::read_to_string(d.join("f.hex")).unwrap(), edited);
+    // With --force both are replaced, and recorded as rmapgen's.
+    ok(&run_in(d, &["maps", "--out", "f.hex", "--force"]));
+    ok(&run_in(
+        d,
+        &["maps", "--format", "bin", "--out", "f.bin", "--force"],
+    ));
+    assert_eq!(std::fs::read(d.join("f.bin")).unwrap(), stream);
+    ok(&run_in(d, &["maps", "--format", "bin", "--out", "f.bin"]));
+    // The record is sha256sum's format: `sha256sum -c` checks the file.
+    let check = Command::new("sha256sum")
+        .args(["-c", ".f.bin.rmapgen-sha256"])
+        .current_dir(d)
+        .output()
+        .unwrap();
+    assert!(check.status.success(), "{check:?}");
+    only(
+        d,
+        &[
+            ".f.bin.rmapgen-sha256",
+            ".f.hex.rmapgen-sha256",
+            ".ours.bin.rmapgen-sha256",
+            "f.bin",
+            "f.hex",
+            "ours.bin",
+        ],
+    );
+}
+
+/// Every command that writes a single file keeps the rule: an edited output, or a file that
+/// merely looks like one (a report with rmapgen's format name), is refused without --force;
+/// the refusal names the file and --force, exits 2, and writes nothing.
+#[test]
+fn every_single_file_output_keeps_an_edited_or_foreign_file() {
+    let t = tempdir();
+    let d = t.path();
+    crate::hdl::generate_config(&d.join("g"), &rmapgen::grid::narrowest(), 5);
+    // Written by rmapgen, then edited.
+    for args in [
+        vec!["vectors", "--count", "10", "--out", "v.hex"],
+        vec!["stress", "--samples", "1000", "--json", "s.json"],
+    ] {
+        ok(&run_in(d, &args));
+        ok(&run_in(d, &args)); // unchanged: replaced
+        let out = args[args.len() - 1];
+        let mut text = std::fs::read(d.join(out)).unwrap();
+        text.push(b'\n');
+        std::fs::write(d.join(out), &text).unwrap();
+        let o = run_in(d, &args);
+        assert_error(
+            &o,
+            &format!("will not replace {out}: it was changed since rmapgen wrote it"),
+        );
+        assert_eq!(std::fs::read(d.join(out)).unwrap(), text);
+        let mut forced = args.clone();
+        forced.push("--force");
+        ok(&run_in(d, &forced));
+    }
+    // Reports that look like rmapgen's but that it did not write there.
+    std::fs::write(d.join("p.json"), "{\"format\": \"rmapgen-prove-2\"}\n").unwrap();
+    std::fs::write(d.join("m.json"), "{\"format\": \"rmapgen-mutants-1\"}\n").unwrap();
+    for (args, out) in [
+        (
+            vec!["prove", "--report", "p.json", "--build", "B", "g"],
+            "p.json",
+        ),
+        (
+            vec!["mutants", "--report", "m.json", "--build", "B", "g"],
+            "m.json",
+        ),
+    ] {
+        let before = helpers::entries(d);
+        let o = run_in(d, &args);
+        assert_error(
+            &o,
+            &format!("will not replace {out}: it exists and was not written by rmapgen"),
+        );
+        assert_error(&o, "use --force to replace it");
+        assert_eq!(helpers::entries(d), before, "{args:?} wrote nothing");
+    }
+}
+
+/// Issue 32 §4: a leftover is removed only if it carries rmapgen's mark: a user's file named
+/// like a partial file of a dead process is kept; a marked staging directory of one goes.
+#[test]
+fn a_users_file_named_like_a_partial_file_is_kept() {
+    let t = tempdir();
+    let d = t.path();
+    std::fs::write(d.join(".v.hex.partial-999999"), "mine\n").unwrap();
+    std::fs::create_dir(d.join(".v.hex.partial-4000000")).unwrap();
+    std::fs::write(d.join(".v.hex.partial-4000000/notes"), "mine too\n").unwrap();
+    let stale = d.join(".v.hex.partial-4000001");
+    std::fs::create_dir(&stale).unwrap();
+    std::fs::write(stale.join(".rmapgen-staging"), "").unwrap();
+    std::fs::write(stale.join("v.hex"), "0 1\n").unwrap();
+    ok(&run_in(d, &["vectors", "--count", "10", "--out", "v.hex"]));
+    assert_eq!(
+        std::fs::read_to_string(d.join(".v.hex.partial-999999")).unwrap(),
+        "mine\n"
+    );
+    assert!(d.join(".v.hex.partial-4000000/notes").is_file());
+    assert!(!stale.exists(), "rmapgen's marked leftover is removed");
+    only(
+        d,
+        &[
+            ".v.hex.partial-4000000",
+            ".v.hex.partial-999999",
+            ".v.hex.rmapgen-sha256",
+            "v.hex",
+        ],
+    );
 }
