@@ -70,6 +70,8 @@ pub struct FitArgs {
     /// for every lane, and --cost cells counts the cells of all of them) [1..=8, default 1].
     #[arg(long, value_name = "L", value_parser = parse::field("lanes"))]
     pub lanes: Option<u32>,
+    #[arg(long, value_name = "P", value_parser = parse::prefix(), help = parse::prefix_help())]
+    pub prefix: Option<String>,
     /// Side of the sphere test image [16..=4096].
     #[arg(long, value_name = "N", default_value_t = 512, value_parser = parse::count::<u32>())]
     pub size: u32,
@@ -101,6 +103,7 @@ pub fn run(a: &FitArgs) -> Result<()> {
         handshake: a.handshake,
         lanes: a.lanes.unwrap_or(Config::default().lanes),
         color: scene.color.is_some(),
+        prefix: a.prefix.clone().unwrap_or_default(),
         ..Config::default()
     };
     base.validate()?;

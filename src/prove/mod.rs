@@ -465,3 +465,40 @@ pub fn run(d: &DesignDir, build: &Path, opts: &Options, progress: &Progress) -> 
     }
     Report::new(d, opts, files, parts, start.elapsed().as_secs_f64())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_shard_is_k_of_n_with_k_in_1_to_n_and_the_shards_tile_the_range() {
+        for ok in ["1/1", "2/2", "1/4", " 3 / 4 "] {
+            assert!(Shard::parse(ok).is_ok(), "{ok}");
+        }
+        let max = format!("1/{MAX_SHARDS}");
+        assert!(Shard::parse(&max).is_ok());
+        for (bad, says) in [
+            ("0/2", "K must be in 1..=2"),
+            ("3/2", "K must be in 1..=2"),
+            ("1/0", "N must be in"),
+            (&format!("1/{}", MAX_SHARDS + 1), "N must be in"),
+            ("-1/2", "K is not a whole number"),
+            ("1/x", "N is not a whole number"),
+            ("12", "a shard is K/N"),
+        ] {
+            let e = Shard::parse(bad).unwrap_err();
+            assert!(e.contains(says), "{bad}: {e}");
+        }
+        // Ranges: contiguous, sizes differing by at most one, together 0..total.
+        for (n, total) in [(1, 10), (3, 10), (4, 3), (7, 1 << 36)] {
+            let mut at = 0;
+            for k in 1..=n {
+                let r = Shard { index: k, count: n }.range(total);
+                assert_eq!(r.start, at);
+                assert!(r.end - r.start <= total / n + 1 && r.end - r.start >= total / n);
+                at = r.end;
+            }
+            assert_eq!(at, total);
+        }
+    }
+}

@@ -259,6 +259,37 @@ fn short_of_pins(said: &str, out_of_context: bool) -> bool {
     !out_of_context && said.contains("TRELLIS_IO")
 }
 
+/// What ran out, in one phrase with what to change, from nextpnr's output `out` and its
+/// complaint `said` (`... no BELs remaining to implement cell type 'ICESTORM_RAM'`): the
+/// cell type's line of nextpnr's utilisation table (`ICESTORM_RAM:   131/   16   818%`)
+/// gives what the design needs and what the part has. None when the complaint names no cell
+/// type or the table has no line for it.
+pub fn shortage(out: &str, said: &str) -> Option<String> {
+    let cell = said.split("cell type '").nth(1)?.split('\'').next()?;
+    let (need, have) = out.lines().find_map(|l| {
+        let rest = l.split_once(&format!("{cell}:"))?.1;
+        let (need, rest) = rest.split_once('/')?;
+        let have = rest.split_whitespace().next()?;
+        Some((need.trim().parse::<u64>().ok()?, have.parse::<u64>().ok()?))
+    })?;
+    let (what, change) = match cell {
+        "ICESTORM_RAM" | "DP16KD" => (
+            "block RAMs",
+            "a larger part (--device), or less memory (a smaller --index-bits or --map-bits, fewer lanes)",
+        ),
+        "ICESTORM_LC" | "TRELLIS_SLICE" | "TRELLIS_COMB" | "TRELLIS_FF" => (
+            "logic cells",
+            "a larger part (--device), fewer lanes, or --mult infer on a part with DSP blocks",
+        ),
+        "SB_MAC16" | "MULT18X18D" => ("DSP blocks", "--mult tree, or a part with more DSP blocks"),
+        "TRELLIS_IO" | "SB_IO" => ("I/O cells (pins)", "a larger package (--package)"),
+        _ => ("cells", "a larger part (--device)"),
+    };
+    Some(format!(
+        "the design needs {need} {cell} ({what}), the part has {have}: use {change}"
+    ))
+}
+
 /// What nextpnr says when the design needs more of a resource than the device has.
 const DOES_NOT_FIT: [&str; 3] = [
     "no BELs remaining",
@@ -504,7 +535,10 @@ pub fn place(syn: &Synthesis, opts: &Options) -> Result<FpgaReport> {
     let out = run.output;
     if !run.status.success() {
         let said = complaint(&out);
-        let mut message = format!("{part}: {said}");
+        let mut message = match shortage(&out, &said) {
+            Some(short) => format!("{part}: {short}; nextpnr: {said}"),
+            None => format!("{part}: {said}"),
+        };
         let pins = short_of_pins(&said, opts.out_of_context);
         if pins {
             message += "; the top has more port bits than the package has pins: place it out of context (--ooc)";
@@ -618,6 +652,15 @@ mod tests {
         assert!(short_of_pins(io, false));
         assert!(!short_of_pins(io, true));
         let ram = "ERROR: Unable to place cell 'u_lane0.u_map_lookup.mem', no BELs remaining to implement cell type 'DP16KD'";
+        assert_eq!(
+            shortage("Info: Device utilisation:\nInfo: \t        DP16KD:   230/  208   110%\n", ram).as_deref(),
+            Some("the design needs 230 DP16KD (block RAMs), the part has 208: use a larger part (--device), or less memory (a smaller --index-bits or --map-bits, fewer lanes)")
+        );
+        assert_eq!(shortage("no table here", ram), None);
+        assert_eq!(
+            shortage("DP16KD:   230/  208   110%", "ERROR: something else"),
+            None
+        );
         assert!(!short_of_pins(ram, false));
     }
 

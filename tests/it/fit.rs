@@ -379,3 +379,21 @@ fn bad_input_is_one_line_exit_2_and_leaves_the_output_alone() {
         );
     }
 }
+
+/// `fit --prefix` writes the chosen design with the prefix, as `generate --prefix` does.
+#[test]
+fn fit_writes_its_design_with_a_prefix() {
+    let tmp = helpers::tempdir();
+    let out = tmp.path().join("f");
+    let (v, _) = fit(
+        "standard",
+        &out,
+        &["--max-error", "24", "--size", "64", "--prefix", "vr_"],
+    );
+    assert_eq!(config(&v["chosen"]).prefix, "vr_");
+    let manifest: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(manifest["top"], "vr_rmap_top");
+    assert!(out.join("vr_rmap_top.v").is_file());
+    assert!(out.join("vr_map_x.hex").is_file());
+}

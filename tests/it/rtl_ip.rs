@@ -264,7 +264,17 @@ fn fpga_fails_on_a_memory_in_logic_and_on_a_design_too_big() {
         "--package",
         "tq144",
     ]);
-    helpers::assert_error(&o, "nextpnr-ice40 --hx1k --package tq144: ERROR:");
+    // One line: what ran out (the need and the part's count, from nextpnr's utilisation
+    // table), what to change, then nextpnr's own words.
+    helpers::assert_error(
+        &o,
+        "nextpnr-ice40 --hx1k --package tq144: the design needs ",
+    );
+    helpers::assert_error(
+        &o,
+        " (logic cells), the part has 1280: use a larger part (--device)",
+    );
+    helpers::assert_error(&o, "; nextpnr: ERROR:");
     helpers::assert_error(&o, "no BELs remaining");
 }
 
