@@ -386,7 +386,7 @@ fn fit_writes_its_design_with_a_prefix() {
     let tmp = helpers::tempdir();
     let out = tmp.path().join("f");
     let (v, _) = fit(
-        "standard",
+        "standard.toml",
         &out,
         &["--max-error", "24", "--size", "64", "--prefix", "vr_"],
     );
