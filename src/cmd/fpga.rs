@@ -74,6 +74,7 @@ pub fn run(a: &FpgaArgs) -> Result<()> {
     let opts = options(a);
     // The design (its directory's manifest, or the flags' configuration) and the part are
     // checked before the log directory is made too.
+    fpga::check(a.dir.as_deref(), &opts)?;
     let cfg = match &a.dir {
         // A design given: its configuration, which the flags may only agree with.
         Some(d) => {
@@ -87,7 +88,6 @@ pub fn run(a: &FpgaArgs) -> Result<()> {
             Some(cfg)
         }
     };
-    fpga::check(a.dir.as_deref(), &opts)?;
     let logs = StagedDir::new(
         &a.logs,
         &a.force.policy(&[a.dir.as_deref(), a.cfg.config.as_deref()]),

@@ -24,9 +24,10 @@ pub struct VectorsArgs {
     /// Seed of the random vectors.
     #[arg(long, value_name = "S", default_value_t = 1)]
     pub seed: u64,
-    /// Take the configuration and the maps from a generated design (its manifest.json,
-    /// `<prefix>map_<axis>.hex` and `<prefix>map2_<axis>.hex`), so the vectors match the scene
-    /// it was generated with; configuration flags may only agree with it.
+    /// Take the maps from a directory (`<prefix>map_<axis>.hex` and `<prefix>map2_<axis>.hex`),
+    /// so the vectors match the scene it was generated with. A generated design's
+    /// configuration comes from its manifest.json (configuration flags may only agree with
+    /// it); a directory of map files alone takes the configuration of the flags.
     #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "map_fit"])]
     pub maps: Option<PathBuf>,
     /// The scene and fit of map 0; map 1 is always the alternate scene's
@@ -41,10 +42,13 @@ pub struct VectorsArgs {
 }
 
 pub fn run(a: &VectorsArgs) -> Result<()> {
-    // With --maps DIR the design's configuration, which the flags may only agree with.
+    // With --maps DIR of a generated design (it has a manifest) the design's configuration,
+    // which the flags may only agree with; a directory of map files alone takes the flags'.
     let cfg = match &a.maps {
-        Some(dir) => a.cfg.for_design(&DesignDir::open(dir)?.config, dir)?,
-        None => a.cfg.resolve()?,
+        Some(dir) if dir.join(crate::rtl::manifest::FILE).is_file() => {
+            a.cfg.for_design(&DesignDir::open(dir)?.config, dir)?
+        }
+        _ => a.cfg.resolve()?,
     };
     vectors::check_stream_vectors(a.count as u64)?;
     let maps = match &a.maps {

@@ -232,6 +232,6 @@ fn fpga_of_no_design_writes_nothing() {
     let logs = t.path().join("build").join("fpga");
     let missing = t.path().join("missing");
     let o = run(&["fpga", "--dir", s(&missing), "--logs", s(&logs)]);
-    assert_error(&o, &format!("design directory {}", missing.display()));
+    assert_error(&o, &format!("no manifest.json in {}", missing.display()));
     assert_eq!(helpers::entries(t.path()), Vec::<String>::new());
 }
