@@ -701,3 +701,27 @@ fn a_users_file_named_like_a_partial_file_is_kept() {
         ],
     );
 }
+
+/// The record's rename can only replace rmapgen's own record: a user's file that has the
+/// record's name (`.f.bin.rmapgen-sha256`), with or without `f.bin` beside it, is never
+/// overwritten without --force, and the refused run writes nothing.
+#[test]
+fn a_users_file_at_the_records_name_is_kept() {
+    let t = tempdir();
+    let d = t.path();
+    let mine = "my notes, not a record\n";
+    std::fs::write(d.join(".f.bin.rmapgen-sha256"), mine).unwrap();
+    let o = run_in(d, &["maps", "--format", "bin", "--out", "f.bin"]);
+    assert_error(&o, "it is not rmapgen's record of f.bin");
+    only(d, &[".f.bin.rmapgen-sha256"]);
+    // With a file of the user's at the target too.
+    std::fs::write(d.join("f.bin"), "theirs").unwrap();
+    let o = run_in(d, &["maps", "--format", "bin", "--out", "f.bin"]);
+    assert_error(&o, "will not replace f.bin");
+    only(d, &[".f.bin.rmapgen-sha256", "f.bin"]);
+    assert_eq!(
+        std::fs::read_to_string(d.join(".f.bin.rmapgen-sha256")).unwrap(),
+        mine
+    );
+    assert_eq!(std::fs::read_to_string(d.join("f.bin")).unwrap(), "theirs");
+}
