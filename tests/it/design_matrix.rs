@@ -5,21 +5,8 @@
 //! success on a wrong result or fails a correct design.
 
 use crate::hdl::require;
-use crate::helpers::{self, tempdir, tree};
-use std::path::Path;
+use crate::helpers::{self, run_in, tempdir, text, tree};
 use std::process::Output;
-
-fn run_in(dir: &Path, args: &[&str]) -> Output {
-    helpers::rmapgen()
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("rmapgen runs")
-}
-
-fn text(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr)
-}
 
 fn ok(what: &str, o: &Output) -> String {
     let t = text(o);

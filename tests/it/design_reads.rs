@@ -4,21 +4,9 @@
 //! own testbenches; a testbench's every mismatch line shows the expected and the actual value.
 
 use crate::hdl::{self, last_line, require, vector_count, vvp};
-use crate::helpers::{self, assert_error, tempdir, tree};
+use crate::helpers::{assert_error, run_in, tempdir, text, tree};
 use std::path::Path;
 use std::process::Output;
-
-fn run_in(dir: &Path, args: &[&str]) -> Output {
-    helpers::rmapgen()
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("rmapgen runs")
-}
-
-fn text(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr)
-}
 
 fn ok(o: &Output) -> String {
     let t = text(o);

@@ -14,6 +14,20 @@ pub fn run(args: &[&str]) -> Output {
     rmapgen().args(args).output().expect("rmapgen runs")
 }
 
+/// Runs rmapgen with arguments in the working directory `dir`.
+pub fn run_in(dir: &Path, args: &[&str]) -> Output {
+    rmapgen()
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("rmapgen runs")
+}
+
+/// A run's standard output, then its standard error.
+pub fn text(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr)
+}
+
 /// The repository root.
 pub fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

@@ -2,20 +2,11 @@
 //! current directory, its ancestors or a directory holding an input, and an interrupted run
 //! leaves nothing behind.
 
-use crate::helpers::{self, assert_error, first_difference, tempdir, tree};
+use crate::helpers::{self, assert_error, first_difference, run_in, tempdir, tree};
 use std::os::unix::process::ExitStatusExt;
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
-
-/// rmapgen run with `dir` as the working directory.
-fn run_in(dir: &Path, args: &[&str]) -> Output {
-    helpers::rmapgen()
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("rmapgen runs")
-}
 
 fn ok(out: &Output) {
     assert!(
