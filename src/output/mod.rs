@@ -565,6 +565,70 @@ mod tests {
         )));
     }
 
+    /// Every entry under `dir`, as sorted relative paths (hidden ones included).
+    fn tree(dir: &Path) -> Vec<String> {
+        let mut out = Vec::new();
+        let mut stack = vec![dir.to_path_buf()];
+        while let Some(d) = stack.pop() {
+            for e in std::fs::read_dir(&d).unwrap().flatten() {
+                let p = e.path();
+                out.push(p.strip_prefix(dir).unwrap().display().to_string());
+                if p.is_dir() {
+                    stack.push(p);
+                }
+            }
+        }
+        out.sort();
+        out
+    }
+
+    /// An output dropped before its commit (an error or an early return) leaves nothing: not
+    /// its hidden staging directory or partial file, not the parents it made, and a file
+    /// already at the target is untouched.
+    #[test]
+    fn an_output_dropped_before_its_commit_leaves_nothing() {
+        let tmp = tempfile::tempdir().unwrap();
+        let policy = Policy::new(false);
+        let deep = tmp.path().join("a").join("b");
+        let dir = StagedDir::new(&deep.join("out"), &policy).unwrap();
+        dir.write_text("x/y.v", "module m; endmodule").unwrap();
+        assert!(deep.is_dir());
+        drop(dir);
+        assert_eq!(tree(tmp.path()), Vec::<String>::new());
+
+        let file = StagedFile::new(&deep.join("report.json"), &policy).unwrap();
+        file.write("{}").unwrap();
+        drop(file);
+        assert_eq!(tree(tmp.path()), Vec::<String>::new());
+
+        // Under a parent that was there: the parent and the user's file stay as they were.
+        std::fs::write(tmp.path().join("report.json"), b"mine").unwrap();
+        let file = StagedFile::new(&tmp.path().join("report.json"), &Policy::new(true)).unwrap();
+        file.write("{}").unwrap();
+        drop(file);
+        assert_eq!(tree(tmp.path()), vec!["report.json".to_string()]);
+        assert_eq!(
+            std::fs::read(tmp.path().join("report.json")).unwrap(),
+            b"mine"
+        );
+    }
+
+    /// Text files end with exactly one newline whether or not the text has it.
+    #[test]
+    fn text_files_end_with_one_newline() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = StagedDir::new(&tmp.path().join("out"), &Policy::new(false)).unwrap();
+        dir.write_text("a.txt", "a").unwrap();
+        dir.write_text("b.txt", "b\n").unwrap();
+        dir.write_text("c.txt", "").unwrap();
+        let out = dir.commit().unwrap();
+        let read = |n: &str| std::fs::read_to_string(out.join(n)).unwrap();
+        assert_eq!(
+            (read("a.txt"), read("b.txt"), read("c.txt")),
+            ("a\n".into(), "b\n".into(), "\n".into())
+        );
+    }
+
     /// A parent that exists as a file is still an error (only a directory made meanwhile is
     /// accepted), and nothing is left behind.
     #[test]
