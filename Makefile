@@ -239,7 +239,9 @@ prove: build
 # mutants-sample (in make test): MUTANTS_SAMPLE Verilog mutants and one per memory file, the
 # ground truth only on those prove passes, ~8 min on 2 cores. mutants: the campaign, every
 # mutant judged by direct, prove, sim and sim --gate (a benchmark-style run, hours; figures in
-# docs/VERIFICATION.md). MUTANTS_SEED picks another draw.
+# docs/VERIFICATION.md). MUTANTS_SEED picks another draw. Both keep a journal of outcomes
+# (build/mutants*/<design>.journal): a run stopped and started again by the same binary on
+# the same files goes on where it stopped.
 MUTANTS_BIN     := target/release/rmapgen
 MUTANTS_DESIGN  ?= build/mutants-design
 MUTANTS_FLAGS   ?= --grad-bits 8 --red-bits 6
@@ -255,10 +257,18 @@ mutants-design:
 	$(CARGO) build --release
 	$(MUTANTS_BIN) generate --out $(MUTANTS_DESIGN) $(MUTANTS_FLAGS)
 
+MUTANTS_SAMPLE_RUN = $(MUTANTS_BIN) mutants $(MUTANTS_DESIGN) --quick --count $(MUTANTS_SAMPLE) \
+	  --memories 1 --seed $(MUTANTS_SEED) --jobs $(MUTANTS_JOBS) --build build/mutants-sample
+
+# The second run reads every outcome from the journal (same binary, files and draw): it
+# judges nothing again and writes the same report, byte for byte.
 mutants-sample: mutants-design
-	$(MUTANTS_BIN) mutants $(MUTANTS_DESIGN) --quick --count $(MUTANTS_SAMPLE) --memories 1 \
-	  --seed $(MUTANTS_SEED) --jobs $(MUTANTS_JOBS) --build build/mutants-sample \
-	  --report build/mutants-sample.json
+	$(MUTANTS_SAMPLE_RUN) --report build/mutants-sample.json
+	$(MUTANTS_SAMPLE_RUN) --report build/mutants-sample-again.json > build/mutants-sample-again.log
+	grep -q "not judged again" build/mutants-sample-again.log
+	! grep -v "(journal)$$" build/mutants-sample-again.log | grep -q "^  \["
+	cmp build/mutants-sample.json build/mutants-sample-again.json
+	@echo "mutants-sample: the journal gave every outcome back, the same report"
 
 mutants: mutants-design
 	$(MUTANTS_BIN) mutants $(MUTANTS_DESIGN) --count $(MUTANTS_COUNT) --memories 4 \

@@ -4,6 +4,7 @@
 
 use super::force::ForceArg;
 use crate::design_dir::DesignDir;
+use crate::mutants::journal::{self, Journal};
 use crate::mutants::{self, Change, Method, Mutant, Outcome, Plan};
 use crate::output::{absolute, StagedDir, StagedFile};
 use anyhow::{bail, Result};
@@ -34,7 +35,7 @@ pub struct MutantsArgs {
     #[arg(long, value_enum, value_delimiter = ',', default_value = "prove")]
     pub method: Vec<Method>,
     /// Judge only these mutants of the draw (their numbers, as printed: `m29` or `29`; the
-    /// null mutant always runs).
+    /// null mutant always runs), again even if the journal has them.
     #[arg(long, value_name = "ID", value_delimiter = ',', allow_hyphen_values = true, value_parser = super::parse::named(parse_id))]
     pub only: Vec<usize>,
     /// Run the ground truth only on the mutants the factored proof passes (enough to show it
@@ -50,7 +51,9 @@ pub struct MutantsArgs {
     /// Random top vectors of `sim`'s C++ stream.
     #[arg(long, default_value_t = 100_000, value_name = "N")]
     pub sim_stream: u64,
-    /// Every mutant's design, builds and logs go to BUILD/<design name>/m<id> (replaced whole).
+    /// Every mutant's design, builds and logs go to BUILD/<design name>/m<id> (replaced whole);
+    /// the outcomes to the journal BUILD/<design name>.journal, which a later run of the same
+    /// binary, design and draw goes on from.
     #[arg(long, default_value = "build/mutants", value_name = "BUILD")]
     pub build: PathBuf,
     /// Write every mutant's verdicts and the tallies as JSON to FILE.
@@ -94,11 +97,15 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
     if let Some(id) = a.only.iter().find(|&&id| id >= n) {
         bail!("--only m{id}: the draw has m0..m{}", n - 1);
     }
-    let list: Vec<Mutant> = changes
+    let draw: Vec<Mutant> = changes
         .into_iter()
         .enumerate()
         .map(|(id, change)| Mutant { id, change })
+        .collect();
+    let list: Vec<Mutant> = draw
+        .iter()
         .filter(|m| m.id == 0 || a.only.is_empty() || a.only.contains(&m.id))
+        .cloned()
         .collect();
     let plan = Plan {
         methods: a.method.clone(),
@@ -106,6 +113,13 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
         timeout: Duration::from_secs(a.timeout),
         sim_stream: a.sim_stream,
     };
+    let key = journal::Key::new(&design, &plan, &draw)?;
+    let journal = Journal::open(
+        &mutants::journal_path(&a.build, &design),
+        &key,
+        &a.only,
+        a.force.force,
+    )?;
     crate::outln!(
         "mutants of {} ({}): the null mutant, {} Verilog (Yosys mutate, seed {}), {} memory; ground truth prove --direct{}; {} at a time",
         design.path().display(),
@@ -116,12 +130,24 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
         if a.quick { " on the mutants prove passes" } else { "" },
         a.jobs
     )?;
+    crate::outln!("{}", journal.said)?;
     let t0 = Instant::now();
     let next = AtomicUsize::new(0);
     let results: Mutex<Vec<Result<Outcome>>> = Mutex::new(Vec::new());
+    // Judged once per binary, design and draw: a run that was stopped goes on where it
+    // stopped (the journal's outcomes are printed first, marked).
+    let judge = |m: &Mutant| -> Result<Outcome> {
+        if let Some(o) = journal.earlier.get(&m.id) {
+            print_outcome(o, n, " (journal)")?;
+            return Ok(o.clone());
+        }
+        let o = mutants::judge(&design, m, &plan, &work)?;
+        journal.record(&o)?;
+        print_outcome(&o, n, "")?;
+        Ok(o)
+    };
     // The null mutant first, alone: if the flow changes the design, nothing else means much.
-    let null = mutants::judge(&design, &list[0], &plan, &work)?;
-    print_outcome(&null, n)?;
+    let null = judge(&list[0])?;
     let broken: Vec<String> = null
         .verdicts
         .iter()
@@ -136,15 +162,24 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
             work.join("m0").display()
         );
     }
+    for m in list.iter().skip(1) {
+        if journal.earlier.contains_key(&m.id) {
+            judge(m)?;
+        }
+    }
     next.store(1, Ordering::SeqCst);
     std::thread::scope(|s| {
         for _ in 0..a.jobs {
             s.spawn(|| loop {
                 let k = next.fetch_add(1, Ordering::SeqCst);
                 let Some(m) = list.get(k) else { break };
-                // A line that cannot be printed is the mutant's error.
-                let r = mutants::judge(&design, m, &plan, &work)
-                    .and_then(|o| print_outcome(&o, n).map(|()| o));
+                // A line that cannot be printed, or a journal that cannot be written, is the
+                // mutant's error.
+                let r = if journal.earlier.contains_key(&m.id) {
+                    Ok(journal.earlier[&m.id].clone())
+                } else {
+                    judge(m)
+                };
                 results.lock().unwrap_or_else(|e| e.into_inner()).push(r);
             });
         }
@@ -230,14 +265,14 @@ fn parse_id(text: &str) -> Result<usize, String> {
         .map_err(|_| "not a mutant number (m29 or 29)".to_string())
 }
 
-fn print_outcome(o: &Outcome, n: usize) -> Result<()> {
+fn print_outcome(o: &Outcome, n: usize, from: &str) -> Result<()> {
     let verdicts: Vec<String> = o
         .verdicts
         .iter()
         .map(|(m, v)| format!("{} {}", m.name(), format!("{v:?}").to_lowercase()))
         .collect();
     crate::outln!(
-        "  [{}/{}] {:>6.1} s  {}: {}",
+        "  [{}/{}] {:>6.1} s  {}: {}{from}",
         o.mutant.id,
         n - 1,
         o.seconds,

@@ -27,7 +27,9 @@ use crate::rng::SplitMix64;
 use crate::stages::unit::file_params;
 use crate::stages::TOP;
 use anyhow::{bail, ensure, Context, Result};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
+
+pub mod journal;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -38,7 +40,7 @@ pub const MAX_MUTANTS: usize = 10_000;
 pub const MAX_PER_MEMORY: usize = 1_000;
 
 /// What a mutant changes.
-#[derive(Clone, Debug, Serialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum Change {
     /// The design as Yosys writes it back, unchanged: the control.
@@ -54,7 +56,7 @@ pub enum Change {
 }
 
 /// One mutant: its number in the run and its change.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct Mutant {
     pub id: usize,
     pub change: Change,
@@ -348,7 +350,7 @@ fn to_config(d: &DesignDir) -> crate::config::Config {
 }
 
 /// A check run on one mutant.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Method {
     /// `rmapgen prove --direct`: the ground truth.
@@ -386,8 +388,19 @@ impl Method {
     }
 }
 
+/// The running binary itself: Linux's `/proc/self/exe`, which stays this build even when a
+/// rebuild replaces `target/release/rmapgen`; elsewhere the path it was started from.
+pub fn own_binary() -> Result<PathBuf> {
+    let own = Path::new("/proc/self/exe");
+    if own.exists() {
+        Ok(own.to_path_buf())
+    } else {
+        std::env::current_exe().context("cannot find the rmapgen binary")
+    }
+}
+
 /// What a check said of a mutant.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Verdict {
     /// It passed the mutant (exit 0).
@@ -421,12 +434,7 @@ pub fn check(
     // The running binary itself (Linux's /proc/self/exe), not its path: a campaign of an
     // hour judges every mutant with the rmapgen it started with, even if a build replaces
     // target/release/rmapgen meanwhile (which once stopped one with "cannot start").
-    let own = Path::new("/proc/self/exe");
-    let exe = if own.exists() {
-        own.to_path_buf()
-    } else {
-        std::env::current_exe().context("cannot find the rmapgen binary")?
-    };
+    let exe = own_binary()?;
     let out =
         std::fs::File::create(log).with_context(|| format!("cannot write {}", log.display()))?;
     let err = out.try_clone()?;
@@ -450,7 +458,7 @@ pub fn check(
 }
 
 /// One mutant's verdicts, method by method, in the order they ran.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct Outcome {
     pub mutant: Mutant,
     pub verdicts: Vec<(Method, Verdict)>,
@@ -571,6 +579,12 @@ pub fn tally(method: Method, outcomes: &[Outcome]) -> Tally {
         }
     }
     t
+}
+
+/// The journal of the runs on design `d` in `build` (beside their work directory, which a
+/// run replaces whole): `build/mutants/<design name>.journal`.
+pub fn journal_path(build: &Path, d: &DesignDir) -> PathBuf {
+    build.join(format!("{}.journal", d.name()))
 }
 
 /// Where a run's mutants, builds and logs go: `build/mutants/<design name>`.

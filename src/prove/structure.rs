@@ -44,6 +44,8 @@ struct Cell {
     inputs: Vec<(String, Vec<Bit>)>,
     outputs: Vec<(String, Vec<Bit>)>,
     params: HashMap<String, String>,
+    /// The input pins with an undefined bit (`x` or `z`).
+    undefined: Vec<String>,
 }
 
 struct Module {
@@ -85,11 +87,16 @@ fn module(json: &Value, name: &str) -> Result<Module> {
             let dirs = &c["port_directions"];
             let mut inputs = Vec::new();
             let mut outputs = Vec::new();
+            let mut undefined = Vec::new();
             for (pin, b) in c["connections"].as_object().into_iter().flatten() {
                 let entry = (pin.clone(), bits(b));
                 if dirs[pin].as_str() == Some("output") {
                     outputs.push(entry);
                 } else {
+                    let x = b.as_array().into_iter().flatten();
+                    if x.filter_map(Value::as_str).any(|v| v == "x" || v == "z") {
+                        undefined.push(pin.clone());
+                    }
                     inputs.push(entry);
                 }
             }
@@ -105,6 +112,7 @@ fn module(json: &Value, name: &str) -> Result<Module> {
                 inputs,
                 outputs,
                 params,
+                undefined,
             }
         })
         .collect();
@@ -137,6 +145,20 @@ fn bitwise(kind: &str) -> bool {
 
 fn is_memory(kind: &str) -> bool {
     kind.starts_with("$mem")
+}
+
+/// Whether an undefined bit on input `pin` of `cell` is harmless: a multiplexer's data input
+/// (`proc` writes `x` as the default of a variable assigned on every path, into an input no
+/// path selects), or the clock or enable of an asynchronous memory read, which it ignores.
+fn may_be_undefined(cell: &Cell, pin: &str) -> bool {
+    let mux =
+        matches!(cell.kind.as_str(), "$mux" | "$pmux" | "$bwmux") && (pin == "A" || pin == "B");
+    let sync = cell
+        .params
+        .get("CLK_ENABLE")
+        .is_some_and(|v| v.contains('1'));
+    let async_read = cell.kind.starts_with("$memrd") && !sync && (pin == "CLK" || pin == "EN");
+    mux || async_read
 }
 
 /// How an input pin of a cell passes to its outputs: registered data (one register), a
@@ -264,6 +286,19 @@ pub fn check(d: &DesignDir, build: &Path) -> Result<Part> {
             None => fails.add(format!("structure: the top has no sample input {p}")),
         }
     }
+    // No undefined value is read. A register that is never loaded (its enable inverted, its
+    // input its own output) is removed by opt_dff and read as `x`: Verilator's two-state
+    // simulation (the proof's, and its ground truth's) gives it 0, synthesis any value it
+    // likes (found by `rmapgen mutants`: an inverted enable in normalise that the proof and
+    // `--direct` passed and the synthesised netlist got wrong, docs/VERIFICATION.md).
+    for c in &m.cells {
+        if let Some(pin) = c.undefined.iter().find(|p| !may_be_undefined(c, p)) {
+            fails.add(format!(
+                "structure: {} ({}) reads an undefined value on {pin}: a register that is never loaded, or a signal nothing drives (simulation and synthesis give it different values)",
+                c.name, c.kind
+            ));
+        }
+    }
     // Drivers: bit -> (cell, output pin, bit position).
     let mut driver: HashMap<u64, (usize, usize)> = HashMap::new();
     for (ci, c) in m.cells.iter().enumerate() {
@@ -271,6 +306,26 @@ pub fn check(d: &DesignDir, build: &Path) -> Result<Part> {
             for x in b.iter().flatten() {
                 driver.insert(*x, (ci, pi));
             }
+        }
+    }
+    // ... and no signal that nothing drives (an input of the top, a cell's output).
+    let inputs: std::collections::HashSet<u64> = m
+        .ports
+        .values()
+        .filter(|(dir, _)| dir == "input")
+        .flat_map(|(_, b)| b.iter().flatten().copied())
+        .collect();
+    for c in &m.cells {
+        let undriven = c.inputs.iter().find(|(_, b)| {
+            b.iter()
+                .flatten()
+                .any(|x| !driver.contains_key(x) && !inputs.contains(x))
+        });
+        if let Some((pin, _)) = undriven {
+            fails.add(format!(
+                "structure: {} ({}) reads a signal that nothing drives on {pin}",
+                c.name, c.kind
+            ));
         }
     }
     // Readers, for the forward reach: bit -> cells.

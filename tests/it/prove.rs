@@ -247,6 +247,26 @@ fn a_small_design_is_proven_in_two_shards_and_every_part_catches_a_planted_fault
     let o = prove(&d, &build, &["--part", "structure"]);
     assert_fails(&o, "structure", &["different clock edges", "polarity 0"]);
 
+    // A register never loaded (it holds its own value): Verilator's two-state simulation
+    // gives it 0, which here changes no output (a_max only hastens a saturation that comes
+    // anyway), so every gradient passes, even under --direct; synthesis takes it as any
+    // value and the netlist is wrong. Found by `rmapgen mutants` (m13: Yosys inverted this
+    // register's enable); the structure now refuses any undefined value read.
+    let d = tmp.path().join("stuck");
+    plant(
+        &dir,
+        &d,
+        "normalise.v",
+        "a_max_q2 <= a_max_q1;",
+        "a_max_q2 <= a_max_q2;",
+    );
+    let o = prove(&d, &build, &["--part", "structure"]);
+    assert_fails(
+        &o,
+        "structure",
+        &["reads an undefined value on D", "never loaded"],
+    );
+
     // The last stage never raises valid_o: no result leaves the top. A wrong design, so a
     // failed proof (exit 1) naming the part and its samples, not an error of the tool.
     let d = tmp.path().join("silent");
