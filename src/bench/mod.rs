@@ -206,17 +206,27 @@ pub fn run(opts: &Options, progress: &dyn Fn(&str)) -> Result<Vec<Row>> {
         let all =
             grads.len() as f64 / time(opts.seconds, || fast.shade_batch_par(&grads, &mut out16));
         progress(&format!("{design}: speed and synthesis"));
+        // What a host prepares once per configuration; the time of a frame is the fit alone.
         let lsq = LsqFit::new(&cfg);
+        let plain = LsqFit::plain(&cfg);
+        let minimax = opts
+            .fits
+            .contains(&MapFit::Minimax)
+            .then(|| map_fit::minimax::MinimaxFit::new(&cfg));
         for (k, (name, scene)) in scenes.iter().enumerate() {
             for &fit in &opts.fits {
                 let p = scene.prepared();
+                let shade = |n| p.shade(n);
                 let build = match fit {
                     MapFit::Sample => median(7, || {
-                        drop(std::hint::black_box(map_fit::contents(&cfg, fit, |n| {
-                            p.shade(n)
-                        })))
+                        drop(std::hint::black_box(map_fit::contents(&cfg, fit, shade)))
                     }),
-                    _ => median(7, || drop(std::hint::black_box(lsq.fit(|n| p.shade(n))))),
+                    MapFit::Lsq => median(7, || drop(std::hint::black_box(lsq.fit(shade)))),
+                    MapFit::LsqPlain => median(7, || drop(std::hint::black_box(plain.fit(shade)))),
+                    MapFit::Minimax => {
+                        let m = minimax.as_ref().expect("made when minimax is measured");
+                        median(3, || drop(std::hint::black_box(m.fit(shade))))
+                    }
                 };
                 let mut s = scene.clone();
                 s.map_fit = fit;

@@ -105,12 +105,16 @@ impl Journal {
             Ok(text) => match read(&text, key) {
                 Ok(Ok(mut done)) => {
                     done.retain(|id, _| !again.contains(id));
-                    let said = format!(
+                    let said = if done.is_empty() {
+                        format!("journal {}: none judged yet", path.display())
+                    } else {
+                        format!(
                         "journal {}: {} mutant{} judged already by this binary on these files, not judged again (their logs are not kept)",
                         path.display(),
                         done.len(),
                         if done.len() == 1 { "" } else { "s" }
-                    );
+                    )
+                    };
                     (done, said)
                 }
                 Ok(Err(why)) => (

@@ -546,7 +546,10 @@ mod tests {
         // before the tag is 16 whole two-byte characters.
         let s = shortened(&"é".repeat(100), 50);
         assert_eq!(s.len(), 49, "{s}");
-        assert!(s.starts_with(&"é".repeat(16)) && s.as_bytes()[32] == b'~', "{s}");
+        assert!(
+            s.starts_with(&"é".repeat(16)) && s.as_bytes()[32] == b'~',
+            "{s}"
+        );
         assert_eq!(shortened("abc", 3), "abc");
         // Two long names that differ only at the end get different prefixes.
         let (a, b) = ("x".repeat(254) + "a", "x".repeat(254) + "b");

@@ -160,3 +160,64 @@ fn roms_command_takes_map_fit() {
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("cubic"));
 }
+
+/// `minimax` (the smallest largest error over every direction the pipeline produces): its
+/// maximum error on the sphere is never above `lsq`'s, on every scene shipped in scenes/ and
+/// in the configuration shapes that change the positions (no interpolation, no compensation,
+/// more index bits), and lower on the standard scene and the sharp two-light one
+/// (docs/PERFORMANCE.md has the table).
+#[test]
+fn minimax_is_never_worse_than_lsq_at_the_maximum() {
+    let small = Options {
+        size: 256,
+        shrink: 0,
+    };
+    let max_error = |cfg: &Config, scene: &Scene, fit: MapFit, o: Options| {
+        let mut s = scene.clone();
+        s.map_fit = fit;
+        render::render(cfg, &s, o, None)
+            .unwrap()
+            .metrics
+            .max_abs_error
+    };
+    let mut scenes: Vec<_> = std::fs::read_dir(helpers::root().join("scenes"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    scenes.sort();
+    for path in &scenes {
+        let scene = Scene::from_toml_file(path).unwrap();
+        let cfg = Config::default();
+        let (lsq, mm) = (
+            max_error(&cfg, &scene, MapFit::Lsq, Options::default()),
+            max_error(&cfg, &scene, MapFit::Minimax, Options::default()),
+        );
+        assert!(mm <= lsq, "{}: minimax {mm}, lsq {lsq}", path.display());
+        let name = path.file_stem().unwrap().to_string_lossy();
+        if name == "standard" || name == "two_lights" {
+            assert!(mm < lsq, "{name}: minimax {mm}, lsq {lsq}");
+        }
+    }
+    for cfg in [
+        Config {
+            interpolation: false,
+            interp_bits: 0,
+            ..Config::default()
+        },
+        Config {
+            compensation: false,
+            ..Config::default()
+        },
+        Config {
+            index_bits: 4,
+            ..Config::default()
+        },
+    ] {
+        let scene = Scene::standard();
+        let (lsq, mm) = (
+            max_error(&cfg, &scene, MapFit::Lsq, small),
+            max_error(&cfg, &scene, MapFit::Minimax, small),
+        );
+        assert!(mm <= lsq, "{}: minimax {mm}, lsq {lsq}", cfg.summary());
+    }
+}

@@ -30,6 +30,8 @@
 //!    its RMS residual (with few entries it can trade badly). It is off without interpolation,
 //!    where it was measured to raise the maximum. [`MapFit::LsqPlain`] leaves it out.
 
+pub mod minimax;
+
 use super::{reflectance_map, Maps};
 use crate::config::Config;
 use glam::DVec3;
@@ -49,6 +51,10 @@ pub enum MapFit {
     Lsq,
     /// Least squares over a dense grid of directions with uniform weights, then rounded.
     LsqPlain,
+    /// The smallest largest error over every direction the pipeline can produce: a linear
+    /// program per face quadrant, then integer entries polished on the hardware's rounding
+    /// ([`minimax`]).
+    Minimax,
 }
 
 impl MapFit {
@@ -57,6 +63,7 @@ impl MapFit {
             MapFit::Sample => "sample",
             MapFit::Lsq => "lsq",
             MapFit::LsqPlain => "lsq-plain",
+            MapFit::Minimax => "minimax",
         }
     }
 }
@@ -81,6 +88,7 @@ pub fn contents(cfg: &Config, fit: MapFit, shade: impl Fn(DVec3) -> f64 + Sync) 
         MapFit::Sample => reflectance_map::contents(cfg, shade),
         MapFit::Lsq => LsqFit::new(cfg).fit(shade),
         MapFit::LsqPlain => LsqFit::plain(cfg).fit(shade),
+        MapFit::Minimax => minimax::MinimaxFit::new(cfg).fit(shade),
     }
 }
 
@@ -212,31 +220,29 @@ impl LsqFit {
             .map(|q| self.fit_quadrant(q, &shade))
             .collect();
         let top = cfg.map_max() as f64;
-        let mut data = vec![0u32; 3 * cfg.map_entries() as usize];
-        for (q, e) in quadrants.iter().enumerate() {
-            let q = q as u32;
-            let (axis, s_max, s_u, s_v) = (q >> 3, (q >> 2) & 1, (q >> 1) & 1, q & 1);
-            for i_u in 0..n {
-                for i_v in 0..n {
-                    let a =
-                        crate::model::map_addr::addr(cfg, s_max, s_u, i_u as u32, s_v, i_v as u32);
-                    let v = e[i_u * n + i_v];
-                    data[(axis * cfg.map_entries() + a) as usize] = if v.is_nan() {
-                        0
-                    } else {
-                        (v + 0.5).floor().clamp(0.0, top) as u32
-                    };
-                }
-            }
-        }
-        Maps::from_data(cfg, data)
+        let rounded: Vec<Vec<u32>> = quadrants
+            .iter()
+            .map(|e| {
+                e.iter()
+                    .map(|&v| {
+                        if v.is_nan() {
+                            0
+                        } else {
+                            (v + 0.5).floor().clamp(0.0, top) as u32
+                        }
+                    })
+                    .collect()
+            })
+            .collect();
+        debug_assert!(rounded.iter().all(|e| e.len() == n * n));
+        pack(cfg, &rounded)
     }
 
     /// The unrounded entries of quadrant q = axis << 3 | s_max << 2 | s_u << 1 | s_v.
     fn fit_quadrant(&self, q: u32, shade: &impl Fn(DVec3) -> f64) -> Vec<f64> {
         let (n, k) = (self.n, self.tangent.len());
         let top = self.cfg.map_max() as f64;
-        let (axis, s_max, s_u, s_v) = (q >> 3, (q >> 2) & 1, (q >> 1) & 1, q & 1);
+        let (axis, s_max, s_u, s_v) = quadrant(q);
         let sg = |s: u32, t: f64| if s == 1 { -t } else { t };
         // Light-model values on the dense grid, in output LSBs, clamped as the reference
         // clamps them.
@@ -365,6 +371,44 @@ impl LsqFit {
             e.copy_from_slice(&b);
         }
     }
+}
+
+/// The face, max sign and component signs of quadrant q = axis << 3 | s_max << 2 | s_u << 1
+/// | s_v (24 in all).
+fn quadrant(q: u32) -> (u32, u32, u32, u32) {
+    (q >> 3, (q >> 2) & 1, (q >> 1) & 1, q & 1)
+}
+
+/// The maps holding the entries of the 24 quadrants (entry i_u * N + i_v of each).
+fn pack(cfg: &Config, quadrants: &[Vec<u32>]) -> Maps {
+    let n = cfg.entries();
+    let mut data = vec![0u32; 3 * cfg.map_entries() as usize];
+    for (q, e) in quadrants.iter().enumerate() {
+        let (axis, s_max, s_u, s_v) = quadrant(q as u32);
+        for i_u in 0..n {
+            for i_v in 0..n {
+                let a = crate::model::map_addr::addr(cfg, s_max, s_u, i_u, s_v, i_v);
+                data[(axis * cfg.map_entries() + a) as usize] = e[(i_u * n + i_v) as usize];
+            }
+        }
+    }
+    Maps::from_data(cfg, data)
+}
+
+/// The entries of quadrant q of `maps` (entry i_u * N + i_v), as [`pack`] places them.
+fn unpack(cfg: &Config, maps: &Maps, q: u32) -> Vec<u32> {
+    let n = cfg.entries();
+    let (axis, s_max, s_u, s_v) = quadrant(q);
+    let mut e = Vec::with_capacity((n * n) as usize);
+    for i_u in 0..n {
+        for i_v in 0..n {
+            e.push(maps.get(
+                axis,
+                crate::model::map_addr::addr(cfg, s_max, s_u, i_u, s_v, i_v),
+            ));
+        }
+    }
+    e
 }
 
 /// The tangent at a position of x entry spacings (0..=entries-1): the tangent the pipeline's

@@ -1,0 +1,453 @@
+//! Minimax map fitting (`--map-fit minimax`): the integer entries that make the largest error
+//! over **every direction the pipeline can produce** as small as it can be, with the
+//! hardware's own positions, interpolation and rounding.
+//!
+//! **What is minimised.** The pipeline maps a gradient to a face quadrant and to a pair of
+//! positions (p_u, p_v), one per component, each a function of the component and the max
+//! alone. So every direction that reaches a position pair shades the same value. For each
+//! position p of one component, [`MinimaxFit::new`] finds the range of tangents (component /
+//! max) that the pipeline maps to p, by running the model's own sort, normalise and position
+//! stages over the gradients (every (max, component) pair up to [`TRACE_BUDGET`], evenly
+//! spread samples of them beyond). A position pair then stands for a rectangle of tangents,
+//! and the light model over it lies in [lo, hi] (its values at a 3 x 3 grid of the rectangle:
+//! corners, edge midpoints and centre). The error of value v there is max(v - lo, hi - v);
+//! the fit minimises the largest such error over all position pairs of the quadrant.
+//!
+//! **How.** Each quadrant (24 per frame, independent) is a linear program in its N^2 entries
+//! and the bound t: minimise t subject to v_k(e) - t <= lo_k and -v_k(e) - t <= -hi_k for
+//! every position pair k, and 0 <= e <= 2^map_bits - 1, where v_k is the exact bilinear
+//! value of the hardware's weights. It is solved by Clarabel (an interior-point solver from
+//! crates.io, pure Rust). The real solution is rounded to integers and **polished on the true
+//! pipeline**: with the hardware's interpolation and rounding
+//! ([`crate::stages::interpolate::model::eval`]), single entries move by ±1 while that lowers
+//! the quadrant's largest error (or keeps it and lowers how many pairs reach it).
+//!
+//! A quadrant whose program the solver does not solve keeps the least-squares fit's entries
+//! ([`super::LsqFit`]), so the maps are always complete; [`MinimaxFit::fit_report`] says how
+//! many did.
+
+use super::super::Maps;
+use crate::config::Config;
+use crate::stages::interpolate::model as interpolate;
+use crate::stages::map_lookup::model::split;
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{
+    DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus,
+};
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// The most (max, component) pairs run through the model to find the positions' tangent
+/// ranges: every pair up to it (G <= 12: 2.1 M pairs), evenly spread samples beyond.
+pub const TRACE_BUDGET: u64 = 1 << 22;
+/// The most ±1 moves of the integer polish per quadrant, per entry.
+pub const POLISH_MOVES_PER_ENTRY: usize = 8;
+
+/// The per-configuration part of the minimax fit: the tangent range of every position.
+#[derive(Clone, Debug)]
+pub struct MinimaxFit {
+    cfg: Config,
+    n: usize,
+    /// For each position p of one component (0..=pos_max): the smallest and largest tangent
+    /// the pipeline maps to p, or None when no gradient reaches p.
+    range: Vec<Option<(f64, f64)>>,
+}
+
+/// What one frame's fit did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FitReport {
+    /// The largest error over every direction of every quadrant (output LSBs), for the
+    /// integer entries through the hardware's interpolation.
+    pub bound: f64,
+    /// Quadrants whose linear program was not solved (they keep the least-squares entries).
+    pub unsolved: usize,
+}
+
+/// One position pair of a quadrant: its entries and bilinear weights, and the light model's
+/// range over its directions.
+struct Pair {
+    base: (usize, usize),
+    w: (u32, u32),
+    lo: f64,
+    hi: f64,
+}
+
+impl MinimaxFit {
+    /// Finds every position's tangent range for `cfg`.
+    pub fn new(cfg: &Config) -> MinimaxFit {
+        let model = super::super::Model::new(cfg);
+        let blank = Maps::from_data(cfg, vec![0; 3 * cfg.map_entries() as usize]);
+        let top = (1u64 << (cfg.grad_bits - 1)) - 1;
+        let all: u64 = (top + 1) * (top + 2) / 2;
+        // Maxes and components: every pair, or about sqrt(budget) of each, evenly spread
+        // (always with the component equal to the max).
+        let (maxes, per_max): (Vec<u64>, u64) = if all <= TRACE_BUDGET {
+            ((1..=top).collect(), u64::MAX)
+        } else {
+            let k = (TRACE_BUDGET as f64).sqrt() as u64;
+            ((1..=k).map(|i| (i * top).div_ceil(k)).collect(), k)
+        };
+        let positions = cfg.pos_max() as usize + 1;
+        let ranges: Vec<Vec<Option<(f64, f64)>>> = maxes
+            .par_iter()
+            .map(|&m| {
+                let mut r: Vec<Option<(f64, f64)>> = vec![None; positions];
+                let count = (m + 1).min(per_max);
+                for i in 0..count {
+                    let c = if count == m + 1 {
+                        i
+                    } else {
+                        (i * m) / (count - 1)
+                    };
+                    let p = model.trace(&blank, [m as i32, c as i32, 0], [0; 3]).p_u as usize;
+                    let t = c as f64 / m as f64;
+                    let e = r[p].get_or_insert((t, t));
+                    e.0 = e.0.min(t);
+                    e.1 = e.1.max(t);
+                }
+                r
+            })
+            .collect();
+        let mut range: Vec<Option<(f64, f64)>> = vec![None; positions];
+        for r in ranges {
+            for (acc, x) in range.iter_mut().zip(r) {
+                if let Some((lo, hi)) = x {
+                    let e = acc.get_or_insert((lo, hi));
+                    e.0 = e.0.min(lo);
+                    e.1 = e.1.max(hi);
+                }
+            }
+        }
+        MinimaxFit {
+            cfg: cfg.clone(),
+            n: cfg.entries() as usize,
+            range,
+        }
+    }
+
+    /// The tangent range of every position of one component (None: no gradient reaches it).
+    pub fn ranges(&self) -> &[Option<(f64, f64)>] {
+        &self.range
+    }
+
+    /// The fitted maps of one frame.
+    pub fn fit(&self, shade: impl Fn(DVec3) -> f64 + Sync) -> Maps {
+        self.fit_report(shade).0
+    }
+
+    /// The fitted maps of one frame (the 24 quadrants in parallel) and what the fit did.
+    pub fn fit_report(&self, shade: impl Fn(DVec3) -> f64 + Sync) -> (Maps, FitReport) {
+        let cfg = &self.cfg;
+        let lsq = std::sync::OnceLock::new();
+        let quadrants: Vec<(Vec<u32>, f64, bool)> = (0..24u32)
+            .into_par_iter()
+            .map(|q| {
+                let pairs = self.pairs(q, &shade);
+                let (real, solved) = match self.solve(&pairs) {
+                    Some(e) => (e, true),
+                    None => {
+                        let fit: &super::LsqFit = lsq.get_or_init(|| super::LsqFit::new(cfg));
+                        (fit.fit_quadrant(q, &shade), false)
+                    }
+                };
+                let (e, bound) = self.polish(&pairs, &real);
+                (e, bound, solved)
+            })
+            .collect();
+        let mut report = FitReport::default();
+        for (_, bound, solved) in &quadrants {
+            report.bound = report.bound.max(*bound);
+            report.unsolved += usize::from(!solved);
+        }
+        let entries: Vec<Vec<u32>> = quadrants.into_iter().map(|(e, _, _)| e).collect();
+        (super::pack(cfg, &entries), report)
+    }
+
+    /// The largest error of `maps` over every direction the pipeline can produce, in output
+    /// LSBs (what [`MinimaxFit::fit`] minimises), for any maps: a measure of a fit.
+    pub fn bound(&self, maps: &Maps, shade: impl Fn(DVec3) -> f64 + Sync) -> f64 {
+        (0..24u32)
+            .into_par_iter()
+            .map(|q| {
+                let e = super::unpack(&self.cfg, maps, q);
+                let pairs = self.pairs(q, &shade);
+                pairs
+                    .iter()
+                    .map(|p| error(p, self.value(p, &e)))
+                    .fold(0.0, f64::max)
+            })
+            .reduce(|| 0.0, f64::max)
+    }
+
+    /// The position pairs of quadrant q = axis << 3 | s_max << 2 | s_u << 1 | s_v that some
+    /// gradient reaches, with the light model's range over each.
+    fn pairs(&self, q: u32, shade: &impl Fn(DVec3) -> f64) -> Vec<Pair> {
+        let cfg = &self.cfg;
+        let top = cfg.map_max() as f64;
+        let (axis, s_max, s_u, s_v) = super::quadrant(q);
+        let sg = |s: u32, t: f64| if s == 1 { -t } else { t };
+        let light = |tu: f64, tv: f64| {
+            let [x, y, z] = crate::geometry::place(axis, sg(s_max, 1.0), sg(s_u, tu), sg(s_v, tv));
+            let i = shade(crate::geometry::sym_normalize(DVec3::new(x, y, z)));
+            if i.is_nan() {
+                0.0
+            } else {
+                i.clamp(0.0, 1.0) * top
+            }
+        };
+        let mut pairs = Vec::new();
+        for (pu, ru) in self.range.iter().enumerate() {
+            let Some((u0, u1)) = *ru else { continue };
+            for (pv, rv) in self.range.iter().enumerate() {
+                let Some((v0, v1)) = *rv else { continue };
+                let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+                for tu in [u0, (u0 + u1) / 2.0, u1] {
+                    for tv in [v0, (v0 + v1) / 2.0, v1] {
+                        let i = light(tu, tv);
+                        lo = lo.min(i);
+                        hi = hi.max(i);
+                    }
+                }
+                let (bu, wu) = split(cfg, pu as u32);
+                let (bv, wv) = split(cfg, pv as u32);
+                pairs.push(Pair {
+                    base: (bu as usize, bv as usize),
+                    w: (wu, wv),
+                    lo,
+                    hi,
+                });
+            }
+        }
+        pairs
+    }
+
+    /// The entries of a pair as the hardware reads them (indices into a quadrant's entries)
+    /// and their exact bilinear weights.
+    fn taps(&self, p: &Pair) -> Vec<(usize, f64)> {
+        let n = self.n;
+        let (bu, bv) = p.base;
+        if !self.cfg.interpolation {
+            return vec![(bu * n + bv, 1.0)];
+        }
+        let s = self.cfg.step() as f64;
+        let (wu, wv) = (p.w.0 as f64 / s, p.w.1 as f64 / s);
+        [
+            (bu * n + bv, (1.0 - wu) * (1.0 - wv)),
+            ((bu + 1) * n + bv, wu * (1.0 - wv)),
+            (bu * n + bv + 1, (1.0 - wu) * wv),
+            ((bu + 1) * n + bv + 1, wu * wv),
+        ]
+        .into_iter()
+        .filter(|&(_, w)| w != 0.0)
+        .collect()
+    }
+
+    /// The hardware's value at a pair for integer entries `e` of a quadrant.
+    fn value(&self, p: &Pair, e: &[u32]) -> u32 {
+        let n = self.n;
+        let (bu, bv) = p.base;
+        if !self.cfg.interpolation {
+            return e[bu * n + bv];
+        }
+        let at = |du: usize, dv: usize| e[(bu + du) * n + bv + dv];
+        interpolate::eval(
+            &self.cfg,
+            [at(0, 0), at(1, 0), at(0, 1), at(1, 1)],
+            p.w.0,
+            p.w.1,
+        )
+    }
+
+    /// The linear program of a quadrant, solved: its real entries, or None if the solver
+    /// did not reach a solution.
+    fn solve(&self, pairs: &[Pair]) -> Option<Vec<f64>> {
+        let nn = self.n * self.n;
+        let t = nn; // the bound's column
+        let (mut rows, mut cols, mut vals, mut b) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut row = 0;
+        for p in pairs {
+            let taps = self.taps(p);
+            // v - t <= lo, then -v - t <= -hi.
+            for (sign, rhs) in [(1.0, p.lo), (-1.0, -p.hi)] {
+                for &(j, w) in &taps {
+                    rows.push(row);
+                    cols.push(j);
+                    vals.push(sign * w);
+                }
+                rows.push(row);
+                cols.push(t);
+                vals.push(-1.0);
+                b.push(rhs);
+                row += 1;
+            }
+        }
+        let top = self.cfg.map_max() as f64;
+        for j in 0..nn {
+            for (sign, rhs) in [(1.0, top), (-1.0, 0.0)] {
+                rows.push(row);
+                cols.push(j);
+                vals.push(sign);
+                b.push(rhs);
+                row += 1;
+            }
+        }
+        let a = CscMatrix::new_from_triplets(row, nn + 1, rows, cols, vals);
+        let p = CscMatrix::<f64>::zeros((nn + 1, nn + 1));
+        let mut q = vec![0.0; nn + 1];
+        q[t] = 1.0;
+        let settings = DefaultSettingsBuilder::default()
+            .verbose(false)
+            .max_iter(200)
+            .build()
+            .ok()?;
+        let cones = [NonnegativeConeT(row)];
+        let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings).ok()?;
+        solver.solve();
+        let ok = matches!(
+            solver.solution.status,
+            SolverStatus::Solved | SolverStatus::AlmostSolved
+        );
+        let x = &solver.solution.x;
+        (ok && x.iter().all(|v| v.is_finite())).then(|| x[..nn].to_vec())
+    }
+
+    /// Integer entries from the real ones, polished on the hardware's interpolation: returns
+    /// them and the quadrant's largest error.
+    fn polish(&self, pairs: &[Pair], real: &[f64]) -> (Vec<u32>, f64) {
+        let top = self.cfg.map_max();
+        let mut e: Vec<u32> = real
+            .iter()
+            .map(|&v| {
+                if v.is_nan() {
+                    0
+                } else {
+                    (v + 0.5).floor().clamp(0.0, top as f64) as u32
+                }
+            })
+            .collect();
+        // The pairs that read each entry.
+        let mut readers: Vec<Vec<usize>> = vec![Vec::new(); e.len()];
+        for (k, p) in pairs.iter().enumerate() {
+            for (j, _) in self.taps(p) {
+                readers[j].push(k);
+            }
+        }
+        let mut err: Vec<f64> = pairs.iter().map(|p| error(p, self.value(p, &e))).collect();
+        let score = |err: &[f64]| -> (f64, usize) {
+            let m = err.iter().copied().fold(0.0, f64::max);
+            (m, err.iter().filter(|&&x| x >= m - 1e-9).count())
+        };
+        let mut best = score(&err);
+        for _ in 0..POLISH_MOVES_PER_ENTRY * e.len() {
+            // The first move that improves the score, at any pair that reaches the max.
+            let worst: Vec<usize> = (0..pairs.len())
+                .filter(|&k| err[k] >= best.0 - 1e-9)
+                .collect();
+            let mut moved = false;
+            'pairs: for &k in &worst {
+                for (j, _) in self.taps(&pairs[k]) {
+                    for delta in [1i64, -1] {
+                        let v = e[j] as i64 + delta;
+                        if v < 0 || v > top as i64 {
+                            continue;
+                        }
+                        let old = e[j];
+                        e[j] = v as u32;
+                        let mut trial = err.clone();
+                        for &r in &readers[j] {
+                            trial[r] = error(&pairs[r], self.value(&pairs[r], &e));
+                        }
+                        let s = score(&trial);
+                        if s.0 < best.0 - 1e-9 || (s.0 <= best.0 + 1e-9 && s.1 < best.1) {
+                            err = trial;
+                            best = s;
+                            moved = true;
+                            break 'pairs;
+                        }
+                        e[j] = old;
+                    }
+                }
+            }
+            if !moved {
+                break;
+            }
+        }
+        (e, best.0)
+    }
+}
+
+/// The largest error of value `v` over a pair's directions.
+fn error(p: &Pair, v: u32) -> f64 {
+    let v = v as f64;
+    (v - p.lo).max(p.hi - v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::super::reflectance_map;
+    use super::*;
+    use crate::scene::Scene;
+
+    fn small() -> Config {
+        let c = Config {
+            grad_bits: 8,
+            red_bits: 6,
+            ..Config::default()
+        };
+        c.validate().unwrap();
+        c
+    }
+
+    /// Every position of a component is reached, the ranges rise with the position and
+    /// together cover the tangents 0..=1.
+    #[test]
+    fn the_positions_cover_every_tangent_in_order() {
+        let cfg = small();
+        let f = MinimaxFit::new(&cfg);
+        let r: Vec<(f64, f64)> = f.ranges().iter().map(|x| x.expect("reached")).collect();
+        assert_eq!(r.len(), cfg.pos_max() as usize + 1);
+        assert_eq!(r[0].0, 0.0);
+        assert_eq!(r.last().unwrap().1, 1.0);
+        for w in r.windows(2) {
+            assert!(w[0].0 <= w[1].0 && w[0].1 <= w[1].1, "{w:?}");
+        }
+    }
+
+    /// A constant light model gives constant maps with no error; on a sharp highlight the
+    /// minimax entries have a smaller bound than the least-squares and sampled ones, and the
+    /// bound the fit reports is the one measured on its maps.
+    #[test]
+    fn minimax_lowers_the_bound_of_lsq_and_sample() {
+        let cfg = small();
+        let f = MinimaxFit::new(&cfg);
+        let (maps, r) = f.fit_report(|_| 0.5);
+        assert_eq!(
+            r,
+            FitReport {
+                bound: 0.5,
+                unsolved: 0
+            }
+        );
+        assert!(maps.data.iter().all(|&v| v == 127 || v == 128));
+
+        let mut scene = Scene::standard();
+        scene.material.shininess = 120.0;
+        let p = scene.prepared();
+        let shade = |n: DVec3| p.shade(n);
+        let (mm, r) = f.fit_report(shade);
+        assert_eq!(r.unsolved, 0);
+        let lsq = super::super::LsqFit::new(&cfg).fit(shade);
+        let smp = reflectance_map::contents(&cfg, shade);
+        let (b_mm, b_lsq, b_smp) = (
+            f.bound(&mm, shade),
+            f.bound(&lsq, shade),
+            f.bound(&smp, shade),
+        );
+        assert_eq!(b_mm, r.bound);
+        assert!(
+            b_mm < b_lsq && b_mm < b_smp,
+            "minimax {b_mm}, lsq {b_lsq}, sample {b_smp}"
+        );
+    }
+}
