@@ -17,8 +17,8 @@ pub struct MapArgs {
     pub scene: Option<PathBuf>,
     /// How the maps are filled from the light model: sample (the light model at each entry's
     /// direction), lsq (least squares over a dense grid, with peak refinement), lsq-plain
-    /// (without it), minimax (the smallest largest error over every direction; about a second
-    /// a frame) [default: the scene's `map_fit`, else sample].
+    /// (without it), minimax (the smallest largest error over every direction; a third of a
+    /// second a frame) [default: the scene's `map_fit`, else sample].
     #[arg(long, value_enum, value_name = "FIT")]
     pub map_fit: Option<MapFit>,
 }

@@ -17,7 +17,8 @@
 //! and the bound t: minimise t subject to v_k(e) - t <= lo_k and -v_k(e) - t <= -hi_k for
 //! every position pair k, and 0 <= e <= 2^map_bits - 1, where v_k is the exact bilinear
 //! value of the hardware's weights. It is solved by Clarabel (an interior-point solver from
-//! crates.io, pure Rust). The real solution is rounded to integers and **polished on the true
+//! crates.io, pure Rust), by cutting planes: a spread subset of the pairs first, then the
+//! pairs its solution violates, until none is ([`MinimaxFit::solve`]). The real solution is rounded to integers and **polished on the true
 //! pipeline**: with the hardware's interpolation and rounding
 //! ([`crate::stages::interpolate::model::eval`]), single entries move by ±1 while that lowers
 //! the quadrant's largest error (or keeps it and lowers how many pairs reach it).
@@ -40,6 +41,14 @@ use rayon::prelude::*;
 /// The most (max, component) pairs run through the model to find the positions' tangent
 /// ranges: every pair up to it (G <= 12: 2.1 M pairs), evenly spread samples beyond.
 pub const TRACE_BUDGET: u64 = 1 << 22;
+/// The weight of the distance to the least-squares entries in a program's objective, over
+/// all entries: at most this times the largest distance (255 LSB at 8 bits) is traded
+/// against the bound, so the bound is within 0.003 LSB of its optimum.
+pub const TIE_BREAK: f64 = 1e-5;
+/// Rounds of cutting planes before the whole program is solved instead.
+pub const CUT_ROUNDS: usize = 12;
+/// A pair whose error exceeds the subset's bound by more than this (LSB) is added to it.
+pub const CUT_TOLERANCE: f64 = 1e-4;
 /// The most ±1 moves of the integer polish per quadrant, per entry.
 pub const POLISH_MOVES_PER_ENTRY: usize = 8;
 
@@ -51,6 +60,9 @@ pub struct MinimaxFit {
     /// For each position p of one component (0..=pos_max): the smallest and largest tangent
     /// the pipeline maps to p, or None when no gradient reaches p.
     range: Vec<Option<(f64, f64)>>,
+    /// The least-squares fit: where each program starts its tie-break, and the entries of
+    /// a quadrant the solver does not solve.
+    lsq: super::LsqFit,
 }
 
 /// What one frame's fit did.
@@ -122,6 +134,7 @@ impl MinimaxFit {
             cfg: cfg.clone(),
             n: cfg.entries() as usize,
             range,
+            lsq: super::LsqFit::new(cfg),
         }
     }
 
@@ -138,17 +151,14 @@ impl MinimaxFit {
     /// The fitted maps of one frame (the 24 quadrants in parallel) and what the fit did.
     pub fn fit_report(&self, shade: impl Fn(DVec3) -> f64 + Sync) -> (Maps, FitReport) {
         let cfg = &self.cfg;
-        let lsq = std::sync::OnceLock::new();
         let quadrants: Vec<(Vec<u32>, f64, bool)> = (0..24u32)
             .into_par_iter()
             .map(|q| {
                 let pairs = self.pairs(q, &shade);
-                let (real, solved) = match self.solve(&pairs) {
+                let lsq = self.lsq.fit_quadrant(q, &shade);
+                let (real, solved) = match self.solve(&pairs, &lsq) {
                     Some(e) => (e, true),
-                    None => {
-                        let fit: &super::LsqFit = lsq.get_or_init(|| super::LsqFit::new(cfg));
-                        (fit.fit_quadrant(q, &shade), false)
-                    }
+                    None => (lsq, false),
                 };
                 let (e, bound) = self.polish(&pairs, &real);
                 (e, bound, solved)
@@ -260,17 +270,66 @@ impl MinimaxFit {
 
     /// The linear program of a quadrant, solved: its real entries, or None if the solver
     /// did not reach a solution.
-    fn solve(&self, pairs: &[Pair]) -> Option<Vec<f64>> {
+    ///
+    /// By cutting planes: the program over an evenly spread subset of the position pairs,
+    /// then again with the pairs its solution violates, until it violates none (at most
+    /// [`CUT_ROUNDS`] rounds, then the whole program). A minimax solution is pinned by few
+    /// pairs, so the programs stay small: this is the whole program's optimum at a fraction
+    /// of its rows.
+    fn solve(&self, pairs: &[Pair], anchor: &[f64]) -> Option<Vec<f64>> {
         let nn = self.n * self.n;
-        let t = nn; // the bound's column
+        let taps: Vec<Vec<(usize, f64)>> = pairs.iter().map(|p| self.taps(p)).collect();
+        let stride = (pairs.len() / (4 * nn)).max(1);
+        let mut active: Vec<usize> = (0..pairs.len()).step_by(stride).collect();
+        let mut chosen = vec![false; pairs.len()];
+        active.iter().for_each(|&k| chosen[k] = true);
+        for _ in 0..CUT_ROUNDS {
+            let (x, t) = self.solve_rows(pairs, &taps, &active, anchor)?;
+            let mut violated: Vec<(f64, usize)> = (0..pairs.len())
+                .filter(|&k| !chosen[k])
+                .filter_map(|k| {
+                    let v: f64 = taps[k].iter().map(|&(j, w)| w * x[j]).sum();
+                    let excess = (v - pairs[k].lo).max(pairs[k].hi - v) - t;
+                    (excess > CUT_TOLERANCE).then_some((excess, k))
+                })
+                .collect();
+            if violated.is_empty() {
+                return Some(x);
+            }
+            // The most violated first, a bounded number a round.
+            violated.sort_by(|a, b| b.0.total_cmp(&a.0));
+            for &(_, k) in violated.iter().take(2 * nn) {
+                chosen[k] = true;
+                active.push(k);
+            }
+        }
+        let all: Vec<usize> = (0..pairs.len()).collect();
+        self.solve_rows(pairs, &taps, &all, anchor).map(|(x, _)| x)
+    }
+
+    /// The program over the position pairs `rows` (and the entries' bounds): the real
+    /// entries and the bound t. Among (nearly) equal bounds it takes the entries closest to
+    /// `anchor` (the least-squares fit) in the sum of |e - anchor|, weighted by
+    /// [`TIE_BREAK`]: a minimax optimum is seldom unique, and the closest to least squares
+    /// keeps the RMS error low.
+    fn solve_rows(
+        &self,
+        pairs: &[Pair],
+        taps: &[Vec<(usize, f64)>],
+        rows_of: &[usize],
+        anchor: &[f64],
+    ) -> Option<(Vec<f64>, f64)> {
+        let nn = self.n * self.n;
+        let t = nn; // the bound's column; then nn distances d_j >= |e_j - anchor_j|
+        let d = nn + 1;
         let (mut rows, mut cols, mut vals, mut b) =
             (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let mut row = 0;
-        for p in pairs {
-            let taps = self.taps(p);
+        for &k in rows_of {
+            let p = &pairs[k];
             // v - t <= lo, then -v - t <= -hi.
             for (sign, rhs) in [(1.0, p.lo), (-1.0, -p.hi)] {
-                for &(j, w) in &taps {
+                for &(j, w) in &taps[k] {
                     rows.push(row);
                     cols.push(j);
                     vals.push(sign * w);
@@ -283,7 +342,7 @@ impl MinimaxFit {
             }
         }
         let top = self.cfg.map_max() as f64;
-        for j in 0..nn {
+        for (j, &a) in anchor.iter().enumerate().take(nn) {
             for (sign, rhs) in [(1.0, top), (-1.0, 0.0)] {
                 rows.push(row);
                 cols.push(j);
@@ -291,10 +350,20 @@ impl MinimaxFit {
                 b.push(rhs);
                 row += 1;
             }
+            // e - d <= anchor, -e - d <= -anchor.
+            let a = if a.is_finite() { a } else { 0.0 };
+            for (sign, rhs) in [(1.0, a), (-1.0, -a)] {
+                rows.extend([row, row]);
+                cols.extend([j, d + j]);
+                vals.extend([sign, -1.0]);
+                b.push(rhs);
+                row += 1;
+            }
         }
-        let a = CscMatrix::new_from_triplets(row, nn + 1, rows, cols, vals);
-        let p = CscMatrix::<f64>::zeros((nn + 1, nn + 1));
-        let mut q = vec![0.0; nn + 1];
+        let a = CscMatrix::new_from_triplets(row, 2 * nn + 1, rows, cols, vals);
+        let p = CscMatrix::<f64>::zeros((2 * nn + 1, 2 * nn + 1));
+        let mut q = vec![TIE_BREAK / nn as f64; 2 * nn + 1];
+        q[..=t].iter_mut().for_each(|x| *x = 0.0);
         q[t] = 1.0;
         let settings = DefaultSettingsBuilder::default()
             .verbose(false)
@@ -309,7 +378,7 @@ impl MinimaxFit {
             SolverStatus::Solved | SolverStatus::AlmostSolved
         );
         let x = &solver.solution.x;
-        (ok && x.iter().all(|v| v.is_finite())).then(|| x[..nn].to_vec())
+        (ok && x.iter().all(|v| v.is_finite())).then(|| (x[..nn].to_vec(), x[t]))
     }
 
     /// Integer entries from the real ones, polished on the hardware's interpolation: returns
@@ -334,19 +403,32 @@ impl MinimaxFit {
             }
         }
         let mut err: Vec<f64> = pairs.iter().map(|p| error(p, self.value(p, &e))).collect();
+        // The score: the largest error, then how many pairs reach it.
         let score = |err: &[f64]| -> (f64, usize) {
             let m = err.iter().copied().fold(0.0, f64::max);
             (m, err.iter().filter(|&&x| x >= m - 1e-9).count())
         };
         let mut best = score(&err);
+        // A move changes only the errors of the pairs that read the entry: they are
+        // evaluated first, and the rest is scanned only when they do not already make the
+        // move worse.
+        let mut trial: Vec<f64> = Vec::new();
+        let mut stamp = vec![0usize; pairs.len()];
+        let mut tries = 0usize;
         for _ in 0..POLISH_MOVES_PER_ENTRY * e.len() {
-            // The first move that improves the score, at any pair that reaches the max.
-            let worst: Vec<usize> = (0..pairs.len())
-                .filter(|&k| err[k] >= best.0 - 1e-9)
-                .collect();
-            let mut moved = false;
-            'pairs: for &k in &worst {
+            // The entries the pairs at the max read, each once, in order.
+            let mut seen = vec![false; e.len()];
+            let mut entries = Vec::new();
+            for k in (0..pairs.len()).filter(|&k| err[k] >= best.0 - 1e-9) {
                 for (j, _) in self.taps(&pairs[k]) {
+                    if !std::mem::replace(&mut seen[j], true) {
+                        entries.push(j);
+                    }
+                }
+            }
+            let mut moved = false;
+            'entries: for &j in &entries {
+                {
                     for delta in [1i64, -1] {
                         let v = e[j] as i64 + delta;
                         if v < 0 || v > top as i64 {
@@ -354,16 +436,39 @@ impl MinimaxFit {
                         }
                         let old = e[j];
                         e[j] = v as u32;
-                        let mut trial = err.clone();
-                        for &r in &readers[j] {
-                            trial[r] = error(&pairs[r], self.value(&pairs[r], &e));
-                        }
-                        let s = score(&trial);
-                        if s.0 < best.0 - 1e-9 || (s.0 <= best.0 + 1e-9 && s.1 < best.1) {
-                            err = trial;
-                            best = s;
-                            moved = true;
-                            break 'pairs;
+                        trial.clear();
+                        trial.extend(
+                            readers[j]
+                                .iter()
+                                .map(|&r| error(&pairs[r], self.value(&pairs[r], &e))),
+                        );
+                        let local = trial.iter().copied().fold(0.0, f64::max);
+                        if local <= best.0 + 1e-9 {
+                            tries += 1;
+                            for &r in &readers[j] {
+                                stamp[r] = tries;
+                            }
+                            let mut m = local;
+                            for (r, &x) in err.iter().enumerate() {
+                                if stamp[r] != tries {
+                                    m = m.max(x);
+                                }
+                            }
+                            let at_max = |x: &f64| *x >= m - 1e-9;
+                            let count = trial.iter().filter(|x| at_max(x)).count()
+                                + err
+                                    .iter()
+                                    .enumerate()
+                                    .filter(|&(r, x)| stamp[r] != tries && at_max(x))
+                                    .count();
+                            if m < best.0 - 1e-9 || (m <= best.0 + 1e-9 && count < best.1) {
+                                for (&r, &x) in readers[j].iter().zip(&trial) {
+                                    err[r] = x;
+                                }
+                                best = (m, count);
+                                moved = true;
+                                break 'entries;
+                            }
                         }
                         e[j] = old;
                     }
@@ -373,6 +478,7 @@ impl MinimaxFit {
                 break;
             }
         }
+        debug_assert_eq!(best, score(&err));
         (e, best.0)
     }
 }
@@ -411,6 +517,38 @@ mod tests {
         assert_eq!(r.last().unwrap().1, 1.0);
         for w in r.windows(2) {
             assert!(w[0].0 <= w[1].0 && w[0].1 <= w[1].1, "{w:?}");
+        }
+    }
+
+    /// The cutting planes reach the whole program's optimum: the largest error of their
+    /// real entries over every pair is the whole program's bound.
+    #[test]
+    fn cutting_planes_reach_the_whole_programs_optimum() {
+        let cfg = small();
+        let f = MinimaxFit::new(&cfg);
+        let mut scene = Scene::standard();
+        scene.material.shininess = 120.0;
+        let p = scene.prepared();
+        let shade = |n: DVec3| p.shade(n);
+        for q in [0, 5, 13, 22] {
+            let pairs = f.pairs(q, &shade);
+            let taps: Vec<Vec<(usize, f64)>> = pairs.iter().map(|p| f.taps(p)).collect();
+            let all: Vec<usize> = (0..pairs.len()).collect();
+            let anchor = f.lsq.fit_quadrant(q, &shade);
+            let (_, whole) = f.solve_rows(&pairs, &taps, &all, &anchor).unwrap();
+            let x = f.solve(&pairs, &anchor).unwrap();
+            let reached = pairs
+                .iter()
+                .zip(&taps)
+                .map(|(p, t)| {
+                    let v: f64 = t.iter().map(|&(j, w)| w * x[j]).sum();
+                    (v - p.lo).max(p.hi - v)
+                })
+                .fold(0.0, f64::max);
+            assert!(
+                (reached - whole).abs() < 1e-3,
+                "quadrant {q}: cutting planes {reached}, whole program {whole}"
+            );
         }
     }
 
