@@ -87,7 +87,13 @@ struct Pair {
 impl MinimaxFit {
     /// Finds every position's tangent range for `cfg`.
     pub fn new(cfg: &Config) -> MinimaxFit {
-        let model = super::super::Model::new(cfg);
+        MinimaxFit::for_model(&super::super::Model::new(cfg))
+    }
+
+    /// Finds every position's tangent range through `model`'s own stages (its compensation
+    /// table may be another than the configuration's atan table).
+    pub fn for_model(model: &super::super::Model) -> MinimaxFit {
+        let cfg = &model.cfg;
         let blank = Maps::from_data(cfg, vec![0; 3 * cfg.map_entries() as usize]);
         let top = (1u64 << (cfg.grad_bits - 1)) - 1;
         let all: u64 = (top + 1) * (top + 2) / 2;
