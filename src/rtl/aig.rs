@@ -444,6 +444,46 @@ mod tests {
         assert_eq!(none, None);
     }
 
+    /// Each check of an AND gate refuses on its own: an odd (negated) left side, a variable
+    /// past the header's maximum, and an input that is not an earlier literal (either side).
+    #[test]
+    fn refuses_each_malformed_and_gate() {
+        let head = "aag 3 2 0 1 1\n2\n4\n6\n";
+        let map = "input 0 0 x\ninput 1 0 y\noutput 0 0 ok\n";
+        Aig::parse(&format!("{head}6 2 4\n"), map).unwrap();
+        for gate in ["7 2 4", "8 2 4", "6 6 4", "6 2 7"] {
+            let e = Aig::parse(&format!("{head}{gate}\n"), map).err();
+            let e = e.unwrap_or_else(|| panic!("{gate} was taken"));
+            assert!(e.to_string().contains("out of order"), "{gate}: {e}");
+        }
+    }
+
+    /// A miter has one output (its `ok`); two are refused before any evaluation.
+    #[test]
+    fn a_miter_with_two_outputs_is_refused() {
+        let aag = "aag 3 2 0 2 1\n2\n4\n6\n7\n6 2 4\n";
+        let map = "input 0 0 x\ninput 1 0 y\noutput 0 0 ok\noutput 1 0 ok2\n";
+        let g = Aig::parse(aag, map).unwrap();
+        let e = exhaustive(&g, &[Vec::new()]).unwrap_err();
+        assert!(e.to_string().contains("2 outputs"), "{e}");
+    }
+
+    /// An input is used when a gate reads it on either side or an output is it; the others
+    /// (z here) are not.
+    #[test]
+    fn used_inputs_are_those_a_gate_or_output_reads() {
+        let map = "input 0 0 x\ninput 1 0 y\ninput 2 0 z\noutput 0 0 ok\n";
+        // y only as the first operand, x only as the second.
+        let g = Aig::parse("aag 4 3 0 1 1\n2\n4\n6\n8\n8 4 2\n", map).unwrap();
+        assert_eq!(g.used(), vec![true, true, false]);
+        // x only as the second operand, y only as the first (the other order).
+        let g = Aig::parse("aag 4 3 0 1 1\n2\n4\n6\n8\n8 2 4\n", map).unwrap();
+        assert_eq!(g.used(), vec![true, true, false]);
+        // z only as the output.
+        let g = Aig::parse("aag 3 3 0 1 0\n2\n4\n6\n6\n", map).unwrap();
+        assert_eq!(g.used(), vec![false, false, true]);
+    }
+
     #[test]
     fn refuses_latches_and_unknown_case_signals() {
         assert!(Aig::parse("aag 1 0 1 1 0\n2 3\n2\n", "").is_err());
