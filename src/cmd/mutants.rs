@@ -51,6 +51,15 @@ pub struct MutantsArgs {
     /// Random top vectors of `sim`'s C++ stream.
     #[arg(long, default_value_t = 100_000, value_name = "N")]
     pub sim_stream: u64,
+    /// The ground truth that classes every mutant: direct (`prove --direct`, every gradient
+    /// through the top; grad_bits <= 9) or stream (`sim --stream N`, a random sample of
+    /// gradients through the top against the model, for wider designs: a mutant it passes is
+    /// "equivalent" only as far as the sample shows).
+    #[arg(long, value_enum, default_value = "direct")]
+    pub truth: Truth,
+    /// Random gradients of the stream ground truth.
+    #[arg(long, default_value_t = 10_000_000, value_name = "N")]
+    pub truth_stream: u64,
     /// Every mutant's design, builds and logs go to BUILD/<design name>/m<id> (replaced whole);
     /// the outcomes to the journal BUILD/<design name>.journal, which a later run of the same
     /// binary, design and draw goes on from.
@@ -63,10 +72,33 @@ pub struct MutantsArgs {
     pub force: ForceArg,
 }
 
+/// The ground truth of a run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Truth {
+    Direct,
+    Stream,
+}
+
 pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
     let design = DesignDir::open(&a.dir)?;
-    if let Err(e) = crate::prove::check_design(&design, true) {
-        bail!("the ground truth of rmapgen mutants is prove --direct: {e}");
+    let truth = match a.truth {
+        Truth::Direct => Method::Direct,
+        Truth::Stream => Method::Stream,
+    };
+    // The factored proof is judged on every mutant, so the design must be one it takes.
+    if let Err(e) = crate::prove::check_design(&design, false) {
+        bail!("rmapgen mutants judges by rmapgen prove: {e}");
+    }
+    if truth == Method::Direct {
+        if let Err(e) = crate::prove::check_design(&design, true) {
+            bail!("the ground truth of rmapgen mutants is prove --direct: {e}; give --truth stream for a sampled one");
+        }
+    }
+    if a.truth_stream == 0 {
+        bail!("--truth-stream 0: give a number of gradients");
+    }
+    if a.method.contains(&Method::Stream) {
+        bail!("--method stream: the stream is a ground truth (--truth stream)");
     }
     if a.jobs == 0 || a.jobs > 64 {
         bail!("--jobs {}: give 1..=64", a.jobs);
@@ -112,6 +144,8 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
         quick: a.quick,
         timeout: Duration::from_secs(a.timeout),
         sim_stream: a.sim_stream,
+        truth,
+        truth_stream: a.truth_stream,
     };
     let key = journal::Key::new(&design, &plan, &draw)?;
     let journal = Journal::open(
@@ -121,12 +155,19 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
         a.force.force,
     )?;
     crate::outln!(
-        "mutants of {} ({}): the null mutant, {} Verilog (Yosys mutate, seed {}), {} memory; ground truth prove --direct{}; {} at a time",
+        "mutants of {} ({}): the null mutant, {} Verilog (Yosys mutate, seed {}), {} memory; ground truth {}{}; {} at a time",
         design.path().display(),
         design.config.summary(),
         list.iter().filter(|m| matches!(m.change, Change::Verilog { .. })).count(),
         a.seed,
         list.iter().filter(|m| matches!(m.change, Change::Memory { .. })).count(),
+        match truth {
+            Method::Stream => format!(
+                "sim --stream {} (a sample: equivalent means no difference found)",
+                a.truth_stream
+            ),
+            _ => "prove --direct".to_string(),
+        },
         if a.quick { " on the mutants prove passes" } else { "" },
         a.jobs
     )?;
@@ -189,9 +230,9 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
         outcomes.push(r?);
     }
     outcomes.sort_by_key(|o| o.mutant.id);
-    let mut methods = vec![Method::Direct];
+    let mut methods = vec![truth];
     if a.quick {
-        methods = vec![Method::Prove, Method::Direct];
+        methods = vec![Method::Prove, truth];
     } else {
         methods.extend(&a.method);
     }
@@ -224,7 +265,8 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
     let unsound: Vec<&Outcome> = outcomes.iter().filter(|o| o.unsound()).collect();
     for o in &unsound {
         crate::outln!(
-            "SURVIVED (outputs differ under prove --direct, passed by prove): {}",
+            "SURVIVED (outputs differ under {}, passed by prove): {}",
+            truth.name(),
             o.mutant.describe()
         )?;
     }
@@ -246,6 +288,7 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
             "config": design.config,
             "seed": a.seed,
             "quick": a.quick,
+            "truth": truth.name(),
             "tallies": tallies,
             "outcomes": outcomes,
         });

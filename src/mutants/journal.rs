@@ -37,6 +37,8 @@ pub struct Key {
     pub quick: bool,
     pub timeout_s: u64,
     pub sim_stream: u64,
+    pub truth: Method,
+    pub truth_stream: u64,
     /// The whole draw (not only the mutants a run selects with `--only`).
     pub draw: Vec<Mutant>,
 }
@@ -57,6 +59,8 @@ impl Key {
             quick: plan.quick,
             timeout_s: plan.timeout.as_secs(),
             sim_stream: plan.sim_stream,
+            truth: plan.truth,
+            truth_stream: plan.truth_stream,
             draw: draw.to_vec(),
         })
     }
@@ -71,8 +75,9 @@ impl Key {
             Some("another draw (seed, count or memories)")
         } else if (&self.methods, self.quick, self.timeout_s, self.sim_stream)
             != (&now.methods, now.quick, now.timeout_s, now.sim_stream)
+            || (self.truth, self.truth_stream) != (now.truth, now.truth_stream)
         {
-            Some("another plan (methods, --quick, --timeout or --sim-stream)")
+            Some("another plan (methods, --quick, --timeout, --sim-stream or --truth)")
         } else {
             None
         }
@@ -213,6 +218,8 @@ mod tests {
             quick: false,
             timeout_s: 900,
             sim_stream: 10,
+            truth: Method::Direct,
+            truth_stream: 0,
             draw: (0..3)
                 .map(|id| Mutant {
                     id,
@@ -291,6 +298,13 @@ mod tests {
             (
                 Key {
                     quick: true,
+                    ..key("b1", 0)
+                },
+                "another plan",
+            ),
+            (
+                Key {
+                    truth: Method::Stream,
                     ..key("b1", 0)
                 },
                 "another plan",

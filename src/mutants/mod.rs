@@ -361,6 +361,10 @@ pub enum Method {
     Sim,
     /// `rmapgen sim --gate`: the top's testbench on the synthesised netlist.
     Gate,
+    /// `rmapgen sim --stream N`: N random gradients through the top against the model, and
+    /// nothing else: the ground truth where `--direct` cannot drive every gradient (a
+    /// sample, so "equivalent" means no difference found).
+    Stream,
 }
 
 impl Method {
@@ -370,19 +374,28 @@ impl Method {
             Method::Prove => "prove",
             Method::Sim => "sim",
             Method::Gate => "gate",
+            Method::Stream => "stream",
         }
     }
 
-    fn args(self, sim_stream: u64) -> Vec<String> {
+    /// Whether it can be a run's ground truth (every mutant is judged by it first).
+    pub fn is_truth(self) -> bool {
+        matches!(self, Method::Direct | Method::Stream)
+    }
+
+    fn args(self, plan: &Plan) -> Vec<String> {
         let v: Vec<&str> = match self {
             Method::Direct => vec!["prove", "--direct"],
             Method::Prove => vec!["prove"],
             Method::Sim => vec!["sim", "--verilator"],
             Method::Gate => vec!["sim", "--gate"],
+            Method::Stream => vec!["sim"],
         };
         let mut v: Vec<String> = v.into_iter().map(String::from).collect();
-        if self == Method::Sim {
-            v.extend(["--stream".to_string(), sim_stream.to_string()]);
+        match self {
+            Method::Sim => v.extend(["--stream".to_string(), plan.sim_stream.to_string()]),
+            Method::Stream => v.extend(["--stream".to_string(), plan.truth_stream.to_string()]),
+            _ => {}
         }
         v
     }
@@ -423,14 +436,7 @@ impl Verdict {
 /// Runs `method` on the mutant design `dir`, as a child process of this binary in a process
 /// group of its own (killed with everything it started on an interrupt or at `timeout`),
 /// its output in `log`.
-pub fn check(
-    method: Method,
-    dir: &Path,
-    build: &Path,
-    log: &Path,
-    timeout: Duration,
-    sim_stream: u64,
-) -> Result<Verdict> {
+pub fn check(method: Method, dir: &Path, build: &Path, log: &Path, plan: &Plan) -> Result<Verdict> {
     // The running binary itself (Linux's /proc/self/exe), not its path: a campaign of an
     // hour judges every mutant with the rmapgen it started with, even if a build replaces
     // target/release/rmapgen meanwhile (which once stopped one with "cannot start").
@@ -439,7 +445,7 @@ pub fn check(
         std::fs::File::create(log).with_context(|| format!("cannot write {}", log.display()))?;
     let err = out.try_clone()?;
     let mut c = Command::new(exe);
-    c.args(method.args(sim_stream))
+    c.args(method.args(plan))
         .arg("--build")
         .arg(build)
         .arg(dir)
@@ -448,7 +454,7 @@ pub fn check(
         .stderr(err);
     let status = crate::toolchain::child::spawn(&mut c)
         .with_context(|| format!("cannot start rmapgen {}", method.name()))?
-        .wait_timeout(timeout)?;
+        .wait_timeout(plan.timeout)?;
     Ok(match status.and_then(|s| s.code()) {
         None if status.is_none() => Verdict::Timeout,
         Some(0) => Verdict::Passed,
@@ -470,9 +476,13 @@ impl Outcome {
         self.verdicts.iter().find(|(k, _)| *k == m).map(|(_, v)| v)
     }
 
-    /// The ground truth's class: `None` when `--direct` did not run on it.
+    /// The ground truth's class (`--direct`, or the stream where it was the truth): `None`
+    /// when no ground truth ran on it.
     pub fn equivalent(&self) -> Option<bool> {
-        self.verdict(Method::Direct).map(|v| *v == Verdict::Passed)
+        self.verdicts
+            .iter()
+            .find(|(m, _)| m.is_truth())
+            .map(|(_, v)| *v == Verdict::Passed)
     }
 
     /// A non-equivalent mutant that the factored proof passed: a soundness bug.
@@ -490,6 +500,10 @@ pub struct Plan {
     pub quick: bool,
     pub timeout: Duration,
     pub sim_stream: u64,
+    /// The ground truth: [`Method::Direct`] (every gradient), or [`Method::Stream`] (a
+    /// sample of `truth_stream` random gradients) for designs `--direct` cannot take.
+    pub truth: Method,
+    pub truth_stream: u64,
 }
 
 /// Judges mutant `m` of design `d` in `work/m<id>` (design, builds, logs).
@@ -513,18 +527,17 @@ pub fn judge(d: &DesignDir, m: &Mutant, plan: &Plan, work: &Path) -> Result<Outc
             &design,
             &dir.join(format!("build-{}", method.name())),
             &dir.join(format!("{}.log", method.name())),
-            plan.timeout,
-            plan.sim_stream,
+            plan,
         )?;
         verdicts.push((method, v.clone()));
         Ok(v)
     };
     if plan.quick {
         if run(Method::Prove)? == Verdict::Passed {
-            run(Method::Direct)?;
+            run(plan.truth)?;
         }
     } else {
-        run(Method::Direct)?;
+        run(plan.truth)?;
         for &method in &plan.methods {
             run(method)?;
         }
@@ -652,6 +665,28 @@ mod tests {
             (6, 1, 4, 2, 2, 1),
             "{t:?}"
         );
+        // The sampled ground truth classes the same way: a difference the stream found that
+        // prove passed is a soundness bug; what it passed is equivalent as far as it shows.
+        let sampled = [
+            outcome(0, &[(Stream, Passed), (Prove, Passed)]),
+            outcome(1, &[(Stream, Failed), (Prove, Passed)]),
+            outcome(2, &[(Stream, Passed), (Prove, Failed)]),
+            outcome(3, &[(Stream, Failed), (Prove, Failed)]),
+        ];
+        assert!(sampled[1].unsound() && !sampled[2].unsound() && !sampled[3].unsound());
+        let t = tally(Prove, &sampled);
+        assert_eq!(
+            (
+                t.judged,
+                t.equivalent,
+                t.non_equivalent,
+                t.killed,
+                t.survived
+            ),
+            (3, 1, 2, 1, 1)
+        );
+        assert_eq!(tally(Stream, &sampled).judged, 3);
+        assert!(Stream.is_truth() && Direct.is_truth() && !Prove.is_truth());
         let d = tally(Direct, &all);
         assert_eq!(
             (d.judged, d.equivalent, d.non_equivalent, d.killed),

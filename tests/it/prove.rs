@@ -400,10 +400,34 @@ fn bad_input_is_one_line_and_exit_2() {
         "grad_bits = 16 is above 9",
     );
     assert!(!build.exists(), "nothing written");
-    // rmapgen mutants judges by prove --direct, so it takes the same designs.
+    // rmapgen mutants judges every mutant by prove, so it takes the designs prove takes,
+    // whatever its ground truth.
+    for truth in ["direct", "stream"] {
+        helpers::assert_error(
+            &helpers::run(&["mutants", s(&dir), "--build", s(&build), "--truth", truth]),
+            "rmapgen mutants judges by rmapgen prove: rmapgen prove covers",
+        );
+    }
+    assert!(!build.exists(), "nothing written");
+    // A design prove takes but --direct does not (G = 12): the sampled truth is named.
+    let g12 = tmp.path().join("g12");
+    hdl::generate(&g12, &[], 0);
     helpers::assert_error(
-        &helpers::run(&["mutants", s(&dir), "--build", s(&build)]),
-        "the ground truth of rmapgen mutants is prove --direct",
+        &helpers::run(&["mutants", s(&g12), "--build", s(&build)]),
+        "the ground truth of rmapgen mutants is prove --direct: --direct drives all 2^(3 grad_bits) gradients",
+    );
+    helpers::assert_error(
+        &helpers::run(&[
+            "mutants",
+            s(&g12),
+            "--build",
+            s(&build),
+            "--truth",
+            "stream",
+            "--truth-stream",
+            "0",
+        ]),
+        "--truth-stream 0",
     );
     assert!(!build.exists(), "nothing written");
     // A file that is not a report.
