@@ -638,6 +638,68 @@ mod tests {
         );
     }
 
+    /// A refresh in place (`generate` over its own design, `roms --update`): the files this
+    /// run writes are the new ones, every other file of the old output is kept as it was; and
+    /// a single file commits the bytes written, with its record.
+    #[test]
+    fn a_refresh_keeps_the_files_it_does_not_write_and_a_file_holds_what_was_written() {
+        let tmp = tempfile::tempdir().unwrap();
+        let policy = Policy::new(false);
+        let target = tmp.path().join("out");
+        let dir = StagedDir::new(&target, &policy).unwrap();
+        dir.write_text("a.hex", "old a").unwrap();
+        dir.write_text("sub/b.v", "old b").unwrap();
+        dir.commit().unwrap();
+
+        let dir = StagedDir::new(&target, &policy).unwrap();
+        dir.write_text("a.hex", "new a").unwrap();
+        dir.keep_others().unwrap();
+        dir.commit().unwrap();
+        let read = |n: &str| std::fs::read_to_string(target.join(n)).unwrap();
+        assert_eq!(
+            (read("a.hex"), read("sub/b.v")),
+            ("new a\n".into(), "old b\n".into())
+        );
+        // Both are rmapgen's, unchanged: a third run may replace them without --force.
+        assert!(StagedDir::new(&target, &policy).is_ok());
+
+        let f = tmp.path().join("v.hex");
+        let file = StagedFile::new(&f, &policy).unwrap();
+        file.write("0a\n").unwrap();
+        file.commit().unwrap();
+        assert_eq!(std::fs::read(&f).unwrap(), b"0a\n");
+        let again = StagedFile::new(&f, &policy).unwrap();
+        again.write("0b\n").unwrap();
+        again.commit().unwrap();
+        assert_eq!(std::fs::read(&f).unwrap(), b"0b\n");
+    }
+
+    /// A leftover is removed only if it is a directory with rmapgen's mark, left by a
+    /// process that is gone: a live process's (this one's), a user's file of the same name
+    /// and an unmarked directory stay.
+    #[test]
+    fn only_marked_leftovers_of_dead_processes_are_removed() {
+        let tmp = tempfile::tempdir().unwrap();
+        let p = tmp.path();
+        let prefix = hidden_prefix("out", "staging");
+        let dead = p.join(format!("{prefix}4000000"));
+        let dead_old = p.join(format!("{prefix}4000001.old"));
+        let live = p.join(format!("{prefix}{}", std::process::id()));
+        let unmarked = p.join(format!("{prefix}4000002"));
+        let file = p.join(format!("{prefix}4000003"));
+        for d in [&dead, &dead_old, &live] {
+            std::fs::create_dir(d).unwrap();
+            std::fs::write(d.join(STAGING_MARK), b"").unwrap();
+        }
+        std::fs::create_dir(&unmarked).unwrap();
+        std::fs::write(&file, b"mine").unwrap();
+        remove_stale(p, &prefix);
+        assert!(!dead.exists() && !dead_old.exists());
+        assert!(live.is_dir() && unmarked.is_dir() && file.is_file());
+        assert!(process_alive(&std::process::id().to_string()));
+        assert!(!process_alive("4000000"));
+    }
+
     /// A parent that exists as a file is still an error (only a directory made meanwhile is
     /// accepted), and nothing is left behind.
     #[test]
