@@ -4,6 +4,7 @@
 use super::helpers;
 use rmapgen::config::Config;
 use rmapgen::hexfile;
+use rmapgen::model::map_fit::minimax::MinimaxFit;
 use rmapgen::model::map_fit::{self, MapFit};
 use rmapgen::model::reflectance_map;
 use rmapgen::render::{self, Options};
@@ -162,9 +163,10 @@ fn roms_command_takes_map_fit() {
 }
 
 /// `minimax` (the smallest largest error over every direction the pipeline produces): its
-/// maximum error on the sphere is never above `lsq`'s, on every scene shipped in scenes/ and
-/// in the configuration shapes that change the positions (no interpolation, no compensation,
-/// more index bits), and lower on the standard scene and the sharp two-light one
+/// bound over those directions is never above `lsq`'s on every scene shipped in scenes/, its
+/// maximum error on the sphere at most 1 LSB above `lsq`'s there and never above it in the
+/// configuration shapes that change the positions (no interpolation, no compensation, more
+/// index bits), and lower on the standard scene and the sharp two-light one
 /// (docs/PERFORMANCE.md has the table).
 #[test]
 fn minimax_is_never_worse_than_lsq_at_the_maximum() {
@@ -188,11 +190,28 @@ fn minimax_is_never_worse_than_lsq_at_the_maximum() {
     for path in &scenes {
         let scene = Scene::from_toml_file(path).unwrap();
         let cfg = Config::default();
+        // What the fit guarantees: its largest error over every direction the pipeline can
+        // produce is never above lsq's.
+        let fit = MinimaxFit::new(&cfg);
+        let p = scene.prepared();
+        let bound = |f: MapFit| {
+            let mut s = scene.clone();
+            s.map_fit = f;
+            fit.bound(&s.maps(&cfg), |n| p.shade(n))
+        };
+        let (lsq_bound, mm_bound) = (bound(MapFit::Lsq), bound(MapFit::Minimax));
+        assert!(
+            mm_bound <= lsq_bound + 1e-9,
+            "{}: minimax bound {mm_bound}, lsq {lsq_bound}",
+            path.display()
+        );
+        // The sphere is a subset of those directions: its maximum may exceed lsq's by a
+        // rounding (1 LSB on scenes/grazing.toml), never more.
         let (lsq, mm) = (
             max_error(&cfg, &scene, MapFit::Lsq, Options::default()),
             max_error(&cfg, &scene, MapFit::Minimax, Options::default()),
         );
-        assert!(mm <= lsq, "{}: minimax {mm}, lsq {lsq}", path.display());
+        assert!(mm <= lsq + 1, "{}: minimax {mm}, lsq {lsq}", path.display());
         let name = path.file_stem().unwrap().to_string_lossy();
         if name == "standard" || name == "two_lights" {
             assert!(mm < lsq, "{name}: minimax {mm}, lsq {lsq}");

@@ -144,6 +144,18 @@ impl MinimaxFit {
         }
     }
 
+    /// The fit for given position ranges (a compensation table other than the atan one,
+    /// whose ranges its caller knows: [`super::table_fit`]).
+    pub fn with_ranges(cfg: &Config, range: Vec<Option<(f64, f64)>>) -> MinimaxFit {
+        assert_eq!(range.len(), cfg.pos_max() as usize + 1);
+        MinimaxFit {
+            cfg: cfg.clone(),
+            n: cfg.entries() as usize,
+            range,
+            lsq: super::LsqFit::new(cfg),
+        }
+    }
+
     /// The tangent range of every position of one component (None: no gradient reaches it).
     pub fn ranges(&self) -> &[Option<(f64, f64)>] {
         &self.range

@@ -31,6 +31,7 @@
 //!    where it was measured to raise the maximum. [`MapFit::LsqPlain`] leaves it out.
 
 pub mod minimax;
+pub mod table_fit;
 
 use super::{reflectance_map, Maps};
 use crate::config::Config;

@@ -1,0 +1,333 @@
+//! A compensation table fitted to the scene (issue 33, the first lever): the position table
+//! that the atan ROM holds today, chosen together with the maps so that the largest error
+//! over every direction the pipeline can produce is as small as it can be made.
+//!
+//! **Why it helps.** The atan table spreads a quadrant's entries evenly over angle; a sharp
+//! highlight needs them bunched where the intensity turns fastest. The table decides where
+//! the entries sit (which tangents each position stands for), the maps decide their values.
+//!
+//! **What is searched.** One table shared by u and v of every face, as the ROM is today: for
+//! each fraction code c a position t(c) in 0..=pos_max, **monotone** (t(c) <= t(c + 1)), so
+//! every position stands for one contiguous range of tangents and the minimax fit's ranges
+//! stay exact. The state of a sample is its quadrant and its code pair (c_u, c_v); the
+//! pipeline shades it `interpolate(maps, t(c_u), t(c_v))`, and the light model over the
+//! rectangle of tangents the pair stands for lies in [lo, hi] (3 x 3 points of it, as in
+//! [`super::minimax`]). Its error is max(v - lo, hi - v).
+//!
+//! **How.** Rounds of two steps, starting from the atan table: (1) the maps by
+//! [`MinimaxFit`] for the current table (position ranges from the code ranges, no tracing);
+//! (2) the table by coordinate descent with the maps fixed: each code's position moves within
+//! its neighbours' (and by at most [`RADIUS_STEPS`] interpolation steps) to the value that minimises the sum of (error / bound)^[`POWER`] over the states it reaches (a
+//! smooth stand-in for the largest error, dominated by the states near it). The best
+//! (table, maps) by the minimax bound is kept, so the fit is never worse than the atan
+//! table's minimax maps.
+
+use super::minimax::{FitReport, MinimaxFit};
+use super::{quadrant, unpack};
+use crate::config::Config;
+use crate::model::{Maps, Model};
+use crate::stages::interpolate::model as interpolate;
+use crate::stages::map_lookup::model::split;
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// Rounds of (maps, table) after the first maps.
+pub const ROUNDS: usize = 6;
+/// Coordinate-descent sweeps over the table per round (fewer when nothing moves).
+pub const SWEEPS: usize = 3;
+/// The exponent of the descent's objective.
+pub const POWER: i32 = 12;
+/// How far a position may move in one step, in interpolation steps (2^interp_bits positions).
+pub const RADIUS_STEPS: u32 = 1;
+
+/// The per-configuration part: the tangent range of every fraction code.
+#[derive(Clone, Debug)]
+pub struct TableFit {
+    cfg: Config,
+    /// For each fraction code: the smallest and largest tangent (component / max) that the
+    /// pipeline's sort and normalise stages give it, or None when no gradient reaches it.
+    range: Vec<Option<(f64, f64)>>,
+    /// The reachable codes, ascending.
+    codes: Vec<usize>,
+}
+
+/// What one frame's table fit did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TableFitReport {
+    /// The minimax bound (output LSBs) of the atan table with its minimax maps.
+    pub atan_bound: f64,
+    /// The minimax bound of the fitted table with its maps.
+    pub bound: f64,
+    /// Table entries that differ from the atan table.
+    pub changed: usize,
+}
+
+/// The light model's range over every state of one quadrant: [c_u * codes + c_v] -> (lo, hi).
+struct Quadrant {
+    lo: Vec<f64>,
+    hi: Vec<f64>,
+}
+
+impl TableFit {
+    /// The code ranges of `cfg` (compensation on), every (max, component) pair traced (the
+    /// code does not depend on the table).
+    pub fn new(cfg: &Config) -> TableFit {
+        assert!(
+            cfg.compensation,
+            "a fitted table replaces the compensation table"
+        );
+        let model = Model::new(cfg);
+        let blank = Maps::from_data(cfg, vec![0; 3 * cfg.map_entries() as usize]);
+        let top = (1u64 << (cfg.grad_bits - 1)) - 1;
+        let n = cfg.frac_max() as usize + 1;
+        let parts: Vec<Vec<Option<(f64, f64)>>> = (1..=top)
+            .into_par_iter()
+            .map(|m| {
+                let mut r = vec![None; n];
+                for c in 0..=m {
+                    let u = model.trace(&blank, [m as i32, c as i32, 0], [0; 3]).norm.u;
+                    let t = c as f64 / m as f64;
+                    widen(&mut r[u as usize], (t, t));
+                }
+                r
+            })
+            .collect();
+        let mut range = vec![None; n];
+        for r in parts {
+            for (acc, x) in range.iter_mut().zip(r) {
+                if let Some(x) = x {
+                    widen(acc, x);
+                }
+            }
+        }
+        let codes = (0..n).filter(|&c| range[c].is_some()).collect();
+        TableFit {
+            cfg: cfg.clone(),
+            range,
+            codes,
+        }
+    }
+
+    /// The minimax maps for `table`: each position's range is the union of its codes'.
+    pub fn maps(&self, table: &[u32], shade: &(impl Fn(DVec3) -> f64 + Sync)) -> (Maps, FitReport) {
+        let mut pos: Vec<Option<(f64, f64)>> = vec![None; self.cfg.pos_max() as usize + 1];
+        for &c in &self.codes {
+            widen(
+                &mut pos[table[c] as usize],
+                self.range[c].expect("reachable"),
+            );
+        }
+        MinimaxFit::with_ranges(&self.cfg, pos).fit_report(shade)
+    }
+
+    /// The fitted table and its maps for one frame.
+    pub fn fit(&self, shade: impl Fn(DVec3) -> f64 + Sync) -> (Vec<u32>, Maps, TableFitReport) {
+        let cfg = &self.cfg;
+        let atan = crate::model::atan_rom::contents(cfg);
+        let (maps, first) = self.maps(&atan, &shade);
+        let quadrants = self.states(&shade);
+        let mut best = (first.bound, atan.clone(), maps.clone());
+        let (mut table, mut maps, mut bound) = (atan.clone(), maps, first.bound);
+        for _ in 0..ROUNDS {
+            let ents: Vec<Vec<u32>> = (0..24).map(|q| unpack(cfg, &maps, q)).collect();
+            let mut moved = 0;
+            for _ in 0..SWEEPS {
+                let m = self.sweep(&quadrants, &mut table, &ents, bound.max(1.0));
+                moved += m;
+                if m == 0 {
+                    break;
+                }
+            }
+            if moved == 0 {
+                break;
+            }
+            let (m, r) = self.maps(&table, &shade);
+            (maps, bound) = (m, r.bound);
+            if bound < best.0 {
+                best = (bound, table.clone(), maps.clone());
+            }
+        }
+        let (bound, mut table, maps) = best;
+        // A code no gradient reaches keeps the position of the reachable code below it (0
+        // below the first), so the whole table is monotone; the hardware never reads it.
+        let mut last = 0;
+        for (c, t) in table.iter_mut().enumerate() {
+            if self.range[c].is_some() {
+                last = *t;
+            } else {
+                *t = last;
+            }
+        }
+        let changed = table.iter().zip(&atan).filter(|(a, b)| a != b).count();
+        let report = TableFitReport {
+            atan_bound: first.bound,
+            bound,
+            changed,
+        };
+        (table, maps, report)
+    }
+
+    /// The light model's range over every (quadrant, code pair) state.
+    fn states(&self, shade: &(impl Fn(DVec3) -> f64 + Sync)) -> Vec<Quadrant> {
+        let n = self.range.len();
+        let top = self.cfg.map_max() as f64;
+        (0..24u32)
+            .into_par_iter()
+            .map(|q| {
+                let (axis, s_max, s_u, s_v) = quadrant(q);
+                let sg = |s: u32, t: f64| if s == 1 { -t } else { t };
+                let light = |tu: f64, tv: f64| {
+                    let [x, y, z] =
+                        crate::geometry::place(axis, sg(s_max, 1.0), sg(s_u, tu), sg(s_v, tv));
+                    let i = shade(crate::geometry::sym_normalize(DVec3::new(x, y, z)));
+                    if i.is_nan() {
+                        0.0
+                    } else {
+                        i.clamp(0.0, 1.0) * top
+                    }
+                };
+                let mut lo = vec![f64::NAN; n * n];
+                let mut hi = vec![f64::NAN; n * n];
+                for &cu in &self.codes {
+                    let (u0, u1) = self.range[cu].expect("reachable");
+                    for &cv in &self.codes {
+                        let (v0, v1) = self.range[cv].expect("reachable");
+                        let (mut l, mut h) = (f64::INFINITY, f64::NEG_INFINITY);
+                        for tu in [u0, (u0 + u1) / 2.0, u1] {
+                            for tv in [v0, (v0 + v1) / 2.0, v1] {
+                                let i = light(tu, tv);
+                                l = l.min(i);
+                                h = h.max(i);
+                            }
+                        }
+                        lo[cu * n + cv] = l;
+                        hi[cu * n + cv] = h;
+                    }
+                }
+                Quadrant { lo, hi }
+            })
+            .collect()
+    }
+
+    /// The hardware's value of quadrant entries `e` at positions (p_u, p_v).
+    fn value(&self, e: &[u32], pu: u32, pv: u32) -> u32 {
+        let cfg = &self.cfg;
+        let n = cfg.entries() as usize;
+        let (bu, wu) = split(cfg, pu);
+        let (bv, wv) = split(cfg, pv);
+        let (bu, bv) = (bu as usize, bv as usize);
+        if !cfg.interpolation {
+            return e[bu * n + bv];
+        }
+        let at = |du: usize, dv: usize| e[(bu + du) * n + bv + dv];
+        interpolate::eval(cfg, [at(0, 0), at(1, 0), at(0, 1), at(1, 1)], wu, wv)
+    }
+
+    /// One sweep of coordinate descent over the table, maps fixed; returns the entries moved.
+    fn sweep(
+        &self,
+        quadrants: &[Quadrant],
+        table: &mut [u32],
+        ents: &[Vec<u32>],
+        scale: f64,
+    ) -> usize {
+        let n = self.range.len();
+        let pmax = self.cfg.pos_max();
+        let radius = RADIUS_STEPS * self.cfg.step().max(1);
+        let mut moved = 0;
+        for (i, &c) in self.codes.iter().enumerate() {
+            let cost = |pc: u32| -> f64 {
+                let mut sum = 0.0;
+                for (qd, e) in quadrants.iter().zip(ents) {
+                    for &o in &self.codes {
+                        let po = if o == c { pc } else { table[o] };
+                        let k = c * n + o;
+                        sum +=
+                            (error(self.value(e, pc, po), qd.lo[k], qd.hi[k]) / scale).powi(POWER);
+                        if o != c {
+                            let k = o * n + c;
+                            sum += (error(self.value(e, po, pc), qd.lo[k], qd.hi[k]) / scale)
+                                .powi(POWER);
+                        }
+                    }
+                }
+                sum
+            };
+            let cur = table[c];
+            let below = if i == 0 { 0 } else { table[self.codes[i - 1]] };
+            let above = self.codes.get(i + 1).map_or(pmax, |&next| table[next]);
+            let lo = cur.saturating_sub(radius).max(below);
+            let hi = (cur + radius).min(above).min(pmax);
+            // The lowest cost; among equal costs the position nearest the current one.
+            let (_, best) = (lo..=hi)
+                .into_par_iter()
+                .map(|p| (cost(p), p))
+                .min_by(|a, b| {
+                    a.0.total_cmp(&b.0)
+                        .then(a.1.abs_diff(cur).cmp(&b.1.abs_diff(cur)))
+                        .then(a.1.cmp(&b.1))
+                })
+                .expect("lo <= cur <= hi");
+            if best != cur {
+                table[c] = best;
+                moved += 1;
+            }
+        }
+        moved
+    }
+}
+
+fn widen(acc: &mut Option<(f64, f64)>, (lo, hi): (f64, f64)) {
+    let e = acc.get_or_insert((lo, hi));
+    e.0 = e.0.min(lo);
+    e.1 = e.1.max(hi);
+}
+
+fn error(v: u32, lo: f64, hi: f64) -> f64 {
+    let v = v as f64;
+    (v - lo).max(hi - v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Scene;
+
+    /// On a G = 8 design and the standard scene: the fitted table is monotone, within the
+    /// positions, never worse than the atan table by the minimax bound and, on this sharp
+    /// enough scene, better; and the model with the table and maps shades within that bound
+    /// of the light model on every sphere pixel (plus 1 LSB: the bound samples each state's
+    /// rectangle of directions at 3 x 3 points).
+    #[test]
+    fn the_fitted_table_is_monotone_and_lowers_the_bound() {
+        let cfg = Config {
+            grad_bits: 8,
+            red_bits: 6,
+            ..Config::default()
+        };
+        cfg.validate().unwrap();
+        let scene = Scene::standard();
+        let p = scene.prepared();
+        let fit = TableFit::new(&cfg);
+        let (table, maps, r) = fit.fit(|n| p.shade(n));
+        assert_eq!(table.len(), cfg.frac_max() as usize + 1);
+        assert!(table.windows(2).all(|w| w[0] <= w[1]), "{table:?}");
+        assert!(table.iter().all(|&t| t <= cfg.pos_max()));
+        assert!(r.bound < r.atan_bound - 1.0, "{r:?}");
+        assert!(r.changed > 0);
+        let mut model = Model::new(&cfg);
+        model.atan = Some(table);
+        let px = crate::render::sphere_gradients(&cfg, 128, 0);
+        let reference = crate::reference::Reference::new(&cfg, &scene);
+        for (_, _, g) in px {
+            let m = model.intensity(&maps, g);
+            let exact = reference.exact(g).unwrap().clamp(0.0, 1.0) * cfg.map_max() as f64;
+            let e = (m as f64 - exact).abs();
+            assert!(
+                e <= r.bound + 1.0,
+                "{g:?}: model {m}, light {exact}, bound {}",
+                r.bound
+            );
+        }
+    }
+}
