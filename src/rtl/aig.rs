@@ -484,6 +484,55 @@ mod tests {
         assert_eq!(g.used(), vec![false, false, true]);
     }
 
+    /// Compiling folds constants: an AND with a fixed 0, x AND NOT x (0), NOT a AND NOT a
+    /// (NOT a); a gate of two free inputs stays. The folded program computes the same values.
+    #[test]
+    fn compile_folds_constants_and_keeps_the_values() {
+        // a = var 1, b = var 2; 6 = !a & !a, 8 = a & !a, 10 = a & b; outputs 6, 8, 10.
+        let aag = "aag 5 2 0 3 3\n2\n4\n6\n8\n10\n6 3 3\n8 2 3\n10 2 4\n";
+        let map = "input 0 0 a\ninput 1 0 b\noutput 0 0 o1\noutput 1 0 o2\noutput 2 0 o3\n";
+        let g = Aig::parse(aag, map).unwrap();
+        let run = |p: &Program, free: &[u64]| {
+            let mut vals = Vec::new();
+            let mut out = [[0u64; 1]; 3];
+            p.eval(&mut vals, |j| [free[j]], &mut out);
+            out.map(|o| o[0])
+        };
+        // b fixed to 0: every gate folds.
+        let p = compile(&g, &[None, Some(false)], &[0]);
+        assert_eq!(p.gates(), 0);
+        let [o1, o2, o3] = run(&p, &[0b10]);
+        assert_eq!((o1 & 0b11, o2 & 0b11, o3 & 0b11), (0b01, 0, 0));
+        // Both free: a & b stays a gate.
+        let p = compile(&g, &[None, None], &[0, 1]);
+        assert_eq!(p.gates(), 1);
+        let [o1, o2, o3] = run(&p, &[0b1010, 0b1100]);
+        assert_eq!((o1 & 0xf, o2 & 0xf, o3 & 0xf), (0b0101, 0, 0b1000));
+    }
+
+    /// With fewer free inputs than a block holds, every input counts, the last one too:
+    /// ok = NOT (x AND y) fails only at input 3.
+    #[test]
+    fn a_failure_at_the_last_of_a_few_inputs_is_found() {
+        let aag = "aag 3 2 0 1 1\n2\n4\n7\n6 2 4\n";
+        let map = "input 0 0 x\ninput 1 0 y\noutput 0 0 ok\n";
+        let g = Aig::parse(aag, map).unwrap();
+        let f = exhaustive(&g, &[Vec::new()]).unwrap();
+        assert_eq!(f, Some(vec![("x".into(), 1), ("y".into(), 1)]));
+    }
+
+    /// A case fixes every bit of a wide signal: ok = NOT (s[1] AND x) fails with s = 2 fixed
+    /// and passes with s = 1 fixed.
+    #[test]
+    fn a_case_fixes_the_high_bits_of_a_signal() {
+        let aag = "aag 4 3 0 1 1\n2\n4\n6\n9\n8 4 6\n";
+        let map = "input 0 0 s\ninput 1 1 s\ninput 2 0 x\noutput 0 0 ok\n";
+        let g = Aig::parse(aag, map).unwrap();
+        let f = exhaustive(&g, &[vec![("s".into(), 2)]]).unwrap();
+        assert_eq!(f, Some(vec![("s".into(), 2), ("x".into(), 1)]));
+        assert_eq!(exhaustive(&g, &[vec![("s".into(), 1)]]).unwrap(), None);
+    }
+
     #[test]
     fn refuses_latches_and_unknown_case_signals() {
         assert!(Aig::parse("aag 1 0 1 1 0\n2 3\n2\n", "").is_err());
