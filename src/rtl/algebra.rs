@@ -474,6 +474,30 @@ mod tests {
         assert!(s.steps > 0);
     }
 
+    /// An AND node inherits the exclusions of its uncomplemented operands only. With the
+    /// half adder k = a & b, s = a ^ b (never both 1), n = !k & x can be 1 with s (a = 1,
+    /// b = 0, x = 1): the term n * s of y = n & s must stay, and y differs from 0.
+    #[test]
+    fn a_complemented_operand_passes_on_no_exclusions() {
+        let mut c = Circuit {
+            inputs: Vec::new(),
+            nodes: Vec::new(),
+            outputs: Vec::new(),
+        };
+        let ab = inputs(&mut c, "a", 2);
+        let x = inputs(&mut c, "x", 1)[0];
+        let s = c.xor(ab[0], ab[1]);
+        let k = c.and(ab[0], ab[1]);
+        let n = c.and(k ^ 1, x);
+        let y = c.and(n, s);
+        c.outputs = vec![vec![y], vec![0]];
+        let (v, _) = equal_mod(&c, 0, 1, 1).unwrap();
+        let Verdict::Differ { input, .. } = v else {
+            panic!("y is 1 at a = 1, b = 0, x = 1, and the rewriting said {v:?}");
+        };
+        assert!(c.eval(&input)[0][0], "{input:?}");
+    }
+
     /// Widths outside 1..=64 are refused (64 is taken); and the half adders' exclusions
     /// drop the terms that vanish as they appear, so the polynomial of the 4 x 3 product
     /// never holds more than 24 terms (without the rule it holds more: the rule is what
