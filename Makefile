@@ -293,6 +293,42 @@ mutants-default:
 	  --method prove --seed $(MUTANTS_SEED) --jobs $(MUTANTS_JOBS) --timeout 3600 \
 	  --build build/mutants-default --report build/mutants-default.json
 
+# ---- cargo-mutants over the Rust that issues verdicts (issue 31, part 2; figures in
+# docs/VERIFICATION.md): `make rust-mutants RUST_MUTANTS_GROUP=G` with G one of
+#   engines  the proof engines src/rtl/{mult_proof,algebra,aig,netlist}.rs
+#   prove    src/prove (parts, shards, reports, --merge)
+#   output   src/output (what rmapgen writes and removes)
+#   model    src/model (the golden model)
+# Each mutant is built in the `mutants` profile (opt-level 1: a 3-6 s rebuild, against 23 s
+# at the dev profile's opt-level 2) and judged by nextest, which stops at the first failing
+# test: every unit test, and the integration tests of the group (RUST_MUTANTS_TESTS_G). A
+# mutant no test fails is listed in build/rust-mutants/G/mutants.out/missed.txt; each gets
+# the test that kills it or is shown equivalent in docs/VERIFICATION.md.
+# RUST_MUTANTS_SHARD=K/N runs a round-robin part; RUST_MUTANTS_ARGS passes more options to
+# cargo-mutants (`--re REGEX`, `--iterate`, `--in-place`). Hours for model and prove.
+RUST_MUTANTS_GROUP ?= engines
+RUST_MUTANTS_SHARD ?= 0/1
+RUST_MUTANTS_ARGS  ?=
+RUST_MUTANTS_FILES_engines := -f src/rtl/mult_proof.rs -f src/rtl/algebra.rs -f src/rtl/aig.rs -f src/rtl/netlist.rs
+RUST_MUTANTS_TESTS_engines := mult_proof|prove
+RUST_MUTANTS_FILES_prove   := -f 'src/prove/**'
+RUST_MUTANTS_TESTS_prove   := prove|errors
+RUST_MUTANTS_FILES_output  := -f 'src/output/**'
+RUST_MUTANTS_TESTS_output  := output_safety|nothing_left|init_files|stdout
+RUST_MUTANTS_FILES_model   := -f 'src/model/**'
+RUST_MUTANTS_TESTS_model   := rtl_generate|model_stages|vectors|symmetry|stability|fast|map_fit|compare
+
+.PHONY: rust-mutants
+rust-mutants:
+	@test -n "$(RUST_MUTANTS_FILES_$(RUST_MUTANTS_GROUP))" || \
+	  { echo "RUST_MUTANTS_GROUP=$(RUST_MUTANTS_GROUP): not one of engines prove output model"; exit 2; }
+	command -v cargo-mutants >/dev/null || $(CARGO) install cargo-mutants --locked --version 27.1.0
+	command -v cargo-nextest >/dev/null || $(CARGO) install cargo-nextest --locked
+	$(CARGO) mutants --profile mutants --test-tool nextest $(RUST_MUTANTS_FILES_$(RUST_MUTANTS_GROUP)) \
+	  --shard $(RUST_MUTANTS_SHARD) --sharding round-robin -o build/rust-mutants/$(RUST_MUTANTS_GROUP) \
+	  $(RUST_MUTANTS_ARGS) \
+	  -- -E 'kind(lib) | (binary(it) & test(/^($(RUST_MUTANTS_TESTS_$(RUST_MUTANTS_GROUP)))::/))'
+
 # ---- Multipliers (rmapgen prove-mult, src/rtl/mult_proof.rs): every adder tree of a
 # generated design equals the product its plan states (a * b + c) on every input. The
 # default design ($(OUT), 5 trees) under engine auto (every input evaluated, ~10 s), then

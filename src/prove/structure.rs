@@ -46,6 +46,8 @@ struct Cell {
     params: HashMap<String, String>,
     /// The input pins with an undefined bit (`x` or `z`).
     undefined: Vec<String>,
+    /// Where the RTL writes it (Yosys's `src` attribute, `normalise.v:73.3-75.6`).
+    src: String,
 }
 
 struct Module {
@@ -113,6 +115,7 @@ fn module(json: &Value, name: &str) -> Result<Module> {
                 outputs,
                 params,
                 undefined,
+                src: c["attributes"]["src"].as_str().unwrap_or("").to_string(),
             }
         })
         .collect();
@@ -127,6 +130,52 @@ fn read(path: &Path) -> Result<Value> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
     serde_json::from_str(&text).with_context(|| format!("{} is not JSON", path.display()))
+}
+
+/// The registers of `m` (a flattened netlist with constants folded, before `opt_dff`) with
+/// bits that are never loaded: `$dff` or `$dffe` (no reset or load that defines them) whose D
+/// bit is its own Q bit. Each as (a name of its output, its source, the bits, `[0]`,
+/// `[3, 5]`).
+fn never_loaded(m: &Module) -> Vec<(String, String, String)> {
+    let mut v = Vec::new();
+    for c in &m.cells {
+        if c.kind != "$dff" && c.kind != "$dffe" {
+            continue;
+        }
+        let pin = |list: &[(String, Vec<Bit>)], p: &str| {
+            list.iter()
+                .find(|(n, _)| n == p)
+                .map(|(_, b)| b.clone())
+                .unwrap_or_default()
+        };
+        let (d, q) = (pin(&c.inputs, "D"), pin(&c.outputs, "Q"));
+        let held: Vec<usize> = (0..d.len().min(q.len()))
+            .filter(|&i| d[i].is_some() && d[i] == q[i])
+            .collect();
+        if held.is_empty() {
+            continue;
+        }
+        // The register's own name: among the nets that are exactly its Q, a register's name
+        // (`_q`, `_q2`: the generated RTL's naming) first, then the shortest.
+        let reg_name = |n: &str| {
+            let t = n.trim_end_matches(|ch: char| ch.is_ascii_digit());
+            t.ends_with("_q")
+        };
+        let name = m
+            .netnames
+            .iter()
+            .filter(|(_, b)| **b == q)
+            .map(|(n, _)| n.as_str())
+            .min_by_key(|n| (n.starts_with('$'), !reg_name(n), n.len(), n.to_string()))
+            .unwrap_or(&c.name)
+            .to_string();
+        // `rmap_top.v:210.15-223.4|interpolate.v:240.3-240.44`: the innermost, line only.
+        let inner = c.src.rsplit('|').next().unwrap_or_default();
+        let src = inner.split('.').take(2).collect::<Vec<_>>().join(".");
+        v.push((name, src, format!("{held:?}")));
+    }
+    v.sort();
+    v
 }
 
 fn is_register(kind: &str) -> bool {
@@ -226,12 +275,13 @@ pub fn check(d: &DesignDir, build: &Path) -> Result<Part> {
         let axis = crate::stages::top(cfg).file(cfg);
         files.retain(|f| *f != axis);
     }
-    let (hier, flat) = yosys::structure(d.path(), &top_name, &files, &logs)?;
+    let netlists = yosys::structure(d.path(), &top_name, &files, &logs)?;
+    let (hier, flat) = (&netlists.hier, &netlists.flat);
     let mut fails = Failures::default();
     let (sample_in, data_out) = sample_ports(d);
 
     // The gradient reaches only the front.
-    let hier = read(&hier)?;
+    let hier = read(hier)?;
     let top = module(&hier, &top_name)?;
     let front: Vec<String> = FRONT.iter().map(|u| u.module(cfg)).collect();
     let grad: Vec<u64> = ["gx_i", "gy_i", "gz_i"]
@@ -277,7 +327,7 @@ pub fn check(d: &DesignDir, build: &Path) -> Result<Part> {
     }
 
     // One sample at a time, in the flattened design.
-    let flat = read(&flat)?;
+    let flat = read(flat)?;
     let m = module(&flat, &top_name)?;
     let mut sources: Vec<u64> = Vec::new();
     for p in &sample_in {
@@ -285,6 +335,18 @@ pub fn check(d: &DesignDir, build: &Path) -> Result<Part> {
             Some((_, b)) => sources.extend(b.iter().flatten()),
             None => fails.add(format!("structure: the top has no sample input {p}")),
         }
+    }
+    // No register is never loaded. With constants folded, a register bit whose D is its own
+    // Q, with no reset to load it, holds its power-up value for ever: Verilog leaves that
+    // value undefined, Verilator's two-state simulation (the proof's, and its ground
+    // truth's) gives it 0, synthesis any value it likes. Checked on the registers as `proc`
+    // wrote them, whatever reads them: after `opt_dff` such a register is an `x`, which the
+    // check below finds only where no multiplexer's data input hides it.
+    let folded = read(&netlists.folded)?;
+    for (reg, src, held) in never_loaded(&module(&folded, &top_name)?) {
+        fails.add(format!(
+            "structure: register {reg} ({src}) is never loaded: bits {held} hold their power-up value, which Verilog leaves undefined (simulation reads 0, synthesis any value)"
+        ));
     }
     // No undefined value is read. A register that is never loaded (its enable inverted, its
     // input its own output) is removed by opt_dff and read as `x`: Verilator's two-state

@@ -70,7 +70,7 @@ impl Aig {
         let mut input_vars = Vec::with_capacity(ni as usize);
         for _ in 0..ni {
             let lit = num(lines.next(), "input literal")?;
-            if lit & 1 == 1 || lit == 0 {
+            if lit & 1 == 1 || lit == 0 || lit / 2 > max_var {
                 bail!("bad input literal {lit}");
             }
             input_vars.push(lit / 2);
@@ -458,6 +458,104 @@ mod tests {
         }
     }
 
+    /// Each check of the parser refuses what it exists for, with its message, and takes the
+    /// limits it allows (an output literal of the last variable, a map line of another kind).
+    /// The file comes from Yosys, but an engine that reads a wrong literal proves the wrong
+    /// circuit.
+    #[test]
+    fn refuses_each_malformed_header_literal_and_map() {
+        let body = "2\n4\n6\n6 2 4\n";
+        let head = "aag 3 2 0 1 1\n";
+        let map = "input 0 0 x\ninput 1 0 y\noutput 0 0 ok\n";
+        let take = |aag: &str, map: &str| Aig::parse(aag, map).unwrap();
+        take(&format!("{head}{body}"), map);
+        // Output 7 is !var 3, the last variable; lines of another kind or length are skipped.
+        take(&format!("{head}2\n4\n7\n6 2 4\n"), map);
+        take(
+            &format!("{head}{body}"),
+            &format!("wire 0 0 q\ninput 0 0\n{map}"),
+        );
+        let refused = [
+            (
+                "aag 3 2 0 1\n".to_string() + body,
+                map,
+                "not an ASCII AIGER header",
+            ),
+            (
+                "aag 3 2 0 1 1 1\n".to_string() + body,
+                map,
+                "not an ASCII AIGER header",
+            ),
+            (
+                "aig 3 2 0 1 1\n".to_string() + body,
+                map,
+                "not an ASCII AIGER header",
+            ),
+            (
+                "aag 3 x 0 1 1\n".to_string() + body,
+                map,
+                "bad AIGER header",
+            ),
+            (
+                format!("{head}3\n4\n6\n6 2 4\n"),
+                map,
+                "bad input literal 3",
+            ),
+            (
+                format!("{head}0\n4\n6\n6 2 4\n"),
+                map,
+                "bad input literal 0",
+            ),
+            (
+                format!("{head}2\n8\n6\n6 2 4\n"),
+                map,
+                "bad input literal 8",
+            ),
+            (
+                format!("{head}2\n4\n8\n6 2 4\n"),
+                map,
+                "output literal 8 out of range",
+            ),
+            (format!("{head}2\n4\n"), map, "missing output literal"),
+            (format!("{head}2\n4\n6\n6 2\n"), map, "missing AND rhs"),
+            (
+                format!("{head}{body}"),
+                "input 0 0 x\noutput 0 0 ok\n",
+                "names 1 of 2 inputs",
+            ),
+            (
+                format!("{head}{body}"),
+                "input 0 0 x\ninput 0 0 y\n",
+                "names input 0 twice",
+            ),
+            (
+                format!("{head}{body}"),
+                "input 0 0 x\ninput 2 0 y\n",
+                "map names input 2 of 2",
+            ),
+            (
+                format!("{head}{body}"),
+                "input 0 0 x\ninput 1 0 y\noutput 0 0 a\noutput 0 0 b\n",
+                "names output 0 twice",
+            ),
+            (
+                format!("{head}{body}"),
+                "input 0 0 x\ninput z 0 y\n",
+                "bad map index",
+            ),
+            (
+                format!("{head}{body}"),
+                "input 0 0 x\ninput 1 z y\n",
+                "bad map bit",
+            ),
+        ];
+        for (aag, map, want) in refused {
+            let e = Aig::parse(&aag, map).err();
+            let e = e.unwrap_or_else(|| panic!("taken: {aag} / {map}"));
+            assert!(format!("{e:#}").contains(want), "{want}: {e:#}");
+        }
+    }
+
     /// A miter has one output (its `ok`); two are refused before any evaluation.
     #[test]
     fn a_miter_with_two_outputs_is_refused() {
@@ -508,6 +606,19 @@ mod tests {
         assert_eq!(p.gates(), 1);
         let [o1, o2, o3] = run(&p, &[0b1010, 0b1100]);
         assert_eq!((o1 & 0xf, o2 & 0xf, o3 & 0xf), (0b0101, 0, 0b1000));
+        // A complemented reference to a folded literal is its complement: a fixed to 1 makes
+        // !a the constant 0 (so 8 = a & !a and 10's twin below fold to 0), and a gate folded to
+        // !b read complemented is b. (cargo-mutants: `^` -> `|` in `lit` kept !1 as 1 and
+        // !!b as !b.)
+        // 6 = !a & b, 8 = 1-of-a & !b = !b with a = 1, 10 = !8 & b = b & b.
+        let aag = "aag 5 2 0 2 3\n2\n4\n6\n10\n6 3 4\n8 2 5\n10 9 4\n";
+        let map = "input 0 0 a\ninput 1 0 b\noutput 0 0 o1\noutput 1 0 o2\n";
+        let g = Aig::parse(aag, map).unwrap();
+        let p = compile(&g, &[Some(true), None], &[1]);
+        let mut vals = Vec::new();
+        let mut out = [[0u64; 1]; 2];
+        p.eval(&mut vals, |_| [0b10], &mut out);
+        assert_eq!((out[0][0] & 0b11, out[1][0] & 0b11), (0, 0b10));
     }
 
     /// With fewer free inputs than a block holds, every input counts, the last one too:

@@ -748,13 +748,17 @@ mod tests {
             let mut exposes = s.lines().filter(|l| l.starts_with("expose -cut "));
             for j in &jobs {
                 let inputs: Vec<String> = j.spec.inputs().into_iter().map(|x| x.name).collect();
-                let free: Vec<&String> =
-                    inputs.iter().filter(|n| !j.input_ports.contains(n)).collect();
+                let free: Vec<&String> = inputs
+                    .iter()
+                    .filter(|n| !j.input_ports.contains(n))
+                    .collect();
                 if free.is_empty() {
                     continue;
                 }
                 cut_somewhere += 1;
-                let line = exposes.next().unwrap_or_else(|| panic!("{}: no cut", j.name()));
+                let line = exposes
+                    .next()
+                    .unwrap_or_else(|| panic!("{}: no cut", j.name()));
                 let names: Vec<&str> = line["expose -cut ".len()..].split(' ').collect();
                 assert_eq!(names.len(), free.len(), "{}: {line}", j.name());
                 for n in free {

@@ -340,21 +340,25 @@ fn last_count(counts: &[(String, u32)], is: impl Fn(&str) -> bool) -> u32 {
 /// enables (`opt_dff`; `-nosdff`, so that no data multiplexer becomes a synchronous reset).
 /// No memory pass runs: `memory_dff` would fold the data registers into the reads and
 /// rewrite their enables as address multiplexers.
-pub fn structure(
-    dir: &Path,
-    top: &str,
-    files: &[String],
-    logs: &Path,
-) -> Result<(PathBuf, PathBuf)> {
+///
+/// The three netlists: the hierarchy (`hier.json`), the flattened design with constants
+/// folded but every register as `proc` wrote it (`folded.json`: a register that is never
+/// loaded still has its D wired to its own Q there, where `opt_dff` would replace it by its
+/// undefined power-up value), and the flattened design after `opt_dff` (`flat.json`).
+pub fn structure(dir: &Path, top: &str, files: &[String], logs: &Path) -> Result<Structure> {
     crate::disk::create_dir_all(logs)?;
-    let hier = logs.join("hier.json");
-    let flat = logs.join("flat.json");
+    let out = Structure {
+        hier: logs.join("hier.json"),
+        folded: logs.join("folded.json"),
+        flat: logs.join("flat.json"),
+    };
     let script = format!(
         "read_verilog {}; hierarchy -check -top {top}; proc; opt_clean; write_json {}; \
-         flatten; opt_expr; opt_clean; opt_dff -nosdff; opt_clean; write_json {}",
+         flatten; opt_expr; opt_clean; write_json {}; opt_dff -nosdff; opt_clean; write_json {}",
         files.join(" "),
-        super::quoted(&hier.to_string_lossy()),
-        super::quoted(&flat.to_string_lossy()),
+        super::quoted(&out.hier.to_string_lossy()),
+        super::quoted(&out.folded.to_string_lossy()),
+        super::quoted(&out.flat.to_string_lossy()),
     );
     let ran = super::run_logged(&mut command(dir, logs, &script), &logs.join("yosys.out"))?;
     if !ran.success() {
@@ -364,7 +368,14 @@ pub fn structure(
             super::complaint(&ran.output)
         );
     }
-    Ok((hier, flat))
+    Ok(out)
+}
+
+/// The netlists [`structure`] writes.
+pub struct Structure {
+    pub hier: PathBuf,
+    pub folded: PathBuf,
+    pub flat: PathBuf,
 }
 
 /// The and-inverter graph `rmapgen prove`'s gate-level front evaluates: `top` (a wrapper

@@ -264,7 +264,35 @@ fn a_small_design_is_proven_in_two_shards_and_every_part_catches_a_planted_fault
     assert_fails(
         &o,
         "structure",
-        &["reads an undefined value on D", "never loaded"],
+        &[
+            "reads an undefined value on D",
+            "register u_normalise.a_max_q2 (normalise.v:",
+            "is never loaded",
+        ],
+    );
+
+    // A register never loaded whose value reaches only a multiplexer's data input: `opt_dff`
+    // makes it an `x`, which a data input may carry (`proc` writes `x` into inputs no path
+    // selects), so the undefined-value check above passed it, and so did every simulation
+    // (two-state: it reads 0, and valid_q ? valid_q : 0 is valid_q); synthesis may make it 1
+    // and raise valid_o for ever. The structure now finds registers whose D is their own Q
+    // before `opt_dff` removes them, whatever reads them.
+    let d = tmp.path().join("held");
+    plant(
+        &dir,
+        &d,
+        "interpolate.v",
+        "  assign valid_o = valid_q[LATENCY-1];",
+        "  reg hold_q;\n  always @(posedge clk_i) hold_q <= hold_q;\n  assign valid_o = valid_q[LATENCY-1] ? valid_q[LATENCY-1] : hold_q;",
+    );
+    let o = prove(&d, &build, &["--part", "structure"]);
+    assert_fails(
+        &o,
+        "structure",
+        &[
+            "register u_interpolate.hold_q (interpolate.v:",
+            "is never loaded: bits [0]",
+        ],
     );
 
     // The last stage never raises valid_o: no result leaves the top. A wrong design, so a
