@@ -11,7 +11,7 @@
 //! optional stages, the AXI4-Stream top, 2 and 4 lanes with and without the handshake, and
 //! both multiplier styles (`--mult infer` at every depth, with and without the handshake).
 
-use crate::config::{Config, Mult, Target, RANGES};
+use crate::config::{CompTable, Config, Mult, Target, RANGES};
 
 /// One configuration of the grid.
 #[derive(Clone, Debug, PartialEq)]
@@ -31,7 +31,8 @@ macro_rules! grid {
     ($( $name:ident: $g:literal $r:literal $w:literal $f:literal $i:literal $p:literal $m:literal
         $comp:literal $interp:literal $color:literal $depth:literal $hs:literal $icarus:literal
         $ice40:literal
-        $(axis $user:literal)? $(lanes $lanes:literal)? $(mult $mult:ident)? $covers:literal; )*) => {
+        $(axis $user:literal)? $(lanes $lanes:literal)? $(mult $mult:ident)? $(table $table:ident)?
+        $covers:literal; )*) => {
         /// Every row, in the order below.
         pub fn rows() -> Vec<GridRow> {
             vec![$(GridRow {
@@ -47,6 +48,7 @@ macro_rules! grid {
                     axis_user: 0 $(+ $user)?,
                     lanes: 1 $(- 1 + $lanes)?,
                     mult: *[Mult::Tree $(, Mult::$mult)?].last().expect("a style"),
+                    comp_table: *[CompTable::Rom $(, CompTable::$table)?].last().expect("a table"),
                 },
                 icarus: $icarus == 1,
                 covers: $covers,
