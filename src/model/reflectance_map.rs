@@ -31,8 +31,8 @@ impl Maps {
     }
 
     /// These maps with the compensation table `table` (`comp_table = ram`): one position of
-    /// at most `pos_max` per fraction code, monotone (the interpolation's neighbours must be
-    /// in order along a face).
+    /// at most `pos_max` per fraction code (the hardware takes any such table; a fit keeps it
+    /// monotone, so that directions keep their order along a face).
     pub fn with_table(mut self, cfg: &Config, table: Vec<u32>) -> anyhow::Result<Maps> {
         if cfg.comp_table.is_rom() {
             anyhow::bail!(
