@@ -47,6 +47,17 @@ pub struct Write {
 /// The write-port axis slot of the compensation table (`comp_table = ram`).
 pub const TABLE_SLOT: u32 = 3;
 
+/// Writes in one frame's stream: every entry of the three maps and, with `comp_table = ram`,
+/// of the table.
+pub fn write_count(cfg: &Config) -> u32 {
+    3 * cfg.map_entries()
+        + if cfg.comp_table.is_rom() {
+            0
+        } else {
+            cfg.atan_entries()
+        }
+}
+
 /// Every entry of `maps` as a write, in write order; with `comp_table = ram` the table
 /// follows the maps, in axis slot [`TABLE_SLOT`], address u 0 upwards.
 pub fn writes(cfg: &Config, maps: &Maps) -> Vec<Write> {
@@ -132,7 +143,7 @@ fn header(cfg: &Config, scene: &Scene, format: Format) -> Vec<String> {
     };
     let (a, m) = (cfg.map_addr_bits(), cfg.map_bits);
     let ram = !cfg.comp_table.is_rom();
-    let n = 3 * cfg.map_entries() + if ram { cfg.atan_entries() } else { 0 };
+    let n = write_count(cfg);
     let table = if ram {
         format!(
             ", then 3 (the compensation table), address u 0..={}",
@@ -324,6 +335,7 @@ mod tests {
         let ws = writes(&cfg, &maps);
         let (n, t) = (3 * cfg.map_entries() as usize, cfg.atan_entries() as usize);
         assert_eq!(ws.len(), n + t);
+        assert_eq!(ws.len(), write_count(&cfg) as usize);
         assert!(ws[n..]
             .iter()
             .enumerate()

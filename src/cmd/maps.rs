@@ -41,7 +41,7 @@ pub fn run(a: &MapsArgs) -> Result<()> {
     let p = out.commit()?;
     crate::errln!(
         "rmapgen: wrote {} host writes ({}, scene {}, map_fit {}) to {}",
-        3 * cfg.map_entries(),
+        map_stream::write_count(&cfg),
         cfg.summary(),
         scene.name,
         scene.map_fit.name(),

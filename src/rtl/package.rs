@@ -404,7 +404,7 @@ pub fn readme(design: &Design) -> Result<String> {
         map_fit: design.scene.map_fit.name(),
         map_max: cfg.map_max(),
         map_bits: cfg.map_bits,
-        writes: 3 * cfg.map_entries(),
+        writes: crate::map_stream::write_count(cfg),
         last_addr: cfg.map_entries() - 1,
         addr_digits: cfg.map_addr_bits().div_ceil(4),
         data_digits: cfg.map_bits.div_ceil(4),

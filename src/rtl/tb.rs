@@ -315,7 +315,7 @@ pub fn data(cfg: &Config, stage: &dyn Vectors) -> Result<TbData> {
         map_entries: cfg.map_entries(),
         map_addr_bits: cfg.map_addr_bits(),
         map_bits: cfg.map_bits,
-        nwrites: 3 * cfg.map_entries() + table_entries,
+        nwrites: crate::map_stream::write_count(cfg),
         table_entries,
     })
 }
