@@ -75,6 +75,43 @@ pub struct Config {
     /// (the default), so a design without it is written as before the field existed.
     #[serde(skip_serializing_if = "Mult::is_tree")]
     pub mult: Mult,
+    /// Where the compensation table's entries come from: [`CompTable`]. Left out of the TOML
+    /// and JSON when `rom` (the default), so a design without it is written as before the
+    /// field existed.
+    #[serde(skip_serializing_if = "CompTable::is_rom")]
+    pub comp_table: CompTable,
+}
+
+/// The compensation table (docs/ARCHITECTURE.md, "Compensation table"): the fixed atan ROM of
+/// the paper, or a RAM the host loads with the maps, so that the table can be fitted to each
+/// frame's scene (the entries bunch where the intensity turns fastest, src/model/map_fit).
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum CompTable {
+    /// A ROM of round(atan(u) / (pi/4) * pos_max), fixed when the design is generated.
+    #[default]
+    Rom,
+    /// A double-buffered RAM written through the map write port (axis slot 3, address the
+    /// fraction code u, data the position) and swapped with the maps by `swap_i`, so that a
+    /// frame's table and maps always change together. Both buffers hold the atan table out of
+    /// reset.
+    Ram,
+}
+
+impl CompTable {
+    pub fn is_rom(&self) -> bool {
+        *self == CompTable::Rom
+    }
+
+    /// `rom` or `ram`, as the flag and the TOML spell it.
+    pub fn name(&self) -> &'static str {
+        match self {
+            CompTable::Rom => "rom",
+            CompTable::Ram => "ram",
+        }
+    }
 }
 
 /// How the multipliers are written (docs/ARCHITECTURE.md, "Multipliers"). The products, the
@@ -302,6 +339,7 @@ impl Default for Config {
             target: Target::Generic,
             lanes: 1,
             mult: Mult::Tree,
+            comp_table: CompTable::Rom,
         }
     }
 }
@@ -398,6 +436,17 @@ impl Config {
                 "axis_user = {} without axis; tuser exists only on the AXI4-Stream ports (add --axis)",
                 self.axis_user
             ));
+        }
+        if !self.comp_table.is_rom() {
+            if !self.compensation {
+                return c(&["comp_table", "compensation"], "comp_table = ram without compensation; the table is the compensation (leave out --no-compensation)".into());
+            }
+            if self.frac_bits > self.map_addr_bits() || self.pos_bits() > self.map_bits {
+                return c(&["comp_table", "frac_bits"], format!(
+                    "comp_table = ram writes its {} entries of {} bits through the map write port, whose address is {} bits and data {} bits; give frac_bits <= {} and index_bits + interp_bits <= map_bits",
+                    self.atan_entries(), self.pos_bits(), self.map_addr_bits(), self.map_bits, self.map_addr_bits()
+                ));
+            }
         }
         if self.interpolation && self.interp_bits == 0 {
             return c(&["interp_bits", "interpolation"], "interp_bits = 0 with interpolation on; give interp_bits >= 1 or turn interpolation off".into());
@@ -625,6 +674,10 @@ impl Config {
             String::new()
         } else {
             format!(" mult={}", self.mult.name())
+        } + &if self.comp_table.is_rom() {
+            String::new()
+        } else {
+            format!(" table={}", self.comp_table.name())
         }
     }
 }
@@ -821,5 +874,55 @@ mod tests {
             "{}",
             infer.summary()
         );
+    }
+
+    /// `comp_table = ram` needs the compensation, and a write port wide enough for the
+    /// table's addresses and entries; it is left out of the TOML when `rom`, and named in
+    /// the summary when `ram`.
+    #[test]
+    fn a_loaded_table_needs_compensation_and_a_port_that_fits_it() {
+        let ram = Config {
+            comp_table: CompTable::Ram,
+            ..Config::default()
+        };
+        ram.validate().unwrap();
+        assert!(ram.summary().ends_with(" table=ram"), "{}", ram.summary());
+        assert!(!toml::to_string(&Config::default())
+            .unwrap()
+            .contains("comp_table"));
+        assert!(toml::to_string(&ram)
+            .unwrap()
+            .contains("comp_table = \"ram\""));
+        let e = Config {
+            compensation: false,
+            ..ram.clone()
+        }
+        .validate()
+        .unwrap_err();
+        assert_eq!(e.fields(), vec!["comp_table", "compensation"]);
+        // 2^8 table entries through a 7-bit map address (index_bits 2).
+        let e = Config {
+            index_bits: 2,
+            ..ram.clone()
+        }
+        .validate()
+        .unwrap_err();
+        assert!(e.to_string().contains("address is 7 bits"), "{e}");
+        Config {
+            index_bits: 2,
+            frac_bits: 7,
+            ..ram.clone()
+        }
+        .validate()
+        .unwrap();
+        // 9 position bits (index 4 + interpolation 5) into 8-bit map entries.
+        let e = Config {
+            index_bits: 4,
+            interp_bits: 5,
+            ..ram
+        }
+        .validate()
+        .unwrap_err();
+        assert!(e.to_string().contains("data 8 bits"), "{e}");
     }
 }

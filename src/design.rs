@@ -21,6 +21,7 @@ impl Design {
     /// `scene`'s map in buffer 0, the alternate scene's in buffer 1.
     pub fn for_scene(cfg: &Config, scene: &Scene) -> Result<Design> {
         cfg.validate()?;
+        scene.map_fit.check(cfg)?;
         Ok(Design {
             model: Model::new(cfg),
             maps: MapSet::from_scenes(cfg, scene, &Scene::alternate()),

@@ -8,10 +8,12 @@
 //! both ends of its range (recip_bits at its smallest legal value, frac_bits + 1), each of the
 //! eight combinations of compensation, interpolation and colour, every pipeline depth, and the
 //! handshake on and off, both memory targets, mixed so that the ends meet each other and the
-//! optional stages, the AXI4-Stream top, 2 and 4 lanes with and without the handshake, and
-//! both multiplier styles (`--mult infer` at every depth, with and without the handshake).
+//! optional stages, the AXI4-Stream top, 2 and 4 lanes with and without the handshake, both
+//! multiplier styles (`--mult infer` at every depth, with and without the handshake), and the
+//! compensation table as a loaded RAM (`--comp-table ram`: with and without the handshake and
+//! lanes, for each memory target).
 
-use crate::config::{Config, Mult, Target, RANGES};
+use crate::config::{CompTable, Config, Mult, Target, RANGES};
 
 /// One configuration of the grid.
 #[derive(Clone, Debug, PartialEq)]
@@ -31,7 +33,8 @@ macro_rules! grid {
     ($( $name:ident: $g:literal $r:literal $w:literal $f:literal $i:literal $p:literal $m:literal
         $comp:literal $interp:literal $color:literal $depth:literal $hs:literal $icarus:literal
         $ice40:literal
-        $(axis $user:literal)? $(lanes $lanes:literal)? $(mult $mult:ident)? $covers:literal; )*) => {
+        $(axis $user:literal)? $(lanes $lanes:literal)? $(mult $mult:ident)? $(table $table:ident)?
+        $covers:literal; )*) => {
         /// Every row, in the order below.
         pub fn rows() -> Vec<GridRow> {
             vec![$(GridRow {
@@ -47,6 +50,7 @@ macro_rules! grid {
                     axis_user: 0 $(+ $user)?,
                     lanes: 1 $(- 1 + $lanes)?,
                     mult: *[Mult::Tree $(, Mult::$mult)?].last().expect("a style"),
+                    comp_table: *[CompTable::Rom $(, CompTable::$table)?].last().expect("a table"),
                 },
                 icarus: $icarus == 1,
                 covers: $covers,
@@ -59,7 +63,8 @@ macro_rules! grid {
 // entry bits; comp(ensation), interp(olation), color, pipeline depth, handshake, run in Icarus,
 // --target ice40 (1), ecp5 (2) or generic (0); `axis U`: the AXI4-Stream top rmap_axis with a U-bit tuser;
 // `lanes L`: the lanes top rmap_lanes with L lanes (its testbench runs in place of rmap_top's);
-// `mult Infer`: inferred multipliers (`--mult infer`), else adder trees.
+// `mult Infer`: inferred multipliers (`--mult infer`), else adder trees; `table Ram`: the
+// compensation table as a RAM the host loads (`--comp-table ram`), else the atan ROM.
 grid! {
 //                  G  R  W  F  I  P  M  comp interp color depth hs icarus ice40
     paper:          12 8  10 8  3  3  8  1    1      0     2     0  1  0
@@ -134,6 +139,12 @@ grid! {
         "inferred multipliers with colour under backpressure, at the middle depth";
     widest_infer:   16 12 20 12 6  5  12 1    1      1     2     1  0  1  mult Infer
         "inferred multipliers at the widest widths (products wider than one 18 x 18 DSP), every stage, the handshake";
+    table_ram:      12 8  10 8  3  3  8  1    1      0     2     0  1  0  table Ram
+        "the compensation table as a RAM the host loads with the maps (--comp-table ram), double-buffered, every testbench in Icarus";
+    table_ram_narrow: 8 6  5 4  2  1  6  1    1      0     0     0  1  2  table Ram
+        "the loaded table at the narrowest widths (a 16-entry table through a 7-bit write address), compact registers, memories for the ECP5";
+    table_ram_lanes2_hs: 12 8 10 8 3  3  8  1    1      1     1     1  0  1  lanes 2 table Ram
+        "two lanes, each with its own loaded table, with colour under whole-beat backpressure, memories for the iCE40";
 }
 
 /// The row called `name`.

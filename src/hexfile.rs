@@ -2,7 +2,7 @@
 //! configuration (Icarus, Verilator and Yosys all accept them), then one entry per line.
 
 use crate::config::Config;
-use crate::model::map_set::{map_file, AXES};
+use crate::model::map_set::{map_file, AXES, TABLE};
 use crate::model::{Maps, Model};
 use crate::stages;
 
@@ -33,14 +33,37 @@ pub fn all(model: &Model, maps: &Maps) -> Vec<(String, String)> {
         stages::recip_rom::init_file(cfg),
         format(cfg, "reciprocal ROM", cfg.recip_bits, &model.recip),
     )];
-    if let Some(atan) = &model.atan {
-        v.push((
+    match (&maps.table, &model.atan) {
+        // Both buffers of the RAM, the scene's table in each, as the map banks hold the
+        // scene's maps in both.
+        (Some(table), _) => v.push((
+            stages::atan_rom::init_file(cfg),
+            format(
+                cfg,
+                "distortion compensation table RAM, address {buf, u}: the scene's table in both buffers",
+                cfg.pos_bits(),
+                &[table.as_slice(), table.as_slice()].concat(),
+            ),
+        )),
+        (None, Some(atan)) => v.push((
             stages::atan_rom::init_file(cfg),
             format(
                 cfg,
                 "distortion compensation (atan) ROM",
                 cfg.pos_bits(),
                 atan,
+            ),
+        )),
+        (None, None) => {}
+    }
+    if let Some(table) = &maps.table {
+        v.push((
+            map_file(cfg, 0, TABLE),
+            format(
+                cfg,
+                "compensation table, address u (write-port axis slot 3)",
+                cfg.pos_bits(),
+                table,
             ),
         ));
     }

@@ -6,9 +6,10 @@
 //   verilator --cc --exe --build -O3 ... --top-module rmap_top <out>/*.v top_stream.cpp \
 //             -CFLAGS "-O2 -I<out>/tb" --Mdir build/... -o top_stream
 // Run as
-//   top_stream VECTOR_FILE MAP2_X MAP2_Y MAP2_Z
-// with the design's second map files (<prefix>map2_<axis>.hex); the design's own $readmemh
-// files are compiled in as absolute paths.
+//   top_stream VECTOR_FILE MAP2_X MAP2_Y MAP2_Z [MAP2_TABLE]
+// with the design's second map files (<prefix>map2_<axis>.hex, and <prefix>map2_table.hex
+// when the compensation table is a RAM, RMAP_TABLE_ENTRIES: written after the maps, axis slot
+// 3, address u); the design's own $readmemh files are compiled in as absolute paths.
 // VECTOR_FILE has the format of vectors/rmap_top.hex (`rmapgen vectors --count N` writes
 // one): fields `map gx gy gz [r g b] zero i [r_o g_o b_o]`. While the map-0 vectors stream,
 // the harness writes the second map MAP2_<AXIS> through the host port into the back buffer, one word
@@ -44,7 +45,12 @@ struct Vector {
     uint8_t rgb_o[3];
 };
 
-constexpr uint32_t kWrites = 3u << RMAP_MAP_ADDR_BITS;
+#ifndef RMAP_TABLE_ENTRIES
+#define RMAP_TABLE_ENTRIES 0
+#endif
+// The maps, then the table (its write k is axis 3, address k: the same split of the count).
+constexpr uint32_t kWrites = (3u << RMAP_MAP_ADDR_BITS) + RMAP_TABLE_ENTRIES;
+constexpr int kFiles = RMAP_TABLE_ENTRIES > 0 ? 4 : 3;
 constexpr uint64_t kTimeout = 1000;
 constexpr int kShow = 10;
 
@@ -126,10 +132,11 @@ std::vector<Vector> load_vectors(const std::string& path) {
     return v;
 }
 
-// The second map's three files (x, y, z): `//` comment lines, then one hex entry per line.
+// The second map's files (x, y, z, and the table with RMAP_TABLE_ENTRIES): `//` comment
+// lines, then one hex entry per line.
 std::vector<uint32_t> load_map2(char** paths) {
     std::vector<uint32_t> m;
-    for (int a = 0; a < 3; ++a) {
+    for (int a = 0; a < kFiles; ++a) {
         const std::string path = paths[a];
         const std::string text = read_file(path);
         size_t before = m.size();
@@ -151,7 +158,8 @@ std::vector<uint32_t> load_map2(char** paths) {
             }
             m.push_back(v);
         }
-        if (m.size() - before != (1u << RMAP_MAP_ADDR_BITS)) die(path + ": wrong number of entries");
+        const size_t want = a < 3 ? (1u << RMAP_MAP_ADDR_BITS) : RMAP_TABLE_ENTRIES;
+        if (m.size() - before != want) die(path + ": wrong number of entries");
     }
     return m;
 }
@@ -159,8 +167,9 @@ std::vector<uint32_t> load_map2(char** paths) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    if (argc != 5) {
-        std::fprintf(stderr, "usage: %s VECTOR_FILE MAP2_X MAP2_Y MAP2_Z\n", argv[0]);
+    if (argc != 2 + kFiles) {
+        std::fprintf(stderr, "usage: %s VECTOR_FILE MAP2_X MAP2_Y MAP2_Z%s\n", argv[0],
+                     kFiles == 4 ? " MAP2_TABLE" : "");
         return 2;
     }
     const std::vector<Vector> vecs = load_vectors(argv[1]);

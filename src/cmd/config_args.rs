@@ -62,6 +62,11 @@ pub struct ConfigArgs {
     /// or infer (plain `*` products registered so DSP blocks absorb them) [default: tree].
     #[arg(long, value_enum, value_name = "M")]
     pub mult: Option<crate::config::Mult>,
+    /// Compensation table: rom (the atan table, fixed) or ram (loaded by the host with the
+    /// maps through the write port, double-buffered, so it can be fitted to each frame's
+    /// scene) [default: rom].
+    #[arg(long, value_enum, value_name = "T")]
+    pub comp_table: Option<crate::config::CompTable>,
 }
 
 impl ConfigArgs {
@@ -112,6 +117,9 @@ impl ConfigArgs {
         }
         if !cfg.mult.is_tree() {
             f.extend(["--mult".into(), cfg.mult.name().into()]);
+        }
+        if !cfg.comp_table.is_rom() {
+            f.extend(["--comp-table".into(), cfg.comp_table.name().into()]);
         }
         f
     }
@@ -288,6 +296,10 @@ impl ConfigArgs {
         if let Some(m) = self.mult {
             c.mult = m;
             flags.push(("mult", format!("--mult {}", m.name())));
+        }
+        if let Some(t) = self.comp_table {
+            c.comp_table = t;
+            flags.push(("comp_table", format!("--comp-table {}", t.name())));
         }
         (c, flags)
     }

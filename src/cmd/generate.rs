@@ -44,7 +44,7 @@ pub const DEFAULT_SEED: u64 = 1;
 pub fn run(a: &GenerateArgs) -> Result<()> {
     vectors::check_stage_vectors(a.vectors, "--vectors")?;
     let cfg = a.cfg.resolve()?;
-    let scene = a.map.scene()?;
+    let scene = a.map.scene_for(&cfg)?;
     let policy = a.force.policy(&[a.cfg.config.as_deref(), a.map.input()]);
     // A design already there: its configuration, to say what this run changes.
     let before = DesignDir::open(&a.out).ok().map(|d| d.config);

@@ -18,7 +18,8 @@ pub struct MapArgs {
     /// How the maps are filled from the light model: sample (the light model at each entry's
     /// direction), lsq (least squares over a dense grid, with peak refinement), lsq-plain
     /// (without it), minimax (the smallest largest error over every direction; a third of a
-    /// second a frame) [default: the scene's `map_fit`, else sample].
+    /// second a frame), table (the compensation table fitted with minimax maps; needs
+    /// --comp-table ram; seconds a frame) [default: the scene's `map_fit`, else sample].
     #[arg(long, value_enum, value_name = "FIT")]
     pub map_fit: Option<MapFit>,
 }
@@ -37,6 +38,14 @@ impl MapArgs {
     /// [`MapArgs::scene_or`] with the standard scene as the default.
     pub fn scene(&self) -> Result<Scene> {
         self.scene_or(|| Ok(Scene::standard()))
+    }
+
+    /// [`MapArgs::scene`] for the design `cfg`: refused when its `map_fit` makes what the
+    /// design cannot hold (`table` without `comp_table = ram`).
+    pub fn scene_for(&self, cfg: &crate::config::Config) -> Result<Scene> {
+        let scene = self.scene()?;
+        scene.map_fit.check(cfg)?;
+        Ok(scene)
     }
 
     /// Applies `--map-fit` to a scene the command chose itself (`bench`'s own scenes).

@@ -31,7 +31,7 @@ pub struct MapsArgs {
 
 pub fn run(a: &MapsArgs) -> Result<()> {
     let cfg = a.cfg.resolve()?;
-    let scene = a.map.scene()?;
+    let scene = a.map.scene_for(&cfg)?;
     let policy = a.force.policy(&[a.cfg.config.as_deref(), a.map.input()]);
     let out = StagedFile::new(&a.out, &policy)?;
     // The design's own maps (buffer 0, what map_<axis>.hex and the bank init files hold).
@@ -41,7 +41,7 @@ pub fn run(a: &MapsArgs) -> Result<()> {
     let p = out.commit()?;
     crate::errln!(
         "rmapgen: wrote {} host writes ({}, scene {}, map_fit {}) to {}",
-        3 * cfg.map_entries(),
+        map_stream::write_count(&cfg),
         cfg.summary(),
         scene.name,
         scene.map_fit.name(),

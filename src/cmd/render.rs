@@ -36,7 +36,7 @@ pub struct RenderArgs {
 
 pub fn run(a: &RenderArgs) -> Result<()> {
     let cfg = a.cfg.resolve()?;
-    let scene = a.map.scene()?;
+    let scene = a.map.scene_for(&cfg)?;
     let options = Options {
         size: a.size,
         shrink: a.shrink,

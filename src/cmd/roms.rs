@@ -40,7 +40,7 @@ pub fn run(a: &RomsArgs) -> Result<()> {
         return update(a, dir);
     }
     let cfg = a.cfg.resolve()?;
-    let scene = a.map.scene()?;
+    let scene = a.map.scene_for(&cfg)?;
     let target = a.out.as_ref().context("--out or --update")?;
     let policy = a.force.policy(&[a.cfg.config.as_deref(), a.map.input()]);
     let out = StagedDir::new(target, &policy)?;

@@ -39,7 +39,7 @@ pub fn run(a: &StressArgs) -> Result<()> {
         stress::check_samples(a.samples)?;
     }
     let cfg = a.cfg.resolve()?;
-    let scene = a.map.scene()?;
+    let scene = a.map.scene_for(&cfg)?;
     // Claimed before the run, so a refused path fails at once rather than after it.
     let json = match &a.json {
         Some(p) => Some(StagedFile::new(

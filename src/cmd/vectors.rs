@@ -53,7 +53,7 @@ pub fn run(a: &VectorsArgs) -> Result<()> {
     vectors::check_stream_vectors(a.count as u64)?;
     let maps = match &a.maps {
         Some(dir) => MapSet::from_dir(&cfg, dir)?,
-        None => MapSet::from_scenes(&cfg, &a.map.scene()?, &Scene::alternate()),
+        None => MapSet::from_scenes(&cfg, &a.map.scene_for(&cfg)?, &Scene::alternate()),
     };
     let policy = a
         .force

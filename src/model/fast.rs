@@ -29,6 +29,10 @@ const PAR_CHUNK: usize = 1 << 14;
 #[derive(Clone, Debug)]
 pub struct FastShader {
     cfg: Config,
+    /// The reciprocal ROM and the table the positions were fused from: with `comp_table =
+    /// ram` a new frame may bring a new table ([`FastShader::set_maps_for`]).
+    model: Model,
+    table: Option<Vec<u32>>,
     positions: Positions,
     intensities: Intensities,
 }
@@ -123,11 +127,13 @@ pub fn intensity_at(
 }
 
 impl Positions {
-    fn new(model: &Model, limit: usize) -> Positions {
+    /// The positions of `model`, reading the compensation table `maps` carries when it
+    /// carries one (`comp_table = ram`).
+    fn new(model: &Model, maps: &Maps, limit: usize) -> Positions {
         let cfg = &model.cfg;
         let lane = |m: u32, a: u32| {
             let recip = model.recip[recip_rom::addr(cfg, m) as usize];
-            model.position(normalise::lane(cfg, a, m, recip))
+            model.position_in(maps, normalise::lane(cfg, a, m, recip))
         };
         let r = cfg.red_bits;
         if 1usize << (2 * r - 1) <= limit.min(FUSED_POSITIONS_MAX) {
@@ -139,7 +145,9 @@ impl Positions {
             });
             Positions::Fused { table, red_bits: r }
         } else {
-            let position = (0..=cfg.frac_max()).map(|u| model.position(u)).collect();
+            let position = (0..=cfg.frac_max())
+                .map(|u| model.position_in(maps, u))
+                .collect();
             Positions::Split {
                 recip: model.recip.clone(),
                 position,
@@ -196,12 +204,15 @@ impl FastShader {
     pub fn for_samples(model: &Model, maps: &Maps, samples: usize) -> FastShader {
         FastShader {
             cfg: model.cfg.clone(),
-            positions: Positions::new(model, samples),
+            model: model.clone(),
+            table: maps.table.clone(),
+            positions: Positions::new(model, maps, samples),
             intensities: Intensities::new(&model.cfg, maps, samples),
         }
     }
 
-    /// Replaces the maps (a new frame), keeping the configuration's position table.
+    /// Replaces the maps (a new frame), keeping the position table unless the frame brings
+    /// its own compensation table.
     pub fn set_maps(&mut self, maps: &Maps) {
         self.set_maps_for(maps, usize::MAX);
     }
@@ -211,6 +222,10 @@ impl FastShader {
     /// [`FastShader::for_samples`]), so a frame that shades few samples does not pay for a
     /// table much larger than its work.
     pub fn set_maps_for(&mut self, maps: &Maps, samples: usize) {
+        if maps.table != self.table {
+            self.positions = Positions::new(&self.model, maps, samples);
+            self.table = maps.table.clone();
+        }
         self.intensities = Intensities::new(&self.cfg, maps, samples);
     }
 
@@ -404,5 +419,67 @@ mod tests {
             assert_eq!(*o as u32, model.intensity(&maps, *g), "{g:?}");
             assert_eq!(fast.shade(*g), model.intensity(&maps, *g), "{g:?}");
         }
+    }
+
+    /// With `comp_table = ram` a frame's table is the buffer's own: out of reset (the atan
+    /// table) the design shades as the ROM design does; with another table, the fast path,
+    /// fused and split, follows it and equals the model; a new frame's table replaces the
+    /// positions, and a frame with the same table keeps them.
+    #[test]
+    fn a_loaded_table_is_read_by_the_model_and_the_fast_path() {
+        let rom_cfg = Config::default();
+        let cfg = Config {
+            comp_table: crate::config::CompTable::Ram,
+            ..Config::default()
+        };
+        let light = |n: glam::DVec3| 0.3 + 0.7 * (n.x * 0.6 + n.z * 0.8).max(0.0).powi(20);
+        let (model, rom_model) = (Model::new(&cfg), Model::new(&rom_cfg));
+        let maps = reflectance_map::contents(&cfg, light);
+        let rom_maps = reflectance_map::contents(&rom_cfg, light);
+        assert_eq!(maps.table.as_deref(), rom_model.atan.as_deref());
+        let mut rng = crate::rng::SplitMix64::new(7);
+        let grads: Vec<[i32; 3]> = (0..20_000)
+            .map(|_| [0; 3].map(|_| (rng.next_u64() % 4096) as i32 - 2048))
+            .collect();
+        for g in &grads {
+            assert_eq!(
+                model.intensity(&maps, *g),
+                rom_model.intensity(&rom_maps, *g)
+            );
+        }
+        // A monotone table of its own: positions squeezed towards the axis (u^2).
+        let max = cfg.pos_max() as u64;
+        let n = cfg.atan_entries() as u64;
+        let table: Vec<u32> = (0..n)
+            .map(|u| (u * u * max / ((n - 1) * (n - 1))) as u32)
+            .collect();
+        let loaded = maps.clone().with_table(&cfg, table).unwrap();
+        let mut fast = FastShader::new(&model, &maps);
+        let mut split = FastShader::for_samples(&model, &maps, 1);
+        assert_eq!((fast.fused().0, split.fused().0), (true, false));
+        let mut differ = 0;
+        for (f, frame) in [&loaded, &maps, &loaded].into_iter().enumerate() {
+            fast.set_maps(frame);
+            split.set_maps_for(frame, 1);
+            let mut out = vec![0u16; grads.len()];
+            fast.shade_batch(&grads, &mut out);
+            for (g, o) in grads.iter().zip(&out) {
+                let want = model.intensity(frame, *g);
+                assert_eq!(
+                    (*o as u32, split.shade(*g)),
+                    (want, want),
+                    "frame {f} {g:?}"
+                );
+                differ += (f == 0 && want != model.intensity(&maps, *g)) as u32;
+            }
+        }
+        assert!(differ > 1000, "the table changes the results: {differ}");
+        // Tables that do not fit are refused, and a ROM design takes none.
+        let e = |r: anyhow::Result<Maps>| r.unwrap_err().to_string();
+        assert!(e(maps.clone().with_table(&cfg, vec![0; 3])).contains("3 entries"));
+        let mut past = vec![0; n as usize];
+        past[5] = cfg.pos_max() + 1;
+        assert!(e(maps.clone().with_table(&cfg, past)).contains("entry 5"));
+        assert!(e(rom_maps.with_table(&rom_cfg, vec![0; n as usize])).contains("comp_table = rom"));
     }
 }

@@ -77,12 +77,24 @@ impl Model {
         }
     }
 
-    /// The position stage: atan ROM, or linear index without compensation.
+    /// The position stage: atan ROM, or linear index without compensation. With `comp_table
+    /// = ram` this is the table both buffers hold out of reset; [`Model::position_in`] reads
+    /// a buffer's own.
     #[inline]
     pub fn position(&self, u: u32) -> u32 {
         match &self.atan {
             Some(rom) => rom[u as usize],
             None => linear_index::eval(&self.cfg, u),
+        }
+    }
+
+    /// The position stage reading the compensation table of `maps`' buffer when it has one
+    /// (`comp_table = ram`), else [`Model::position`].
+    #[inline]
+    pub fn position_in(&self, maps: &Maps, u: u32) -> u32 {
+        match &maps.table {
+            Some(t) => t[u as usize],
+            None => self.position(u),
         }
     }
 
@@ -92,8 +104,8 @@ impl Model {
         let zero = zero_detect::eval(g);
         let sort = sort_shift::eval(cfg, g);
         let norm = normalise::eval(cfg, &self.recip, sort.m, sort.a, sort.b);
-        let p_u = self.position(norm.u);
-        let p_v = self.position(norm.v);
+        let p_u = self.position_in(maps, norm.u);
+        let p_v = self.position_in(maps, norm.v);
         let lookup = map_lookup::eval(
             cfg, maps, sort.axis, sort.s_max, sort.s_u, sort.s_v, p_u, p_v,
         );

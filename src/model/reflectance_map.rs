@@ -6,20 +6,54 @@ use super::map_addr;
 use crate::config::Config;
 use glam::DVec3;
 
-/// All three maps of one buffer, `map_bits` per entry, indexed [axis][addr].
+/// All three maps of one buffer, `map_bits` per entry, indexed [axis][addr], and with
+/// `comp_table = ram` the buffer's compensation table, which the host loads with them.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Maps {
     entries_per_map: usize,
     pub data: Vec<u32>,
+    /// The compensation table of this buffer, one position per fraction code (`comp_table =
+    /// ram`); None with the ROM, whose contents the model holds ([`crate::model::Model`]).
+    pub table: Option<Vec<u32>>,
 }
 
 impl Maps {
+    /// The maps `data`; with `comp_table = ram`, beside the atan table (what both buffers
+    /// hold out of reset), which [`Maps::with_table`] replaces.
     pub fn from_data(cfg: &Config, data: Vec<u32>) -> Maps {
         assert_eq!(data.len(), 3 * cfg.map_entries() as usize);
         Maps {
             entries_per_map: cfg.map_entries() as usize,
             data,
+            table: (!cfg.comp_table.is_rom())
+                .then(|| crate::stages::atan_rom::model::contents(cfg)),
         }
+    }
+
+    /// These maps with the compensation table `table` (`comp_table = ram`): one position of
+    /// at most `pos_max` per fraction code (the hardware takes any such table; a fit keeps it
+    /// monotone, so that directions keep their order along a face).
+    pub fn with_table(mut self, cfg: &Config, table: Vec<u32>) -> anyhow::Result<Maps> {
+        if cfg.comp_table.is_rom() {
+            anyhow::bail!(
+                "a compensation table for a design whose table is a ROM (comp_table = rom)"
+            );
+        }
+        if table.len() != cfg.atan_entries() as usize {
+            anyhow::bail!(
+                "a compensation table of {} entries; the design has {} (2^frac_bits)",
+                table.len(),
+                cfg.atan_entries()
+            );
+        }
+        if let Some((u, &p)) = table.iter().enumerate().find(|(_, &p)| p > cfg.pos_max()) {
+            anyhow::bail!(
+                "compensation table entry {u} is {p}, past the largest position {}",
+                cfg.pos_max()
+            );
+        }
+        self.table = Some(table);
+        Ok(self)
     }
     #[inline]
     pub fn get(&self, axis: u32, addr: u32) -> u32 {

@@ -169,10 +169,15 @@ pub fn memory_files(d: &DesignDir) -> Vec<(String, u32)> {
         .into_iter()
         .map(|p| (p.default, p.width))
         .collect();
-    for axis in crate::model::map_set::AXES {
-        let f = crate::model::map_set::map_file(cfg, 0, axis);
+    for name in crate::model::map_set::buffer_names(cfg) {
+        let f = crate::model::map_set::map_file(cfg, 0, name);
+        let bits = if name == crate::model::map_set::TABLE {
+            cfg.pos_bits()
+        } else {
+            cfg.map_bits
+        };
         if !v.iter().any(|(n, _)| *n == f) {
-            v.push((f, cfg.map_bits));
+            v.push((f, bits));
         }
     }
     v

@@ -138,8 +138,8 @@ pub fn read_files(d: &DesignDir) -> Vec<String> {
             .map(|f| f.default),
     );
     for buf in 0..2 {
-        for axis in crate::model::map_set::AXES {
-            names.push(crate::model::map_set::map_file(cfg, buf, axis));
+        for name in crate::model::map_set::buffer_names(cfg) {
+            names.push(crate::model::map_set::map_file(cfg, buf, name));
         }
     }
     names.sort();

@@ -19,7 +19,7 @@ pub mod verilated;
 
 use crate::design::Design;
 use crate::hexfile;
-use crate::model::map_set::{map_file, AXES};
+use crate::model::map_set::{map_file, AXES, TABLE};
 use crate::output::StagedDir;
 use crate::stages::map_bank::banks;
 use crate::stages::{self, Head};
@@ -43,6 +43,17 @@ pub fn hex_files(design: &Design) -> Vec<(String, String)> {
         v.push((
             map_file(cfg, 1, name),
             hexfile::format(cfg, &what, cfg.map_bits, alt.axis(axis as u32)),
+        ));
+    }
+    if let Some(table) = &alt.table {
+        v.push((
+            map_file(cfg, 1, TABLE),
+            hexfile::format(
+                cfg,
+                "second compensation table (the linear index's positions), address u",
+                cfg.pos_bits(),
+                table,
+            ),
         ));
     }
     v.extend(banks::bank_files(cfg, &maps.scene));

@@ -75,6 +75,14 @@ struct Readme {
     /// The edge after which `valid_o` is high for a sample accepted at edge 0.
     valid_edge: u32,
     compensation: bool,
+    /// The compensation table is a RAM the host loads (`comp_table = ram`): its entries,
+    /// position width and largest position.
+    table_ram: bool,
+    table_entries: u32,
+    pos_bits: u32,
+    pos_max: u32,
+    frac_bits: u32,
+    interp_bits: u32,
     interpolation: bool,
     addr_bits: u32,
     /// (name, bits, width, meaning) of each address field.
@@ -334,6 +342,12 @@ pub fn readme(design: &Design) -> Result<String> {
         target: cfg.target.name(),
         valid_edge: top_latency(cfg) - 1,
         compensation: cfg.compensation,
+        table_ram: !cfg.comp_table.is_rom(),
+        table_entries: cfg.atan_entries(),
+        pos_bits: cfg.pos_bits(),
+        pos_max: cfg.pos_max(),
+        frac_bits: cfg.frac_bits,
+        interp_bits: cfg.interp_bits,
         interpolation: cfg.interpolation,
         addr_bits: cfg.map_addr_bits(),
         addr_fields: map_addr::fields(cfg)
@@ -390,7 +404,7 @@ pub fn readme(design: &Design) -> Result<String> {
         map_fit: design.scene.map_fit.name(),
         map_max: cfg.map_max(),
         map_bits: cfg.map_bits,
-        writes: 3 * cfg.map_entries(),
+        writes: crate::map_stream::write_count(cfg),
         last_addr: cfg.map_entries() - 1,
         addr_digits: cfg.map_addr_bits().div_ceil(4),
         data_digits: cfg.map_bits.div_ceil(4),

@@ -2,6 +2,7 @@
 //! with [`render`] (so the Verilog cannot disagree with the list) and the manifest, the README
 //! and the testbenches read the same list.
 
+use crate::config::Config;
 use serde::Serialize;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -46,6 +47,23 @@ pub fn o(name: &'static str, bits: u32, note: &'static str) -> Port {
 /// The clock port of every stage and top: the one clock the FPGA flows time
 /// (`rtl::fpga` checks nextpnr's Fmax is for it).
 pub const CLOCK: &str = "clk_i";
+
+/// The host write port of a stage with writable memories (map_lookup's banks, and atan_rom's
+/// table with `comp_table = ram`): every stage on the port sees every write and takes those
+/// of its own axis slots (the maps 0..=2, the table 3), into the back buffer `wr_buf_i`.
+pub fn host_write(cfg: &Config) -> Vec<Port> {
+    vec![
+        i("wr_en_i", 1, "host write, independent of en_i"),
+        i("wr_buf_i", 1, ""),
+        i("wr_axis_i", 2, ""),
+        i(
+            "wr_addr_i",
+            cfg.map_addr_bits(),
+            "{s_max, s_u, i_u, s_v, i_v}",
+        ),
+        i("wr_data_i", cfg.map_bits, ""),
+    ]
+}
 
 /// clk_i, rst_ni, en_i, valid_i: the head of every pipeline stage.
 pub fn stage_head() -> Vec<Port> {

@@ -14,12 +14,12 @@
 
 use crate::config::Config;
 use crate::design::Design;
-use crate::model::map_set::{map_file, AXES};
+use crate::model::map_set::{buffer_names, map_file, TABLE};
 use crate::output::StagedDir;
 use crate::rtl::ports::{self, Width};
 use crate::stages::recip_rom::{self, RecipRom};
 use crate::stages::rmap_top::top_latency;
-use crate::stages::testbench::{FieldView, Sig, TbData, TbFile};
+use crate::stages::testbench::{FieldView, Map2File, Sig, TbData, TbFile};
 use crate::stages::unit::{file_param, file_params, param_overrides, Unit};
 use crate::stages::{self, Vectors, TOP};
 use crate::vectors::Dir;
@@ -220,7 +220,30 @@ pub fn data(cfg: &Config, stage: &dyn Vectors) -> Result<TbData> {
     } else {
         memories
     };
-    let map2_axes: &[&str] = if map2 { &AXES } else { &[] };
+    let map2_axes: Vec<&str> = if map2 { buffer_names(cfg) } else { Vec::new() };
+    let table_entries = if map2_axes.contains(&TABLE) {
+        cfg.atan_entries()
+    } else {
+        0
+    };
+    // Axis k's map fills writes [k 2^A, (k + 1) 2^A), the table the 2^F after the maps.
+    let span = |k: usize| match k {
+        1 => "MAP_ENTRIES".to_string(),
+        _ => format!("{k} * MAP_ENTRIES"),
+    };
+    let map2_params: Vec<Map2File> = map2_axes
+        .iter()
+        .enumerate()
+        .map(|(k, a)| Map2File {
+            param: map2_param(a),
+            first: if k == 0 { "0".into() } else { span(k) },
+            last: if *a == TABLE {
+                format!("{} + TABLE_ENTRIES - 1", span(k))
+            } else {
+                format!("{} - 1", span(k + 1))
+            },
+        })
+        .collect();
     let mut files: Vec<TbFile> = file_params(&memories)
         .into_iter()
         .map(|p| TbFile {
@@ -287,12 +310,13 @@ pub fn data(cfg: &Config, stage: &dyn Vectors) -> Result<TbData> {
         files,
         dut_params: param_overrides(cfg, stage),
         rom: if reads_rom { tb_rom(cfg) } else { String::new() },
-        map2_params: map2_axes.iter().map(|a| map2_param(a)).collect(),
+        map2_params,
         map2_pattern: map_file(cfg, 1, "*"),
         map_entries: cfg.map_entries(),
         map_addr_bits: cfg.map_addr_bits(),
         map_bits: cfg.map_bits,
-        nwrites: 3 * cfg.map_entries(),
+        nwrites: crate::map_stream::write_count(cfg),
+        table_entries,
     })
 }
 
@@ -353,7 +377,12 @@ pub fn harness_header(cfg: &Config) -> String {
         top_latency(cfg),
         fields.len(),
         cfg.handshake as u32,
-    )
+    ) + &if cfg.comp_table.is_rom() {
+        String::new()
+    } else {
+        // The second buffer's compensation table, written after the maps (axis slot 3).
+        format!("#define RMAP_TABLE_ENTRIES {}\n", cfg.atan_entries())
+    }
 }
 
 /// Writes `tb/<module>_tb.v` for every stage present in `cfg` and the top, plus

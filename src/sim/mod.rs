@@ -22,7 +22,7 @@
 //! its output, and the other runs go on; [`Outcome::failed`] lists them.
 
 use crate::design_dir::DesignDir;
-use crate::model::map_set::{map_file, AXES};
+use crate::model::map_set::{buffer_names, map_file};
 use crate::stages::TOP;
 use crate::toolchain::{self, icarus, verilator, yosys, Ran};
 use crate::vectors::{self, MapSet};
@@ -270,7 +270,7 @@ pub fn run(
             // The harness loads the design's second map through the host port
             // (tb/top_stream.cpp): its files by name, as the configuration (prefix) has them.
             let mut args = vec![vec.display().to_string()];
-            args.extend(AXES.iter().map(|a| {
+            args.extend(buffer_names(&design.config).iter().map(|a| {
                 let f = map_file(&design.config, 1, a);
                 design.path().join(f).display().to_string()
             }));

@@ -80,13 +80,24 @@ pub struct TbData {
     /// The declarations and instance of the reciprocal ROM the design reads through its
     /// `recip_*` ports when rmap_lanes shares it (empty otherwise).
     pub rom: String,
-    /// The parameters naming the second map's files, loaded through the host port (map_lookup
-    /// and the top), one per axis.
-    pub map2_params: Vec<String>,
+    /// The second map's files, loaded through the host port (map_lookup, atan_rom with
+    /// `comp_table = ram`, and the top): one per axis, and the table with `comp_table = ram`.
+    pub map2_params: Vec<Map2File>,
     /// `map2_*.hex` with the prefix, for messages.
     pub map2_pattern: String,
     pub map_entries: u32,
     pub map_addr_bits: u32,
     pub map_bits: u32,
     pub nwrites: u32,
+    /// Entries of the compensation table the host port writes after the maps (0 without).
+    pub table_entries: u32,
+}
+
+/// One file of the second map in a testbench: its parameter, and the first and last index of
+/// the testbench's write list it fills (Verilog expressions of MAP_ENTRIES, TABLE_ENTRIES).
+#[derive(Clone, Debug)]
+pub struct Map2File {
+    pub param: String,
+    pub first: String,
+    pub last: String,
 }

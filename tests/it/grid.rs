@@ -12,7 +12,7 @@
 
 use crate::hdl::{self, require};
 use crate::helpers;
-use rmapgen::config::{Mult, Target, PIPELINE_DEPTHS, RANGES};
+use rmapgen::config::{CompTable, Mult, Target, PIPELINE_DEPTHS, RANGES};
 use rmapgen::grid::{self, GridRow};
 use std::path::Path;
 
@@ -41,7 +41,8 @@ tests! {
     grad8_red8, no_truncation, frac4_recip20, frac12_recip13, index6_interp1, index2_interp5,
     map12, map6_nearest, index6_nearest, axis_color, lanes2, lanes2_hs, lanes4, lanes4_hs,
     lanes2_hs_ecp5, lanes4_ecp5,
-    paper_infer, color_infer, hs_infer, widest_infer,
+    paper_infer, color_infer, hs_infer, widest_infer, table_ram, table_ram_narrow,
+    table_ram_lanes2_hs,
 }
 
 #[test]
@@ -235,6 +236,20 @@ fn grid_covers_every_range_end_and_switch() {
         assert!(
             inf.iter().any(|r| r.config.pipeline_depth == depth),
             "no row with --mult infer at depth {depth}"
+        );
+    }
+    // The loaded compensation table (--comp-table ram): with and without the handshake, with
+    // lanes, for every memory target, in Icarus too.
+    let ram: Vec<&GridRow> = rows
+        .iter()
+        .filter(|r| r.config.comp_table == CompTable::Ram)
+        .collect();
+    assert!(ram.iter().any(|r| r.config.handshake) && ram.iter().any(|r| !r.config.handshake));
+    assert!(ram.iter().any(|r| r.config.lanes > 1) && ram.iter().any(|r| r.icarus));
+    for target in [Target::Generic, Target::Ice40, Target::Ecp5] {
+        assert!(
+            ram.iter().any(|r| r.config.target == target),
+            "no row with the loaded table and target {target:?}"
         );
     }
     // Lanes: 2 and 4, each with and without the handshake.

@@ -56,6 +56,10 @@ pub enum MapFit {
     /// program per face quadrant, then integer entries polished on the hardware's rounding
     /// ([`minimax`]).
     Minimax,
+    /// The compensation table and the minimax maps fitted together to the scene, so that the
+    /// entries bunch where the intensity turns fastest ([`table_fit`]); the table is loaded
+    /// with the maps, so the design needs `comp_table = ram`.
+    Table,
 }
 
 impl MapFit {
@@ -65,7 +69,18 @@ impl MapFit {
             MapFit::Lsq => "lsq",
             MapFit::LsqPlain => "lsq-plain",
             MapFit::Minimax => "minimax",
+            MapFit::Table => "table",
         }
+    }
+
+    /// Whether `cfg` can hold what this fit makes: `table` needs a table the host loads.
+    pub fn check(self, cfg: &Config) -> anyhow::Result<()> {
+        if self == MapFit::Table && cfg.comp_table.is_rom() {
+            anyhow::bail!(
+                "map_fit table fits the compensation table, which this design holds in a ROM; generate it with --comp-table ram (comp_table = \"ram\"), or use another map_fit"
+            );
+        }
+        Ok(())
     }
 }
 
@@ -90,6 +105,14 @@ pub fn contents(cfg: &Config, fit: MapFit, shade: impl Fn(DVec3) -> f64 + Sync) 
         MapFit::Lsq => LsqFit::new(cfg).fit(shade),
         MapFit::LsqPlain => LsqFit::plain(cfg).fit(shade),
         MapFit::Minimax => minimax::MinimaxFit::new(cfg).fit(shade),
+        MapFit::Table => {
+            MapFit::Table
+                .check(cfg)
+                .expect("map_fit table is checked against the configuration first");
+            let (table, maps, _) = table_fit::TableFit::new(cfg).fit(shade);
+            maps.with_table(cfg, table)
+                .expect("a fitted table is a table of the configuration")
+        }
     }
 }
 

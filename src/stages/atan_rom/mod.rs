@@ -1,6 +1,8 @@
-//! The distortion-compensation (atan) ROM: the position stage with compensation on. Each
-//! fraction reads the ROM [`init_file`]; the ROM is instantiated twice (u and v), so each
-//! copy is a single-port synchronous ROM in its own block RAM.
+//! The distortion-compensation table: the position stage with compensation on. Each fraction
+//! reads the table [`init_file`]. With `comp_table = rom` (the paper's) it is the atan ROM;
+//! with `comp_table = ram` a double-buffered RAM the host writes through the map write port
+//! (axis slot 3, address u, data the position), each sample reading the buffer it was
+//! accepted with, so that a frame's table changes with its maps.
 
 pub mod model;
 
@@ -10,23 +12,36 @@ use super::unit::{file_param, Head, Memory, Unit, Vectors};
 use crate::config::Config;
 use crate::model::{MapSet, Model};
 use crate::rng::SplitMix64;
-use crate::rtl::ports::Port;
+use crate::rtl::ports::{i, Port};
 use crate::vectors::field::Field;
 use askama::Template;
 
 pub struct AtanRom;
 
-/// Its `$readmemh` file, `<module>.hex`.
-/// The ROM's arrays: one copy per read port (u, v) for the iCE40, whose block RAM has one read
-/// port; one array read through two ports otherwise.
+/// The table's arrays: one copy per read port (u, v) for the iCE40, whose block RAM has one
+/// read port, and for the RAM (two reads and a write are more ports than a block RAM has);
+/// one ROM array read through two ports otherwise.
 fn arrays(cfg: &Config) -> Vec<&'static str> {
-    if cfg.target.ice40() {
+    if ram(cfg) {
+        vec!["ram_u", "ram_v"]
+    } else if cfg.target.ice40() {
         vec!["rom_u", "rom_v"]
     } else {
         vec!["rom"]
     }
 }
 
+/// A RAM the host loads (`comp_table = ram`), not a ROM.
+fn ram(cfg: &Config) -> bool {
+    !cfg.comp_table.is_rom()
+}
+
+/// Entries of one array: both buffers of the RAM, {buf, u}.
+fn array_entries(cfg: &Config) -> u32 {
+    cfg.atan_entries() << ram(cfg) as u32
+}
+
+/// Its `$readmemh` file, `<module>.hex`.
 pub fn init_file(cfg: &Config) -> String {
     format!("{}.hex", AtanRom.module(cfg))
 }
@@ -52,6 +67,12 @@ struct Verilog {
     rom_v: &'static str,
     pos: u32,
     entries: u32,
+    /// The RAM's write port (`comp_table = ram`): map address and data widths, and the
+    /// fraction width of a table address.
+    ram: bool,
+    a: u32,
+    m: u32,
+    f: u32,
 }
 
 crate::tb_template!(Testbench, "atan_rom/atan_rom_tb.v");
@@ -62,7 +83,19 @@ impl Unit for AtanRom {
     }
 
     fn ports(&self, cfg: &Config) -> Vec<Port> {
-        position::ports(cfg)
+        let mut v = position::ports(cfg);
+        if ram(cfg) {
+            // After valid_i, u_i, v_i; before the outputs.
+            let at = v
+                .iter()
+                .position(|p| p.name == "valid_o")
+                .expect("an output");
+            let mut tail = v.split_off(at);
+            v.push(i("rd_buf_i", 1, "buffer this sample reads"));
+            v.extend(crate::rtl::ports::host_write(cfg));
+            v.append(&mut tail);
+        }
+        v
     }
 
     /// The block RAM's output register and the optional fabric register.
@@ -79,9 +112,9 @@ impl Unit for AtanRom {
                     self.module(cfg),
                     file_param(self.name()),
                     init_file(cfg),
-                    cfg.atan_entries(),
+                    array_entries(cfg),
                     cfg.pos_bits(),
-                    false,
+                    ram(cfg),
                 )
             })
             .collect()
@@ -100,6 +133,10 @@ impl Unit for AtanRom {
             rom_v: arrays(cfg).last().expect("at least one array"),
             pos: cfg.pos_bits(),
             entries: cfg.atan_entries(),
+            ram: ram(cfg),
+            a: cfg.map_addr_bits(),
+            m: cfg.map_bits,
+            f: cfg.frac_bits,
         }
         .render()
     }
@@ -109,21 +146,53 @@ impl Unit for AtanRom {
     }
 }
 
+/// With the RAM the vectors carry the buffer a sample reads, after u and v: the testbench
+/// loads the second buffer's table first, and every vector is checked against its buffer's.
 impl Vectors for AtanRom {
     fn fields(&self, cfg: &Config) -> Vec<Field> {
-        position::fields(cfg)
+        let mut v = position::fields(cfg);
+        if ram(cfg) {
+            v.insert(2, Field::input("buf", 1));
+        }
+        v
     }
 
+    /// Every code in both lanes, in each buffer with the RAM.
     fn corners(&self, model: &Model, _maps: &MapSet) -> Vec<Vec<u64>> {
-        position::corners(&model.cfg)
+        let cfg = &model.cfg;
+        let c = position::corners(cfg);
+        if !ram(cfg) {
+            return c;
+        }
+        (0..2)
+            .flat_map(|buf| c.iter().map(move |uv| vec![uv[0], uv[1], buf]))
+            .collect()
     }
 
     fn random(&self, cfg: &Config, rng: &mut SplitMix64) -> Vec<u64> {
-        position::random(cfg, rng)
+        let mut v = position::random(cfg, rng);
+        if ram(cfg) {
+            v.push(rng.bits(1));
+        }
+        v
     }
 
-    fn expected(&self, model: &Model, _maps: &MapSet, inp: &[u64]) -> Vec<u64> {
-        position::expected(model, inp)
+    fn expected(&self, model: &Model, maps: &MapSet, inp: &[u64]) -> Vec<u64> {
+        if !ram(&model.cfg) {
+            return position::expected(model, inp);
+        }
+        let m = maps.buffer(inp[2]);
+        [inp[0], inp[1]]
+            .map(|u| model.position_in(m, u as u32) as u64)
+            .to_vec()
+    }
+
+    /// The buffer field drives rd_buf_i.
+    fn port(&self, field: &Field) -> Option<String> {
+        Some(match field.name {
+            "buf" => "rd_buf_i".to_string(),
+            _ => super::unit::port_of(field),
+        })
     }
 
     fn testbench(&self, t: &TbData) -> askama::Result<String> {

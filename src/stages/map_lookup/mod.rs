@@ -88,15 +88,7 @@ impl Unit for MapLookup {
         v.push(i("pu_i", pos, "position along u"));
         v.push(i("pv_i", pos, "position along v"));
         v.push(i("rd_buf_i", 1, "buffer this sample reads"));
-        v.push(i("wr_en_i", 1, "host write, independent of en_i"));
-        v.push(i("wr_buf_i", 1, ""));
-        v.push(i("wr_axis_i", 2, ""));
-        v.push(i(
-            "wr_addr_i",
-            cfg.map_addr_bits(),
-            "{s_max, s_u, i_u, s_v, i_v}",
-        ));
-        v.push(i("wr_data_i", mb, ""));
+        v.extend(crate::rtl::ports::host_write(cfg));
         v.push(o("valid_o", 1, ""));
         v.push(o("e00_o", mb, "entry (base_u, base_v)"));
         if cfg.interpolation {

@@ -68,6 +68,11 @@ pub struct SidebandDelays {
     /// with [`Config::side_bits`] > 0; left out of the manifest without it).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub side: Option<u32>,
+    /// The read buffer, from acceptance to the compensation table's inputs (only with
+    /// `comp_table = ram`, whose table is double-buffered; left out of the manifest without
+    /// it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub table_buf: Option<u32>,
 }
 
 pub fn sideband_delays(cfg: &Config) -> SidebandDelays {
@@ -89,6 +94,7 @@ pub fn sideband_delays(cfg: &Config) -> SidebandDelays {
         rgb: color.map(|_| before_color),
         intensity: color,
         side: (cfg.side_bits() > 0).then(|| top_latency(cfg) - OUTPUT_LATENCY),
+        table_buf: (!cfg.comp_table.is_rom()).then(|| sort + lat(cfg, &Normalise)),
     }
 }
 

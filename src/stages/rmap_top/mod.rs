@@ -102,6 +102,10 @@ struct Verilog {
     side_delay: u32,
     /// normalise reads a reciprocal ROM shared in rmap_lanes through the recip_* ports.
     recip_out: bool,
+    /// The compensation table is a double-buffered RAM on the host write port
+    /// (`comp_table = ram`), read in the buffer delayed by `table_buf_delay`.
+    table_ram: bool,
+    table_buf_delay: u32,
 }
 
 /// `sort_shift 4, normalise 6, ...`: each stage of [`pipeline`] with its latency.
@@ -264,6 +268,8 @@ impl Unit for RmapTop {
             axis: cfg.axis,
             side_delay: d.side.unwrap_or(0),
             recip_out: recip_rom::dual(cfg),
+            table_ram: d.table_buf.is_some(),
+            table_buf_delay: d.table_buf.unwrap_or(0),
         }
         .render()
     }

@@ -47,6 +47,9 @@ module {= h.module =}{= h.params =} (
 {%- if sd > 0 %}
   localparam SIDE_DELAY = {= side_delay =};  // accept to the output register
 {%- endif %}
+{%- if table_ram %}
+  localparam TABLE_BUF_DELAY = {= table_buf_delay =};  // accept to {= position =} in
+{%- endif %}
 
 {%- if handshake %}
   // Every stage's clock enable: a register (see the flow control below).
@@ -134,6 +137,19 @@ module {= h.module =}{= h.params =} (
   // ---------------------------------------------------------------- {= position =}
   wire           ps_valid;
   wire [POS-1:0] ps_u, ps_v;
+{%- if table_ram %}
+  wire           ps_rd_buf;  // the buffer whose table the sample reads
+
+  {= mods.pipe_delay =} #(
+    .WIDTH (1),
+    .DEPTH (TABLE_BUF_DELAY)
+  ) u_table_buf_delay (
+    .clk_i (clk_i),
+    .en_i  (en),
+    .d_i   (front_d),
+    .q_o   (ps_rd_buf)
+  );
+{%- endif %}
 
   {= mods.position =}{= pars.position =} u_{= position =} (
     .clk_i   (clk_i),
@@ -142,6 +158,14 @@ module {= h.module =}{= h.params =} (
     .valid_i (nm_valid),
     .u_i     (nm_u),
     .v_i     (nm_v),
+{%- if table_ram %}
+    .rd_buf_i  (ps_rd_buf),
+    .wr_en_i   (wr_en_i),
+    .wr_buf_i  (~front_d),
+    .wr_axis_i (wr_axis_i),
+    .wr_addr_i (wr_addr_i),
+    .wr_data_i (wr_data_i),
+{%- endif %}
     .valid_o (ps_valid),
     .pu_o    (ps_u),
     .pv_o    (ps_v)
