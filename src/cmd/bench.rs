@@ -102,6 +102,11 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     );
     let d = Options::default();
     let out = StagedDir::new(&a.out, &a.force.policy(&[a.map.input()]))?;
+    // Its designs hold the compensation table in a ROM (the loaded table has no rows yet).
+    anyhow::ensure!(
+        a.map.map_fit != Some(crate::model::map_fit::MapFit::Table),
+        "bench measures designs whose compensation table is a ROM, and map_fit table needs --comp-table ram; give another --map-fit"
+    );
     let opts = Options {
         size: a.size,
         seconds: a.seconds,

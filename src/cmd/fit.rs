@@ -95,6 +95,11 @@ pub struct FitArgs {
 pub fn run(a: &FitArgs) -> Result<()> {
     crate::vectors::check_stage_vectors(a.vectors, "--vectors")?;
     let scene = a.map.scene_or(|| anyhow::bail!("fit needs --scene FILE"))?;
+    // The search is over ROM designs (the loaded table is not among its options yet).
+    anyhow::ensure!(
+        scene.map_fit != crate::model::map_fit::MapFit::Table,
+        "fit searches designs whose compensation table is a ROM, and map_fit table needs --comp-table ram; give another --map-fit"
+    );
     let scene_file = a.map.input().unwrap_or(std::path::Path::new("")).display();
     let base = Config {
         grad_bits: a.grad_bits,

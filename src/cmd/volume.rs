@@ -491,6 +491,7 @@ fn timing(
 pub fn run(a: &VolumeArgs) -> Result<()> {
     let cfg = a.cfg.resolve()?;
     let mut scene = scene(a)?;
+    scene.map_fit.check(&cfg)?;
     let opts = CastOptions {
         size: a.size,
         step: a.step,
