@@ -184,14 +184,19 @@ axis-test: build venv
 # grouped proof of the narrowest design with the skid-drop plant must fail (the groups'
 # assumption is not vacuous); then each planted fault of run_formal.py must make a bounded search from reset on the narrowest
 # design fail the property it breaks, and every property must be broken by at least three of
-# them (--all-plants). The SymbiYosys runs of each step go side by side, one per core (JOBS
-# sets how many). Logs in $(FORMAL_BUILD). About 1 minute on 2 cores (101 s one run at a
-# time; docs/VERIFICATION.md).
+# them (--all-plants). With the compensation table a loaded RAM ($(FORMAL_TABLE_FLAGS): the
+# narrow design with the table and interpolation, 11 pipeline clocks) the proof adds the
+# table's read buffer and writes (a_tbl_rd_buf, a_tbl_wr_buf), and each of the table's six
+# plants must break one. The SymbiYosys runs of each step go side by side, one per core (JOBS
+# sets how many). Logs in $(FORMAL_BUILD). About 2 minutes on 2 cores (docs/VERIFICATION.md).
 FORMAL_OUT       ?= build/rtl_formal
 FORMAL_DEF_OUT   ?= build/rtl_formal_default
 FORMAL_BUILD     ?= build/formal
 FORMAL_FLAGS     ?= --handshake --axis --axis-user 3 --grad-bits 8 --red-bits 6 --recip-bits 5 --frac-bits 4 --index-bits 2 --no-interpolation --map-bits 6 --no-compensation --pipeline-depth 0
 FORMAL_DEF_FLAGS ?= --handshake --axis --axis-user 4
+FORMAL_TABLE_OUT   ?= build/rtl_formal_table
+FORMAL_TABLE_FLAGS ?= --handshake --axis --axis-user 3 --grad-bits 8 --red-bits 6 --recip-bits 5 --frac-bits 4 --index-bits 2 --interp-bits 1 --map-bits 6 --pipeline-depth 0 --comp-table ram
+FORMAL_TABLE_PLANTS = $(foreach p,tbl-swap-late tbl-rd-zero tbl-delay tbl-wr-front tbl-wr-same tbl-wr-one,--plant $(p))
 
 .PHONY: formal
 
@@ -202,6 +207,9 @@ formal: build venv
 	$(VENV)/bin/python formal/run_formal.py $(FORMAL_OUT) --build $(FORMAL_BUILD)/narrow --proof-plant skid-drop
 	$(VENV)/bin/python formal/run_formal.py $(FORMAL_DEF_OUT) --build $(FORMAL_BUILD)/default
 	$(VENV)/bin/python formal/run_formal.py $(FORMAL_OUT) --build $(FORMAL_BUILD)/narrow --all-plants
+	$(RMAPGEN) generate --out $(FORMAL_TABLE_OUT) $(FORMAL_TABLE_FLAGS)
+	$(VENV)/bin/python formal/run_formal.py $(FORMAL_TABLE_OUT) --build $(FORMAL_BUILD)/table
+	$(VENV)/bin/python formal/run_formal.py $(FORMAL_TABLE_OUT) --build $(FORMAL_BUILD)/table $(FORMAL_TABLE_PLANTS)
 
 # ---- Every input (rmapgen prove, src/prove/): the generated RTL of $(PROVE_DIR) equal to
 # its model on all 2^(3G) gradients (2^36 for the default design), factored by the pipeline's

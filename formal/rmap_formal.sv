@@ -15,6 +15,9 @@
 //              is the pipeline's clock enable register (ready_i reaches it only through a clock)
 //   a_rd_buf   the sample entering map_lookup reads the front buffer of its acceptance edge
 //              (swap_i in that clock included); a_wr_buf: host writes go to the back buffer
+//   a_tbl_rd_buf, a_tbl_wr_buf  the same for the compensation table when it is a loaded RAM
+//              (comp_table = ram, TBUFD > 0): the sample entering atan_rom reads the table of
+//              its acceptance edge's front buffer, and host writes go to its back buffer
 //   a_live     bounded response: after LAT + 1 edges in a row with ready_i high, the samples in
 //              flight are exactly those accepted at the last LAT edges (LAT: the manifest's
 //              documented latency), so every sample leaves LAT edges after its acceptance
@@ -32,6 +35,7 @@ module rmap_formal #(
   parameter SD   = 5,   // side_i width: the tag
   parameter L    = 23,  // pipeline length, accept to the output register (SIDE_DELAY)
   parameter BUFD = 12,  // accept to map_lookup's input (BUF_DELAY)
+  parameter TBUFD = 0,  // accept to atan_rom's input (TABLE_BUF_DELAY); 0: the table is a ROM
   parameter FW   = 6,   // width of the in-flight count: 2^FW > L + 2
   parameter LAT  = 24,  // documented latency, accept to valid_o (the manifest's "latency")
   parameter INV  = 1,   // 1: assert the inductive invariants inv_* too (the proof); 0: only the
@@ -58,6 +62,11 @@ module rmap_formal #(
   wire [L*SD-1:0] p_s;      // u_side_delay's line, newest in the low SD bits
   wire [BUFD-1:0] p_b;      // u_buf_delay's line
   wire            p_rd;     // map_lookup's rd_buf_i
+  localparam TBW = TBUFD > 0 ? TBUFD : 1;
+  localparam TBI = TBUFD > 0 ? TBUFD - 1 : 0;
+  wire [TBW-1:0]  p_tb;     // u_table_buf_delay's line (TBUFD > 0)
+  wire            p_trd;    // atan_rom's rd_buf_i (TBUFD > 0)
+  wire            p_twrbuf; // atan_rom's wr_buf_i (TBUFD > 0)
   wire            p_wrbuf;  // map_lookup's wr_buf_i
   wire            p_front;  // the front-buffer register
   wire            p_head;   // the output queue: head (valid_o) and skid entries
@@ -207,6 +216,7 @@ module rmap_formal #(
         // ... and stage k holds what was accepted at the last k + 1 edges: d[k] = win_q[k].
         if (hi_q >= k + 2) live_ok = live_ok && {{FW-SD{1'b0}}, d[k]} == win_q[k];
         if (k < BUFD && p_v[k]) rd_ok = rd_ok && p_b[k] == rec_q[p_s[k*SD +: SD]];
+        if (k < TBUFD && p_v[k]) rd_ok = rd_ok && p_tb[k] == rec_q[p_s[k*SD +: SD]];
       end
     end
     // The head holds what was accepted LAT edges ago: with the line, the samples in flight
@@ -260,8 +270,11 @@ module rmap_formal #(
   wire c_hold      = rs || first || !stall_q || (valid_o && i_o == i_q && zero_o == zero_q && side_o == side_q);
   wire c_rdy_rule  = rs || first || ready_o || stall_q;
   wire c_wr_buf    = p_wrbuf == !front_d;
+  wire c_tbl_rd_buf = TBUFD == 0 || rs || !p_v[TBI] || p_trd == rec_q[p_s[TBI*SD +: SD]];
+  wire c_tbl_wr_buf = TBUFD == 0 || p_twrbuf == !front_d;
   wire props_ok = c_rdy_reset && c_fly && c_order && c_rd_buf && c_rdy_en && c_head && c_live
-               && c_rdy_first && c_hold && c_rdy_rule && c_wr_buf;
+               && c_rdy_first && c_hold && c_rdy_rule && c_wr_buf && c_tbl_rd_buf
+               && c_tbl_wr_buf;
   wire invs_ok  = c_front0 && c_live0 && c_queue && c_fill && c_chain && c_bound && c_end && c_rd
                && c_front && c_en && c_live_q && c_live_s;
 
@@ -290,6 +303,7 @@ module rmap_formal #(
       a_rdy_first: assert (c_rdy_first);
       a_rdy_rule:  assert (c_rdy_rule);
       a_wr_buf:    assert (c_wr_buf);
+      a_tbl_wr_buf: assert (c_tbl_wr_buf);
       if (INV) begin inv_front0: assert (c_front0); end
       if (INV) begin inv_live0:  assert (c_live0); end
       if (INV) begin inv_front:  assert (c_front); end
@@ -308,6 +322,7 @@ module rmap_formal #(
     if (INV && (CHK == 0 || CHK == 6)) begin inv_end:   assert (c_end); end
     if (CHK == 0 || CHK == 7) begin
       a_rd_buf:    assert (c_rd_buf);
+      a_tbl_rd_buf: assert (c_tbl_rd_buf);
       if (INV) begin inv_rd:     assert (c_rd); end
     end
     if (CHK == 0 || CHK == 8) begin

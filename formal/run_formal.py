@@ -114,7 +114,26 @@ PLANTS = {
     # would read the wrong result): only the bounded response sees it.
     "latency-doc": (re.compile(r'^(  "latency": )(\d+),$', re.M),
                     lambda m: f"{m.group(1)}{int(m.group(2)) + 1},", "a_live", "manifest.json"),
+    # The loaded compensation table (comp_table = ram): its read buffer and its writes.
+    "tbl-swap-late": (".d_i   (front_d),\n    .q_o   (ps_rd_buf)",
+                      ".d_i   (front_q),\n    .q_o   (ps_rd_buf)", "a_tbl_rd_buf"),
+    "tbl-rd-zero": (".d_i   (front_d),\n    .q_o   (ps_rd_buf)",
+                    ".d_i   (1'b0),\n    .q_o   (ps_rd_buf)", "a_tbl_rd_buf"),
+    "tbl-delay": (re.compile(r"(localparam TABLE_BUF_DELAY = )(\d+);"),
+                  lambda m: f"{m.group(1)}{int(m.group(2)) + 1};", "a_tbl_rd_buf"),
+    "tbl-wr-front": (".rd_buf_i  (ps_rd_buf),\n    .wr_en_i   (wr_en_i),\n    .wr_buf_i  (~front_d),",
+                     ".rd_buf_i  (ps_rd_buf),\n    .wr_en_i   (wr_en_i),\n    .wr_buf_i  (~front_q),",
+                     "a_tbl_wr_buf"),
+    "tbl-wr-same": (".rd_buf_i  (ps_rd_buf),\n    .wr_en_i   (wr_en_i),\n    .wr_buf_i  (~front_d),",
+                    ".rd_buf_i  (ps_rd_buf),\n    .wr_en_i   (wr_en_i),\n    .wr_buf_i  (front_d),",
+                    "a_tbl_wr_buf"),
+    "tbl-wr-one": (".rd_buf_i  (ps_rd_buf),\n    .wr_en_i   (wr_en_i),\n    .wr_buf_i  (~front_d),",
+                   ".rd_buf_i  (ps_rd_buf),\n    .wr_en_i   (wr_en_i),\n    .wr_buf_i  (1'b1),",
+                   "a_tbl_wr_buf"),
 }
+
+# The properties that hold only of a design whose compensation table is a loaded RAM.
+TABLE_PROPS = ("a_tbl_rd_buf", "a_tbl_wr_buf")
 
 
 def tool(name):
@@ -156,6 +175,9 @@ def params(top):
     if "map_lookup" not in names:
         sys.exit(f"run_formal: {top}: no map_lookup stage")
     p["BUFD"] = sum(n for _, n in stages[:names.index("map_lookup")])
+    # atan_rom's input, when its table is a loaded RAM (the top has the table's buffer line).
+    p["TBUFD"] = (sum(n for _, n in stages[:names.index("atan_rom")])
+                  if "u_table_buf_delay" in text else 0)
     p["FW"] = (p["L"] + 2).bit_length() + 1
     # The documented latency (accept to valid_o, enabled clocks) from the manifest rmapgen wrote
     # with the design, not from the Verilog: a_live holds the RTL to what the design promises.
@@ -183,6 +205,9 @@ def sby_text(design, p, stages, mode, depth, engine):
                "p_rd u_dut.ml_rd_buf", "p_wrbuf u_dut.u_map_lookup.wr_buf_i",
                "p_front u_dut.front_q", "p_head u_dut.valid_q", "p_skid u_dut.skid_valid_q",
                "p_skid_s u_dut.skid_side_q", "p_en u_dut.en_q"]
+    if p["TBUFD"]:
+        probes += [f"p_tb u_dut.u_table_buf_delay.line_q[{p['TBUFD'] - 1}:0]",
+                   "p_trd u_dut.ps_rd_buf", "p_twrbuf u_dut.u_atan_rom.wr_buf_i"]
     connects = "\n".join(f"connect -nounset -set {c}" for c in probes)
     listed = "\n".join([str(HARNESS)] + [str(f) for f in files])
     return f"""[options]
@@ -292,6 +317,17 @@ def prove(design, build, depth, bmc, solver, pool, one_query=False, stop=False):
     return status, sorted(set(failed)), secs, p, runs
 
 
+def applies(design, name):
+    """Whether each edit of the plant matches the design exactly once (the table's plants
+    need a loaded table; the others' patterns occur twice in such a design)."""
+    old, new, _ = PLANTS[name][:3]
+    file = PLANTS[name][3] if len(PLANTS[name]) > 3 else "rmap_top.v"
+    text = (design / file).read_text()
+    edits = old if isinstance(old, list) else [(old, new)]
+    return all((len(o.findall(text)) if isinstance(o, re.Pattern) else text.count(o)) == 1
+               for o, _ in edits)
+
+
 def plant(design, build, name):
     """A copy of `design` with the plant's edits: (old, new, assertion[, file]), or with a list
     of (old, new) pairs in place of old and None for new."""
@@ -337,9 +373,12 @@ def main():
     if a.jobs < 1:
         sys.exit(f"run_formal: --jobs {a.jobs}: must be at least 1")
     pool = concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs)
-    if a.all_plants:
-        a.plant = list(PLANTS)
     design = a.design.resolve()
+    # Every plant that applies to the design (see applies): the table's on a design with a
+    # loaded table.
+    applicable = [n for n in PLANTS if applies(design, n)]
+    if a.all_plants:
+        a.plant = applicable
     build = a.build.resolve()
     ok = bad = 0
     broke = {}  # plant -> the assertions it made fail
@@ -387,8 +426,11 @@ def main():
         ok, bad = (ok + 1, bad) if good else (ok, bad + 1)
     # Every property of the harness must be broken by at least three of the plants (the
     # assertions that failed at each plant's first failing step), when all of them ran.
-    if set(a.plant) == set(PLANTS):
+    if a.all_plants:
         props = re.findall(r"\b(a_\w+):\s+assert", HARNESS.read_text())
+        # A property of the loaded table holds trivially (and no plant applies) without one.
+        if not any(n.startswith("tbl-") for n in applicable):
+            props = [p for p in props if p not in TABLE_PROPS]
         counts = {p: sum(1 for f in broke.values() if p in f) for p in props}
         print("run_formal: plants per property: "
               + ", ".join(f"{p} {n}" for p, n in counts.items()), flush=True)
