@@ -661,6 +661,13 @@ mod tests {
         let f = exhaustive(&g, &[vec![("s".into(), 2)]]).unwrap();
         assert_eq!(f, Some(vec![("s".into(), 2), ("x".into(), 1)]));
         assert_eq!(exhaustive(&g, &[vec![("s".into(), 1)]]).unwrap(), None);
+        // A signal whose first input bit is not bit 0 is reported at its own bit: s = 2, not
+        // 0 (cargo-mutants: `<<` -> `>>` where a signal's first bit is placed).
+        let aag = "aag 3 2 0 1 1\n2\n4\n7\n6 2 4\n";
+        let map = "input 0 0 x\ninput 1 1 s\noutput 0 0 ok\n";
+        let g = Aig::parse(aag, map).unwrap();
+        let f = exhaustive(&g, &[Vec::new()]).unwrap();
+        assert_eq!(f, Some(vec![("x".into(), 1), ("s".into(), 2)]));
     }
 
     #[test]
