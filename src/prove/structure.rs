@@ -637,3 +637,33 @@ pub fn check(d: &DesignDir, build: &Path) -> Result<Part> {
     fails.checked = 1;
     Ok(Part::new("structure", 0..1, 1, fails))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn reg(kind: &str, d: u64, q: u64) -> Cell {
+        Cell {
+            name: format!("r{q}"),
+            kind: kind.to_string(),
+            inputs: vec![("D".into(), vec![Some(d)])],
+            outputs: vec![("Q".into(), vec![Some(q)])],
+            params: HashMap::new(),
+            undefined: Vec::new(),
+            src: "top.v:1.1-1.2|s.v:7.3-7.9".into(),
+        }
+    }
+
+    /// A `$dff` holding its own value is never loaded; one with a reset that loads it
+    /// (`$adff`) is defined, and a register loaded from elsewhere is not flagged.
+    #[test]
+    fn only_registers_without_a_reset_that_hold_themselves_are_never_loaded() {
+        let m = Module {
+            ports: HashMap::new(),
+            netnames: HashMap::from([("u.hold_q".to_string(), vec![Some(5)])]),
+            cells: vec![reg("$dff", 5, 5), reg("$adff", 6, 6), reg("$dff", 7, 8)],
+        };
+        let v = never_loaded(&m);
+        assert_eq!(v, vec![("u.hold_q".into(), "s.v:7".into(), "[0]".into())]);
+    }
+}
