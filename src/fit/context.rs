@@ -95,6 +95,8 @@ impl Ctx<'_> {
             summary: cfg.summary(),
             bits: space::bits(cfg),
             cells: None,
+            fits: None,
+            shortage: None,
             meets_target: target.met_by(&errors),
             errors,
         }

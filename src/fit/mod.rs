@@ -50,11 +50,14 @@ pub struct Options {
     pub size: u32,
     pub target: Target,
     pub cost: CostKind,
-    /// The family whose Yosys synthesis counts the cells (cost in cells).
-    pub family: crate::rtl::fpga::Family,
+    /// The part: its family's Yosys synthesis counts the cells (cost in cells); with
+    /// `check_part`, the choice and the runners-up must fit it.
+    pub part: crate::rtl::fpga::Options,
+    /// Whether a passing candidate must fit `part` ([`cells::on_part`] packs it) to be chosen.
+    pub check_part: bool,
     /// Passing candidates reported after the choice.
     pub runners_up: usize,
-    /// With cost in cells: candidates synthesised.
+    /// With cost in cells, or the part checked: passing candidates synthesised (at most).
     pub synth_limit: usize,
     /// How the maps are filled (the scene's own `map_fit` unless overridden).
     pub map_fit: MapFit,
@@ -101,12 +104,25 @@ pub fn search(scene: &Scene, opts: &Options, progress: Progress) -> Result<Outco
     let mut class_left: Vec<usize> = (0..4)
         .map(|k| cands.iter().filter(|c| classes(c) == k).count())
         .collect();
-    let wanted = |passing: &[usize], minimal: &[Vec<usize>], left: &[usize]| match opts.cost {
+    // With the part checked and cost in bits: passing candidates in bits order are
+    // synthesised and packed (a few at a time) until enough fit or `synth_limit` were tried.
+    let check_bits = opts.check_part && opts.cost == CostKind::Bits;
+    let mut on_part: Vec<Option<cells::OnPart>> = vec![None; cands.len()];
+    let mut fitting: Vec<usize> = Vec::new();
+    let mut tried = 0;
+    let wanted = |passing: &[usize],
+                  fitting: &[usize],
+                  tried: usize,
+                  minimal: &[Vec<usize>],
+                  left: &[usize]| match opts.cost {
+        CostKind::Bits if check_bits => {
+            fitting.len() > opts.runners_up || tried >= opts.synth_limit
+        }
         CostKind::Bits => passing.len() > opts.runners_up,
         CostKind::Cells => (0..4).all(|k| minimal[k].len() >= per_class || left[k] == 0),
     };
     let mut pos = 0;
-    while pos < cands.len() && !wanted(&passing, &minimal, &class_left) {
+    while pos < cands.len() && !wanted(&passing, &fitting, tried, &minimal, &class_left) {
         let end = (pos + BATCH).min(cands.len());
         let batch: Vec<Errors> = cands[pos..end]
             .par_iter()
@@ -128,6 +144,39 @@ pub fn search(scene: &Scene, opts: &Options, progress: Progress) -> Result<Outco
             results[i] = Some(e);
         }
         pos = end;
+        if check_bits {
+            let fresh: Vec<usize> = passing
+                .iter()
+                .copied()
+                .filter(|&i| on_part[i].is_none())
+                .collect();
+            for chunk in fresh.chunks(rayon::current_num_threads().max(1)) {
+                if fitting.len() > opts.runners_up || tried >= opts.synth_limit {
+                    break;
+                }
+                let chunk = &chunk[..chunk.len().min(opts.synth_limit - tried)];
+                let done: Vec<cells::OnPart> = chunk
+                    .par_iter()
+                    .map(|&i| cells::on_part(&cands[i], scene, &opts.part, true))
+                    .collect::<Result<_>>()?;
+                for (&i, o) in chunk.iter().zip(done) {
+                    tried += 1;
+                    if o.shortage.is_none() {
+                        fitting.push(i);
+                    }
+                    progress(
+                        tried,
+                        opts.synth_limit,
+                        &format!(
+                            "packed {}: {}",
+                            cands[i].summary(),
+                            o.shortage.as_deref().unwrap_or("fits")
+                        ),
+                    );
+                    on_part[i] = Some(o);
+                }
+            }
+        }
         let note = match first {
             Some(f) => format!("cheapest passing so far: {} bits", space::bits(&cands[f])),
             None => format!(
@@ -143,7 +192,29 @@ pub fn search(scene: &Scene, opts: &Options, progress: Progress) -> Result<Outco
             &ctx, &cands, &target, progress,
         ))));
     };
+    let with_part = |mut c: Candidate, o: &cells::OnPart| {
+        if opts.cost == CostKind::Cells {
+            c.cells = Some(o.cells);
+        }
+        if opts.check_part {
+            c.fits = Some(o.shortage.is_none());
+            c.shortage = o.shortage.clone();
+        }
+        c
+    };
+    // Every passing candidate synthesised (and with the part checked, packed), in the order
+    // of the choice.
     let mut shown: Vec<Candidate> = match opts.cost {
+        CostKind::Bits if check_bits => passing
+            .iter()
+            .filter_map(|&i| Some((i, on_part[i].as_ref()?)))
+            .map(|(i, o)| {
+                with_part(
+                    ctx.candidate(&cands[i], results[i].expect("measured"), &target),
+                    o,
+                )
+            })
+            .collect(),
         CostKind::Bits => passing
             .iter()
             .take(opts.runners_up + 1)
@@ -156,22 +227,44 @@ pub fn search(scene: &Scene, opts: &Options, progress: Progress) -> Result<Outco
             let mut v: Vec<Candidate> = pick
                 .par_iter()
                 .map(|&i| {
-                    let mut c = ctx.candidate(&cands[i], results[i].expect("measured"), &target);
-                    c.cells = Some(cells::cells(&cands[i], scene, opts.family)?);
+                    let c = ctx.candidate(&cands[i], results[i].expect("measured"), &target);
+                    let o = cells::on_part(&cands[i], scene, &opts.part, opts.check_part)?;
                     let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                     progress(n, pick.len(), &format!("synthesised {}", c.summary));
-                    Ok(c)
+                    Ok(with_part(c, &o))
                 })
                 .collect::<Result<_>>()?;
             v.sort_by_key(|c| (c.cells, space::order_key(&c.config, c.bits)));
             v
         }
     };
-    let synthesised = if opts.cost == CostKind::Cells {
+    let synthesised = if opts.cost == CostKind::Cells || check_bits {
         shown.len()
     } else {
         0
     };
+    // Those that do not fit the part are not chosen; the first of them is reported.
+    let too_big: Vec<Candidate> = shown
+        .iter()
+        .filter(|c| c.fits == Some(false))
+        .cloned()
+        .collect();
+    shown.retain(|c| c.fits != Some(false));
+    if shown.is_empty() {
+        let c = too_big
+            .first()
+            .expect("a passing candidate was synthesised");
+        anyhow::bail!(
+            "none of the {} configurations that meet {} and were synthesised fits the {} {} (--synth-limit {}): the first, {}: {}",
+            too_big.len(),
+            target.describe(),
+            opts.part.family.title(),
+            opts.part.device,
+            opts.synth_limit,
+            c.summary,
+            c.shortage.as_deref().unwrap_or_default()
+        );
+    }
     let chosen = shown.remove(0);
     shown.truncate(opts.runners_up);
     // The nearest rejected candidates below the (bits-)cheapest passing one, measured in full.
@@ -183,13 +276,22 @@ pub fn search(scene: &Scene, opts: &Options, progress: Progress) -> Result<Outco
         .map(|i| ctx.full(&cands[i], &target))
         .collect();
     let mut paper = ctx.full(&space::paper(&base), &target);
-    if opts.cost == CostKind::Cells {
-        paper.cells = Some(cells::cells(&paper.config, scene, opts.family)?);
+    if opts.cost == CostKind::Cells || opts.check_part {
+        let o = cells::on_part(&paper.config, scene, &opts.part, opts.check_part)?;
+        paper = with_part(paper, &o);
     }
+    let part = opts.check_part.then(|| outcome::Part {
+        family: opts.part.family,
+        device: opts.part.device.clone(),
+        package: opts.part.package.clone(),
+        too_big: too_big.len(),
+        first_too_big: too_big.into_iter().next(),
+    });
     Ok(Outcome::Found(Box::new(Decision {
         target,
         cost: opts.cost,
-        family: opts.family,
+        family: opts.part.family,
+        part,
         image_size: opts.size,
         pixels: img.pixels(),
         map_fit: opts.map_fit,

@@ -18,6 +18,24 @@ pub struct Candidate {
     pub cells: Option<u64>,
     pub errors: Errors,
     pub meets_target: bool,
+    /// With the part checked (`fit --family/--device`): whether its design, synthesised and
+    /// packed, fits the part; what it needs more of than the part has, when it does not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fits: Option<bool>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shortage: Option<String>,
+}
+
+/// The part a search had to fit, and the passing candidates it turned away.
+#[derive(Clone, Debug, Serialize)]
+pub struct Part {
+    pub family: crate::rtl::fpga::Family,
+    pub device: String,
+    pub package: String,
+    /// Passing candidates synthesised and packed that do not fit.
+    pub too_big: usize,
+    /// The first of them (cheapest in the order of the choice).
+    pub first_too_big: Option<Candidate>,
 }
 
 /// The result of a successful search.
@@ -29,6 +47,9 @@ pub struct Decision {
     /// default), so a default fit writes what it wrote before the flag.
     #[serde(skip_serializing_if = "is_ice40")]
     pub family: crate::rtl::fpga::Family,
+    /// With `--family`/`--device`: the part every chosen or listed candidate fits.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub part: Option<Part>,
     pub image_size: u32,
     pub pixels: usize,
     pub map_fit: MapFit,
@@ -132,7 +153,11 @@ impl Decision {
                 } else {
                     String::new()
                 },
-                if c.meets_target { "" } else { "  (misses)" }
+                match (c.meets_target, c.fits) {
+                    (false, _) => "  (misses)",
+                    (true, Some(false)) => "  (does not fit)",
+                    _ => "",
+                }
             ));
         };
         row("chosen", &self.chosen);

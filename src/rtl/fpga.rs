@@ -272,6 +272,13 @@ pub fn shortage(out: &str, said: &str) -> Option<String> {
         let have = rest.split_whitespace().next()?;
         Some((need.trim().parse::<u64>().ok()?, have.parse::<u64>().ok()?))
     })?;
+    Some(ran_out(cell, need, have))
+}
+
+/// "the design needs NEED CELL (what it is), the part has HAVE: use (what to change)": one
+/// phrase for nextpnr's cell type `cell`, whether nextpnr failed to place it ([`shortage`]) or
+/// its packing counted more than the part has ([`Utilisation::shortage`]).
+fn ran_out(cell: &str, need: u64, have: u64) -> String {
     let (what, change) = match cell {
         "ICESTORM_RAM" | "DP16KD" => (
             "block RAMs",
@@ -281,13 +288,84 @@ pub fn shortage(out: &str, said: &str) -> Option<String> {
             "logic cells",
             "a larger part (--device), fewer lanes, or --mult infer on a part with DSP blocks",
         ),
-        "SB_MAC16" | "MULT18X18D" => ("DSP blocks", "--mult tree, or a part with more DSP blocks"),
+        "SB_MAC16" | "ICESTORM_DSP" | "MULT18X18D" => {
+            ("DSP blocks", "--mult tree, or a part with more DSP blocks")
+        }
         "TRELLIS_IO" | "SB_IO" => ("I/O cells (pins)", "a larger package (--package)"),
         _ => ("cells", "a larger part (--device)"),
     };
-    Some(format!(
-        "the design needs {need} {cell} ({what}), the part has {have}: use {change}"
-    ))
+    format!("the design needs {need} {cell} ({what}), the part has {have}: use {change}")
+}
+
+/// What a packed design uses of the part, and what the part has, per cell type of nextpnr's
+/// report ([`pack`]).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Utilisation {
+    pub family: Family,
+    /// Cell type (nextpnr's utilisation key), used, available; in the report's order.
+    pub cells: Vec<(String, u64, u64)>,
+}
+
+impl Utilisation {
+    /// Reads nextpnr's report (`utilization`: {"ICESTORM_RAM": {"used": 35, "available": 32},
+    /// ...}).
+    fn from_report(family: Family, report: &serde_json::Value) -> Result<Utilisation> {
+        let util = report["utilization"]
+            .as_object()
+            .context("nextpnr's report has no utilization")?;
+        let cells = util
+            .iter()
+            .map(|(k, v)| {
+                let n = |f: &str| v[f].as_u64().context("nextpnr's utilization is not counts");
+                Ok((k.clone(), n("used")?, n("available")?))
+            })
+            .collect::<Result<_>>()?;
+        Ok(Utilisation { family, cells })
+    }
+
+    /// Used and available of nextpnr's cell type `key` (0 of 0 when the part has none).
+    pub fn of(&self, key: &str) -> (u64, u64) {
+        self.cells
+            .iter()
+            .find(|(k, _, _)| k == key)
+            .map_or((0, 0), |&(_, u, a)| (u, a))
+    }
+
+    /// The first of the family's logic cells, block RAMs and DSP blocks that the design needs
+    /// more of than the part has, as [`ran_out`] says it; None when the design fits. Pins are
+    /// not counted: a core's ports are nets inside the larger design it goes into.
+    pub fn shortage(&self) -> Option<String> {
+        let f = self.family;
+        [f.logic_key(), f.block_ram_key(), f.dsp_key()]
+            .into_iter()
+            .find_map(|k| {
+                let (used, available) = self.of(k);
+                (used > available).then(|| ran_out(k, used, available))
+            })
+    }
+}
+
+/// Packs a [`Synthesis`] into `opts`'s part without placing it (nextpnr `--pack-only`, in the
+/// synthesis's log directory): what the design uses of the part and what the part has. How
+/// `rmapgen fit --family/--device` asks whether a candidate fits the part.
+pub fn pack(syn: &Synthesis, opts: &Options) -> Result<Utilisation> {
+    anyhow::ensure!(
+        syn.family == opts.family,
+        "the design was synthesised for the {}, not the {}",
+        syn.family.title(),
+        opts.family.title()
+    );
+    let run = toolchain::capture(&mut nextpnr::pack_only(&target(opts), &syn.logs, &syn.top))?;
+    if !run.status.success() {
+        bail!("{} --pack-only: {}", part_of(opts), complaint(&run.output));
+    }
+    let report = syn.logs.join(nextpnr::REPORT);
+    let rep: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(&report)
+            .with_context(|| format!("nextpnr wrote no {}", report.display()))?,
+    )
+    .context("nextpnr's report is not JSON")?;
+    Utilisation::from_report(syn.family, &rep)
 }
 
 /// What nextpnr says when the design needs more of a resource than the device has.
@@ -319,6 +397,11 @@ impl Synthesis {
     /// The directory holding the netlist and the logs.
     pub fn logs(&self) -> &Path {
         &self.logs
+    }
+
+    /// What Yosys mapped the design to.
+    pub fn stat(&self) -> &yosys::Ice40Stat {
+        &self.stat
     }
 }
 
@@ -630,6 +713,53 @@ pub fn place(syn: &Synthesis, opts: &Options) -> Result<FpgaReport> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_packed_design_fits_unless_logic_ram_or_dsp_runs_out() {
+        // nextpnr-ice40 --hx8k --pack-only's report of G10 I4 colour (35 of 32 block RAMs;
+        // 116 of 256 I/O, which a core's ports are not).
+        let rep = serde_json::json!({"utilization": {
+            "ICESTORM_LC": {"available": 7680, "used": 3042},
+            "ICESTORM_RAM": {"available": 32, "used": 35},
+            "SB_IO": {"available": 256, "used": 116}}});
+        let u = Utilisation::from_report(Family::Ice40, &rep).unwrap();
+        assert_eq!(u.of("ICESTORM_RAM"), (35, 32));
+        assert_eq!(u.of("ICESTORM_DSP"), (0, 0));
+        assert_eq!(
+            u.shortage().as_deref(),
+            Some("the design needs 35 ICESTORM_RAM (block RAMs), the part has 32: use a larger part (--device), or less memory (a smaller --index-bits or --map-bits, fewer lanes)")
+        );
+        // Exactly full fits; a full part's pins do not count.
+        let full = |lc: u64, io: u64| {
+            Utilisation::from_report(
+                Family::Ice40,
+                &serde_json::json!({"utilization": {
+                "ICESTORM_LC": {"available": 1280, "used": lc},
+                "ICESTORM_RAM": {"available": 16, "used": 16},
+                "SB_IO": {"available": 96, "used": io}}}),
+            )
+            .unwrap()
+            .shortage()
+        };
+        assert_eq!(full(1280, 500), None);
+        assert!(full(1281, 0)
+            .unwrap()
+            .starts_with("the design needs 1281 ICESTORM_LC (logic cells), the part has 1280"));
+        // ECP5: multipliers are counted.
+        let e = Utilisation::from_report(
+            Family::Ecp5,
+            &serde_json::json!({"utilization": {
+            "TRELLIS_COMB": {"available": 24288, "used": 2000},
+            "DP16KD": {"available": 56, "used": 10},
+            "MULT18X18D": {"available": 28, "used": 30}}}),
+        )
+        .unwrap();
+        assert!(e
+            .shortage()
+            .unwrap()
+            .contains("30 MULT18X18D (DSP blocks), the part has 28"));
+        assert!(Utilisation::from_report(Family::Ecp5, &serde_json::json!({})).is_err());
+    }
 
     #[test]
     fn the_fmax_line_names_the_design_clock() {

@@ -344,10 +344,10 @@ fn bad_input_is_one_line_exit_2_and_leaves_the_output_alone() {
             vec!["--scene", &s, "--rmse", "0.0001", "--size", "64"],
             "the lowest RMSE reachable",
         ),
-        // The family only says whose synthesis counts cells.
+        // A part nextpnr does not know is refused before the search.
         (
-            vec!["--scene", &s, "--max-error", "4", "--family", "ecp5"],
-            "--family chooses the synthesis that counts --cost cells",
+            vec!["--scene", &s, "--max-error", "4", "--device", "hx9k"],
+            "nextpnr-ice40 --hx9k: ",
         ),
         (
             vec![
@@ -396,4 +396,77 @@ fn fit_writes_its_design_with_a_prefix() {
     assert_eq!(manifest["top"], "vr_rmap_top");
     assert!(out.join("vr_rmap_top.v").is_file());
     assert!(out.join("vr_map_x.hex").is_file());
+}
+
+/// `fit --device` chooses only what fits the part: every passing configuration it lists is
+/// synthesised and packed into the part, and fits; the paper's G8 design, which needs more
+/// logic cells than the iCE40 HX1K has, is shown as not fitting. When none of those
+/// synthesised fits, the one line names the first and what it needs, and nothing is written.
+#[test]
+fn fit_with_a_part_chooses_only_what_fits_it() {
+    if !require("yosys") || !require("nextpnr-ice40") {
+        return;
+    }
+    let tmp = helpers::tempdir();
+    let g8 = [
+        "--grad-bits",
+        "8",
+        "--map-bits",
+        "6",
+        "--size",
+        "32",
+        "--device",
+        "hx1k",
+    ];
+    let mut args = vec!["--max-error", "4", "--runners-up", "1"];
+    args.extend(g8);
+    let (d, stdout) = fit("standard.toml", &tmp.path().join("f"), &args);
+    assert_eq!(d["part"]["device"], "hx1k", "{stdout}");
+    // A device alone takes nextpnr's package for it.
+    assert_eq!(d["part"]["package"], "tq144", "{stdout}");
+    assert_eq!(d["chosen"]["fits"], true, "{stdout}");
+    for r in d["runners_up"].as_array().unwrap() {
+        assert_eq!(r["fits"], true, "{stdout}");
+    }
+    assert_eq!(d["paper"]["fits"], false, "{stdout}");
+    assert!(
+        d["paper"]["shortage"]
+            .as_str()
+            .unwrap()
+            .contains("ICESTORM_LC (logic cells), the part has 1280"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("(does not fit)"), "{stdout}");
+    assert!(stdout.contains("fit: the iCE40 hx1k (tq144): "), "{stdout}");
+
+    // A tighter target: only designs with the interpolator's multipliers meet it, and none of
+    // the two synthesised fits.
+    let out = tmp.path().join("g");
+    let mut a = vec![
+        "fit",
+        "--scene",
+        &scene_path("standard.toml"),
+        "--out",
+        out.to_str().unwrap(),
+        "--max-error",
+        "2",
+        "--synth-limit",
+        "2",
+    ]
+    .into_iter()
+    .map(String::from)
+    .collect::<Vec<_>>();
+    a.extend(g8.iter().map(|x| x.to_string()));
+    let a: Vec<&str> = a.iter().map(|x| x.as_str()).collect();
+    let o = helpers::run(&a);
+    helpers::assert_error(
+        &o,
+        "none of the 2 configurations that meet max abs error <= 2 LSB and were synthesised fits the iCE40 hx1k (--synth-limit 2): the first, G8 ",
+    );
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("ICESTORM_LC (logic cells), the part has 1280"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(!out.exists());
 }
