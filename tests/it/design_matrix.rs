@@ -1,8 +1,9 @@
 //! Every command that takes a generated design, on small designs built with each option that
 //! changes what a design is (issue 32 §2): a prefix, lanes, the AXI4-Stream top, colour, ECP5
-//! memories, inferred multipliers and a non-default width. Each command reads the design (its
-//! manifest) and either does its job right or refuses in one line (exit 2); none reports
-//! success on a wrong result or fails a correct design.
+//! memories, inferred multipliers and a non-default width. Each command (lint, synth, roms
+//! --update, vectors --maps, sim, fpga --dir, prove) reads the design (its manifest) and either
+//! does its job right or refuses in one line (exit 2); none reports success on a wrong result
+//! or fails a correct design.
 
 use crate::hdl::require;
 use crate::helpers::{self, run_in, tempdir, text, tree};
@@ -93,6 +94,33 @@ fn check(flags: &[&str], prove: Prove) {
         said.contains(&format!("ok:   icarus {tb_top}_tb: ")),
         "{said}"
     );
+
+    // fpga --dir, from the design's parent directory: placed on the iCE40 when the design has
+    // block-RAM memories (an ECP5 design's DP16KD attributes are block RAM on the iCE40 too),
+    // else refused in one line naming the target to generate. The ECP5 design also on the
+    // ECP5, whose tools are the venv's, found from this directory too.
+    let target = manifest["config"]["target"].as_str().unwrap_or("generic");
+    let placed = run_in(p, &["fpga", "--dir", "d", "--logs", "f"]);
+    if target == "generic" {
+        helpers::assert_error(
+            &placed,
+            "the design was generated for --target generic: generate it with --target ice40",
+        );
+    } else {
+        let said = ok("fpga --dir", &placed);
+        assert!(said.contains("fpga: timing "), "{said}");
+        if crate::ecp5::ecp5_tools() {
+            let said = ok(
+                "fpga --family ecp5 --dir",
+                &run_in(
+                    p,
+                    &["fpga", "--family", "ecp5", "--dir", "d", "--logs", "f5"],
+                ),
+            );
+            assert!(said.contains("fpga: timing "), "{said}");
+            assert!(said.contains("ECP5 85k CABGA381"), "{said}");
+        }
+    }
 
     match prove {
         Prove::Refused => {

@@ -13,7 +13,7 @@ use crate::helpers;
 use rmapgen::rtl::{self, fpga};
 use rmapgen::toolchain::{self, nextpnr, yosys};
 
-fn ecp5_tools() -> bool {
+pub(crate) fn ecp5_tools() -> bool {
     let found = toolchain::installed(&nextpnr::nextpnr(fpga::Family::Ecp5))
         && toolchain::installed(&yosys::yosys_ecp5());
     if !found {
