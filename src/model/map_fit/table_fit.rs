@@ -117,7 +117,9 @@ impl TableFit {
                 self.range[c].expect("reachable"),
             );
         }
-        MinimaxFit::with_ranges(&self.cfg, pos).fit_report(shade)
+        MinimaxFit::with_ranges(&self.cfg, pos)
+            .rms_slack(0.0)
+            .fit_report(shade)
     }
 
     /// The fitted table and its maps for one frame.
