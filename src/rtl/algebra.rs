@@ -208,7 +208,7 @@ pub struct Stats {
 /// Whether output words `got` and `spec` of `c` (bits least significant first; bits at and
 /// above `m` ignored) agree modulo 2^m on every input. `m` is at most 64.
 pub fn equal_mod(c: &Circuit, got: usize, spec: usize, m: u32) -> Result<(Verdict, Stats)> {
-    rewrite(c, got, Spec::Word(spec), m)
+    rewrite(c, got, Spec::Word(spec), m, MAX_TERMS)
 }
 
 /// Whether output word `got` of `c` equals the polynomial `spec` over the circuit's inputs
@@ -222,7 +222,7 @@ pub fn equals_polynomial(
     spec: &[Term],
     m: u32,
 ) -> Result<(Verdict, Stats)> {
-    rewrite(c, got, Spec::Polynomial(spec), m)
+    rewrite(c, got, Spec::Polynomial(spec), m, MAX_TERMS)
 }
 
 /// A half adder's carry node, with its two operand literals.
@@ -237,11 +237,10 @@ enum Spec<'a> {
     Polynomial(&'a [Term]),
 }
 
-fn rewrite(c: &Circuit, got: usize, spec: Spec, m: u32) -> Result<(Verdict, Stats)> {
-    if m == 0 || m > 64 {
-        bail!("the algebraic engine compares 1 to 64 bits, not {m}");
-    }
-    let mask = if m == 64 { u64::MAX } else { (1u64 << m) - 1 };
+/// Each XOR node's half-adder carry (None: no AND of the same two variables), and for each
+/// variable the nodes it can never be 1 with (see [`Poly::exclusive`]), nearest first, at
+/// most [`MAX_EXCLUSIVE`] inherited.
+fn exclusions(c: &Circuit) -> (Vec<Option<Carry>>, Vec<Vec<u32>>) {
     let base = c.inputs.len() as u32 + 1;
     // For each XOR node, an AND node of the same two variables, either complemented: the
     // half adder it belongs to (Yosys's ripple carries are ORs, so the carry a sum bit
@@ -299,6 +298,24 @@ fn rewrite(c: &Circuit, got: usize, spec: Spec, m: u32) -> Result<(Verdict, Stat
             }
         }
     }
+    (carry_of, exclusive)
+}
+
+/// Rewrites `sum 2^i got_i - spec` down to the inputs (the module documentation), giving up
+/// when the polynomial holds more than `max_terms` terms ([`MAX_TERMS`]).
+fn rewrite(
+    c: &Circuit,
+    got: usize,
+    spec: Spec,
+    m: u32,
+    max_terms: usize,
+) -> Result<(Verdict, Stats)> {
+    if m == 0 || m > 64 {
+        bail!("the algebraic engine compares 1 to 64 bits, not {m}");
+    }
+    let mask = if m == 64 { u64::MAX } else { (1u64 << m) - 1 };
+    let base = c.inputs.len() as u32 + 1;
+    let (carry_of, exclusive) = exclusions(c);
     let mut p = Poly {
         terms: BTreeMap::new(),
         mask,
@@ -328,9 +345,9 @@ fn rewrite(c: &Circuit, got: usize, spec: Spec, m: u32) -> Result<(Verdict, Stat
     let mut stats = Stats::default();
     loop {
         stats.peak = stats.peak.max(p.terms.len());
-        if p.terms.len() > MAX_TERMS {
+        if p.terms.len() > max_terms {
             bail!(
-                "the polynomial grew past {MAX_TERMS} terms after {} of {} nodes: this netlist needs another engine",
+                "the polynomial grew past {max_terms} terms after {} of {} nodes: this netlist needs another engine",
                 stats.steps,
                 c.nodes.len()
             );
@@ -472,6 +489,93 @@ mod tests {
         let (v, s) = equal_mod(&c, 0, 1, 7).unwrap();
         assert_eq!(v, Verdict::Equal);
         assert!(s.steps > 0);
+    }
+
+    /// The exclusions as documented, read directly (a wrong choice here only slows the
+    /// rewriting, so the verdict tests cannot see it): a sum's carry is the AND of its
+    /// operands complemented alike, the nearest of those, even where an AND complemented
+    /// otherwise is nearer; the pair excludes each other; an AND node inherits what its
+    /// uncomplemented operands exclude, each node once, the nearest [`MAX_EXCLUSIVE`].
+    #[test]
+    fn exclusions_pair_sums_with_carries_and_pass_on_to_ands() {
+        let mut c = Circuit {
+            inputs: Vec::new(),
+            nodes: Vec::new(),
+            outputs: Vec::new(),
+        };
+        let ab = inputs(&mut c, "a", 2);
+        let z = inputs(&mut c, "z", 1)[0];
+        let (a, b) = (ab[0], ab[1]);
+        let x = c.xor(a, b);
+        let mixed = c.and(a, b ^ 1);
+        let _other = c.and(a, z);
+        let k = c.and(a ^ 1, b ^ 1);
+        let n = c.and(k, z);
+        let nc = c.and(k ^ 1, z);
+        let nn = c.and(n, k);
+        let far = c.and(a, b);
+        let (carry, ex) = exclusions(&c);
+        let node = |l: Lit| l / 2;
+        let idx = |l: Lit| (node(l) - 4) as usize;
+        // Among the alike ANDs (a & b, !a & !b) the nearest, not the nearer mixed one.
+        assert_eq!(carry[idx(x)], Some((node(k), a ^ 1, b ^ 1)));
+        assert!(ex[node(far) as usize].is_empty());
+        assert!(ex[node(x) as usize].contains(&node(k)));
+        assert_eq!(ex[node(k) as usize], vec![node(x)]);
+        assert!(!ex[node(mixed) as usize].contains(&node(x)));
+        assert_eq!(ex[node(n) as usize], vec![node(x)]);
+        assert!(
+            ex[node(nc) as usize].is_empty(),
+            "{:?}",
+            ex[node(nc) as usize]
+        );
+        // From both operands, once.
+        assert_eq!(ex[node(nn) as usize], vec![node(x)]);
+
+        // Ten half adders, and an AND of all their carries: it keeps the nearest eight.
+        let mut c = Circuit {
+            inputs: Vec::new(),
+            nodes: Vec::new(),
+            outputs: Vec::new(),
+        };
+        let v = inputs(&mut c, "v", 20);
+        let mut sums = Vec::new();
+        let mut acc = 1;
+        for i in 0..10 {
+            sums.push(c.xor(v[2 * i], v[2 * i + 1]));
+            let k = c.and(v[2 * i], v[2 * i + 1]);
+            acc = c.and(acc, k);
+        }
+        let (_, ex) = exclusions(&c);
+        let mut want: Vec<u32> = sums
+            .iter()
+            .map(|&s| s / 2)
+            .rev()
+            .take(MAX_EXCLUSIVE)
+            .collect();
+        want.sort_unstable_by(|p, q| q.cmp(p));
+        assert_eq!(ex[(acc / 2) as usize], want);
+    }
+
+    /// The term limit: a rewriting whose polynomial peaks at P terms passes with a limit of
+    /// P and is refused, in one message naming the limit, with any limit below it.
+    #[test]
+    fn the_term_limit_is_the_largest_polynomial_allowed() {
+        let c = products(None);
+        let (v, s) = rewrite(&c, 0, Spec::Word(1), 7, MAX_TERMS).unwrap();
+        assert_eq!(v, Verdict::Equal);
+        assert_eq!(
+            rewrite(&c, 0, Spec::Word(1), 7, s.peak).unwrap().0,
+            Verdict::Equal
+        );
+        for limit in 1..s.peak {
+            let e = rewrite(&c, 0, Spec::Word(1), 7, limit).unwrap_err();
+            assert!(
+                e.to_string()
+                    .contains(&format!("the polynomial grew past {limit} terms")),
+                "{e}"
+            );
+        }
     }
 
     /// An AND node inherits the exclusions of its uncomplemented operands only. With the
