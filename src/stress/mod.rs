@@ -37,6 +37,8 @@ pub struct Setup {
     pub fast: FastShader,
     pub reference: Reference,
     pub scene: Scene,
+    /// The tangent each position of a component stands for ([`position_tangents`]).
+    pub tangents: Vec<f64>,
 }
 
 impl Setup {
@@ -46,12 +48,37 @@ impl Setup {
         Setup {
             cfg: cfg.clone(),
             reference: Reference::new(cfg, scene),
+            tangents: position_tangents(&model, &maps),
             model,
             maps,
             fast,
             scene: scene.clone(),
         }
     }
+}
+
+/// The tangent (component / max) each position 0..=pos_max of a component stands for, which
+/// the angular error is measured from. With the compensation ROM (or none) it is the
+/// encoding's own, [`encoded_tangent`]. A compensation table loaded with the maps
+/// (`comp_table = ram`) places the positions where the scene needs them, so a position stands
+/// for the tangents the pipeline maps to it through that table: the middle of their range
+/// (found by [`MinimaxFit::for_model`](crate::model::map_fit::minimax::MinimaxFit::for_model),
+/// as the fit finds it); a position no gradient reaches keeps [`encoded_tangent`] (nothing
+/// reads it).
+pub fn position_tangents(model: &Model, maps: &Maps) -> Vec<f64> {
+    let cfg = &model.cfg;
+    let encoded = |p: u32| encoded_tangent(cfg, p);
+    let Some(table) = &maps.table else {
+        return (0..=cfg.pos_max()).map(encoded).collect();
+    };
+    let mut loaded = model.clone();
+    loaded.atan = Some(table.clone());
+    let fit = crate::model::map_fit::minimax::MinimaxFit::for_model(&loaded);
+    fit.ranges()
+        .iter()
+        .zip(0..)
+        .map(|(r, p)| r.map_or_else(|| encoded(p), |(lo, hi)| (lo + hi) / 2.0))
+        .collect()
 }
 
 /// The magnitude class (sort & shift's shift) of a largest magnitude `max` >= 1.
@@ -80,9 +107,10 @@ pub fn encoded_tangent(cfg: &Config, p: u32) -> f64 {
     crate::geometry::face_tangent(cfg.compensation, p as f64 / cfg.pos_max() as f64)
 }
 
-/// The encoded direction (unit) of a sample with these sort results and positions.
+/// The encoded direction (unit) of a sample with these sort results and positions, each
+/// position standing for `tangents[p]` ([`position_tangents`]).
 pub fn encoded_direction(
-    cfg: &Config,
+    tangents: &[f64],
     axis: u32,
     signs: (u32, u32, u32),
     p_u: u32,
@@ -92,8 +120,8 @@ pub fn encoded_direction(
     let [x, y, z] = crate::geometry::place(
         axis,
         sg(signs.0, 1.0),
-        sg(signs.1, encoded_tangent(cfg, p_u)),
-        sg(signs.2, encoded_tangent(cfg, p_v)),
+        sg(signs.1, tangents[p_u as usize]),
+        sg(signs.2, tangents[p_v as usize]),
     );
     DVec3::new(x, y, z).normalize()
 }
@@ -421,7 +449,13 @@ pub fn sampled_with_progress(
                 class.inputs += 1;
                 class.zero += (out == 0) as u64;
                 class.full += (out == cfg.map_max()) as u64;
-                let dir = encoded_direction(cfg, s.axis, (s.s_max, s.s_u, s.s_v), tr.p_u, tr.p_v);
+                let dir = encoded_direction(
+                    &setup.tangents,
+                    s.axis,
+                    (s.s_max, s.s_u, s.s_v),
+                    tr.p_u,
+                    tr.p_v,
+                );
                 let gv = DVec3::new(g[0] as f64, g[1] as f64, g[2] as f64).normalize();
                 class.angle(angle_deg(dir, gv), i, g);
                 let exact = setup

@@ -71,7 +71,7 @@ fn brute_force(setup: &Setup) -> Vec<(u64, u64, f64, u64, u64)> {
                     let out = t.out.intensity;
                     let e = (out as i64 - setup.reference.intensity(g) as i64).unsigned_abs();
                     let d = stress::encoded_direction(
-                        cfg,
+                        &setup.tangents,
                         s.axis,
                         (s.s_max, s.s_u, s.s_v),
                         t.p_u,
@@ -101,7 +101,9 @@ fn brute_force(setup: &Setup) -> Vec<(u64, u64, f64, u64, u64)> {
 
 /// The exhaustive run's factored evaluation and bounded error search give exactly what
 /// evaluating every 8-bit gradient one by one gives, for scenes with a highlight, two lights
-/// and two-sided lighting, with and without compensation and interpolation.
+/// and two-sided lighting, with and without compensation and interpolation, and with a
+/// compensation table loaded with the maps (`comp_table = ram`, a table bunched toward small
+/// tangents): its angles measured from the positions' own tangent ranges.
 #[test]
 fn exhaustive_equals_brute_force_on_8_bit_gradients() {
     let base = Config {
@@ -133,8 +135,35 @@ fn exhaustive_equals_brute_force_on_8_bit_gradients() {
             two_sided,
         ),
     ];
-    for (cfg, scene) in cases {
-        let setup = Setup::new(&cfg, &scene, scene.maps(&cfg));
+    let loaded = Config {
+        comp_table: rmapgen::config::CompTable::Ram,
+        ..base.clone()
+    };
+    let squashed: Vec<u32> = (0..loaded.atan_entries())
+        .map(|u| {
+            let x = u as f64 / (loaded.atan_entries() - 1) as f64;
+            (x.sqrt() * loaded.pos_max() as f64).round() as u32
+        })
+        .collect();
+    let mut setups: Vec<(Config, Setup)> = cases
+        .into_iter()
+        .map(|(cfg, scene)| {
+            let s = Setup::new(&cfg, &scene, scene.maps(&cfg));
+            (cfg, s)
+        })
+        .collect();
+    let scene = Scene::standard();
+    let maps = scene.maps(&loaded).with_table(&loaded, squashed).unwrap();
+    let table_setup = Setup::new(&loaded, &scene, maps);
+    // The table is honoured: its positions stand for other tangents than the atan ROM's.
+    let rom = Setup::new(&base, &scene, scene.maps(&base));
+    assert!(table_setup
+        .tangents
+        .iter()
+        .zip(&rom.tangents)
+        .any(|(t, r)| (t - r).abs() > 0.01));
+    setups.push((loaded, table_setup));
+    for (cfg, setup) in setups {
         let r = exhaustive::run(&setup, &|_| {}).unwrap();
         assert_eq!(r.inputs, 1 << 24);
         assert_eq!(r.mismatches, 0);

@@ -104,7 +104,10 @@ impl MinimaxFit {
     /// table may be another than the configuration's atan table).
     pub fn for_model(model: &super::super::Model) -> MinimaxFit {
         let cfg = &model.cfg;
-        let blank = Maps::from_data(cfg, vec![0; 3 * cfg.map_entries() as usize]);
+        // Maps without a table of their own (a `comp_table = ram` design's maps start with the
+        // atan table), so that the positions are `model`'s.
+        let mut blank = Maps::from_data(cfg, vec![0; 3 * cfg.map_entries() as usize]);
+        blank.table = None;
         let top = (1u64 << (cfg.grad_bits - 1)) - 1;
         let all: u64 = (top + 1) * (top + 2) / 2;
         // Maxes and components: every pair, or about sqrt(budget) of each, evenly spread

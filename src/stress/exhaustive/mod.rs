@@ -24,7 +24,7 @@ pub mod error_search;
 mod positions;
 mod signs;
 
-use super::{angle_deg, class_of, classes, encoded_direction, encoded_tangent, Acc, Report, Setup};
+use super::{angle_deg, class_of, classes, encoded_direction, Acc, Report, Setup};
 use crate::geometry::place;
 use crate::model::fast::ordered_signs;
 use crate::model::sort_shift::{self, SortShift};
@@ -83,9 +83,7 @@ pub fn run(setup: &Setup, progress: &(dyn Fn(u64) + Sync)) -> Result<Report> {
 
     // 2. Every input, and the angle once per sorted triple.
     let t_inputs = Instant::now();
-    let tan: Vec<f64> = (0..=cfg.pos_max())
-        .map(|p| encoded_tangent(cfg, p))
-        .collect();
+    let tan = &setup.tangents;
     let drop = cfg.grad_bits - cfg.red_bits;
     // The fused output table's flags, [axis][sign code][p_u][p_v]: zero + full scale << 16.
     let ps = cfg.pos_max() as usize + 1;
@@ -246,7 +244,13 @@ pub fn run(setup: &Setup, progress: &(dyn Fn(u64) + Sync)) -> Result<Report> {
             let g = representative(*mags, full);
             let t = setup.model.trace(&setup.maps, g, [0; 3]);
             let s = t.sort;
-            let dir = encoded_direction(cfg, s.axis, (s.s_max, s.s_u, s.s_v), t.p_u, t.p_v);
+            let dir = encoded_direction(
+                &setup.tangents,
+                s.axis,
+                (s.s_max, s.s_u, s.s_v),
+                t.p_u,
+                t.p_v,
+            );
             let deg = angle_deg(
                 dir,
                 DVec3::new(g[0] as f64, g[1] as f64, g[2] as f64).normalize(),
