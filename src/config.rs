@@ -533,13 +533,16 @@ impl Config {
     }
     /// Bits of the fixed ROMs (reciprocal and, when on, compensation).
     pub fn rom_total_bits(&self) -> u64 {
-        let recip = self.recip_entries() as u64 * self.recip_bits as u64;
-        let atan = if self.compensation {
+        self.recip_entries() as u64 * self.recip_bits as u64 + self.comp_table_bits()
+    }
+    /// Bits of the compensation table, one buffer (2^frac_bits positions; 0 without
+    /// compensation): a ROM, or with `comp_table = ram` memory the host loads each frame.
+    pub fn comp_table_bits(&self) -> u64 {
+        if self.compensation {
             (1u64 << self.frac_bits) * self.pos_bits() as u64
         } else {
             0
-        };
-        recip + atan
+        }
     }
     pub fn map_max(&self) -> u32 {
         (1 << self.map_bits) - 1

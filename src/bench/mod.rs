@@ -59,8 +59,16 @@ pub struct Options {
     pub fits: Vec<MapFit>,
 }
 
-/// The map fits measured by default.
-pub const FITS: [MapFit; 2] = [MapFit::Sample, MapFit::Lsq];
+/// The map fits measured by default (each on the configurations it applies to, [`measured`]).
+pub const FITS: [MapFit; 3] = [MapFit::Sample, MapFit::Lsq, MapFit::Table];
+
+/// Whether a row measures `fit` on `cfg`: a fit the design can hold ([`MapFit::check`]: the
+/// `table` fit needs a loaded compensation table), and on a design whose table is loaded with
+/// the maps only the fit that fits it (another fit loads the atan table, and its rows would be
+/// the ROM design's again).
+pub fn measured(fit: MapFit, cfg: &Config) -> bool {
+    fit.check(cfg).is_ok() && (cfg.comp_table.is_rom() || fit == MapFit::Table)
+}
 
 impl Default for Options {
     fn default() -> Self {
@@ -81,7 +89,12 @@ impl Options {
     /// Progress steps of [`run`]: each scene's reference, each configuration's speed and
     /// synthesis and its (scene, fit) rows, each scene's octahedral map.
     pub fn steps(&self) -> usize {
-        configurations(self.quick).len() * (1 + self.fits.len() * self.scenes.len())
+        configurations(self.quick)
+            .iter()
+            .map(|(_, c)| {
+                1 + self.fits.iter().filter(|&&f| measured(f, c)).count() * self.scenes.len()
+            })
+            .sum::<usize>()
             + 2 * self.scenes.len()
     }
 }
@@ -146,6 +159,16 @@ pub fn configurations(quick: bool) -> Vec<(&'static str, Config)> {
                 ..d.clone()
             },
         ),
+        // The compensation table loaded with the maps and fitted to the scene (issue 33):
+        // the paper's maps plus 256 x 7 bits of table, with 4 interpolation bits.
+        (
+            "I3 P4 table",
+            Config {
+                interp_bits: 4,
+                comp_table: crate::config::CompTable::Ram,
+                ..d.clone()
+            },
+        ),
     ]);
     v
 }
@@ -202,6 +225,11 @@ pub fn run(opts: &Options, progress: &dyn Fn(&str)) -> Result<Vec<Row>> {
         };
         let model = Model::new(&cfg);
         let fast = FastShader::new(&model, &Scene::standard().maps(&cfg));
+        let loaded_table = if cfg.comp_table.is_rom() {
+            0
+        } else {
+            cfg.comp_table_bits()
+        };
         let one = grads.len() as f64 / time(opts.seconds, || fast.shade_batch(&grads, &mut out16));
         let all =
             grads.len() as f64 / time(opts.seconds, || fast.shade_batch_par(&grads, &mut out16));
@@ -214,8 +242,7 @@ pub fn run(opts: &Options, progress: &dyn Fn(&str)) -> Result<Vec<Row>> {
             .contains(&MapFit::Minimax)
             .then(|| map_fit::minimax::MinimaxFit::new(&cfg));
         for (k, (name, scene)) in scenes.iter().enumerate() {
-            // A fit the design cannot hold (`table` on a ROM design) has no row.
-            for &fit in opts.fits.iter().filter(|f| f.check(&cfg).is_ok()) {
+            for &fit in opts.fits.iter().filter(|&&f| measured(f, &cfg)) {
                 let p = scene.prepared();
                 let shade = |n| p.shade(n);
                 let build = match fit {
@@ -257,8 +284,9 @@ pub fn run(opts: &Options, progress: &dyn Fn(&str)) -> Result<Vec<Row>> {
                     msamples_all_cores: all / 1e6,
                     float_ratio: all / reference_speed[k],
                     map_build_us: build * 1e6,
-                    rom_bits: cfg.rom_total_bits(),
-                    map_bits: cfg.map_total_bits(),
+                    // A loaded table is per-frame memory like the maps, not a ROM.
+                    rom_bits: cfg.rom_total_bits() - loaded_table,
+                    map_bits: cfg.map_total_bits() + loaded_table,
                     ice40_cells: placed.map(|f| f.logic_cells),
                     ice40_brams: placed.map(|f| f.block_rams),
                     fmax_mhz: placed.map(|f| f.fmax_mhz),

@@ -21,7 +21,10 @@ pub struct Row {
     /// All-core throughput over the float reference's, same inputs.
     pub float_ratio: f64,
     pub map_build_us: f64,
+    /// Bits of the fixed ROMs (reciprocal, and the atan compensation ROM when it is one).
     pub rom_bits: u64,
+    /// Bits the host loads per frame: the maps, and a loaded compensation table
+    /// (`comp_table = ram`).
     pub map_bits: u64,
     /// The part after place and route (with the tools): logic cells, block RAMs, Fmax. The
     /// part is the iCE40 HX8K unless `family` says ECP5 (the LFE5U-85F); the names are the

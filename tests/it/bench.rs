@@ -182,6 +182,11 @@ fn bad_fpga_flags_are_one_line_and_write_nothing() {
             &["--throughput", "--family", "ecp5,ecp5"],
             "--family names ecp5 twice",
         ),
+        // --quick's one design holds the atan table in a ROM.
+        (
+            &["--map-fit", "table"],
+            "--quick measures the paper's design, whose compensation table is a ROM",
+        ),
     ];
     for (args, needle) in cases {
         let mut a = vec!["bench", "--quick", "--out", o];
@@ -239,4 +244,37 @@ fn quick_run_writes_table_csv_and_plots() {
     assert_eq!((png.width(), png.height()), (900, 600));
     let bad = helpers::run(&["bench", "--size", "3", "--out", out.to_str().unwrap()]);
     helpers::assert_error(&bad, "size 3 is out of range");
+}
+
+/// The loaded compensation table's configuration is measured with the fit that loads it and
+/// nothing else, and no other configuration with that fit; its table counts as per-frame
+/// memory (the maps' column), not ROM.
+#[test]
+fn the_loaded_table_has_rows_of_its_own_fit_only() {
+    use rmapgen::bench::{configurations, measured, Options};
+    use rmapgen::model::map_fit::MapFit;
+    let all = configurations(false);
+    let tables: Vec<_> = all.iter().filter(|(_, c)| !c.comp_table.is_rom()).collect();
+    assert_eq!(tables.len(), 1);
+    for (name, c) in &all {
+        for f in [MapFit::Sample, MapFit::Lsq, MapFit::Minimax, MapFit::Table] {
+            assert_eq!(
+                measured(f, c),
+                (f == MapFit::Table) == !c.comp_table.is_rom(),
+                "{name} {}",
+                f.name()
+            );
+        }
+    }
+    // Steps: one per configuration, one per (scene, fit) row, two per scene.
+    let o = Options::default();
+    let rows: usize = all
+        .iter()
+        .map(|(_, c)| o.fits.iter().filter(|&&f| measured(f, c)).count())
+        .sum();
+    assert_eq!(rows, 2 * (all.len() - 1) + 1);
+    assert_eq!(
+        o.steps(),
+        all.len() + rows * o.scenes.len() + 2 * o.scenes.len()
+    );
 }
