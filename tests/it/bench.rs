@@ -260,7 +260,7 @@ fn the_loaded_table_has_rows_of_its_own_fit_only() {
         for f in [MapFit::Sample, MapFit::Lsq, MapFit::Minimax, MapFit::Table] {
             assert_eq!(
                 measured(f, c),
-                (f == MapFit::Table) == !c.comp_table.is_rom(),
+                (f == MapFit::Table) != c.comp_table.is_rom(),
                 "{name} {}",
                 f.name()
             );
