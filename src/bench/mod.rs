@@ -377,29 +377,71 @@ pub fn write(rows: &[Row], out: &StagedDir) -> Result<()> {
             2
         } else if r.map_fit == "sample" {
             0
+        } else if r.map_fit == MapFit::Table.name() {
+            3
         } else {
             1
         }
     };
     let index = |r: &Row| scene_names.iter().position(|s| *s == r.scene).unwrap_or(0);
-    type Axis = (
+    /// A chart: file, x label, y label, log x, x and y of a row, and the row's mark of the
+    /// Pareto front (None: the front of x and y, [`pareto::front`]); its title is apart.
+    type Axis<'a> = (
         &'static str,
-        &'static str,
+        &'a str,
         &'static str,
         bool,
         fn(&Row) -> f64,
-        fn(&Row) -> bool,
+        fn(&Row) -> f64,
+        Option<fn(&Row) -> bool>,
     );
-    let charts: [Axis; 2] = [
-        ("error_vs_cost", "RMSE vs ROM + map bits (dot sampled, triangle fitted, cross octahedral; lines: Pareto)", "ROM + map bits", true, |r| r.bits() as f64, |r| r.pareto_cost),
-        ("error_vs_speed", "RMSE vs speed (dot sampled, triangle fitted, cross octahedral; lines: Pareto)", "million samples/s, one thread", false, |r| r.msamples_1_thread, |r| r.pareto_speed),
+    const KEY: &str =
+        "dot sampled, triangle fitted, square fitted table, cross octahedral; lines: Pareto";
+    let cost = format!("ROM + per-frame map (and table) bits; {KEY}");
+    let speed = format!("million samples/s, one thread; {KEY}");
+    let cost = cost.as_str();
+    let rmse = "RMSE (LSB), sphere image";
+    let titles = [
+        "RMSE against memory",
+        "RMSE against speed",
+        "Largest error against memory",
     ];
-    for (file, title, x_label, log_x, x, on_front) in charts {
+    let charts: [Axis; 3] = [
+        (
+            "error_vs_cost",
+            cost,
+            rmse,
+            true,
+            |r| r.bits() as f64,
+            |r| r.rmse,
+            Some(|r| r.pareto_cost),
+        ),
+        (
+            "error_vs_speed",
+            speed.as_str(),
+            rmse,
+            false,
+            |r| r.msamples_1_thread,
+            |r| r.rmse,
+            Some(|r| r.pareto_speed),
+        ),
+        (
+            "max_error_vs_cost",
+            cost,
+            "largest abs error (LSB), sphere image",
+            true,
+            |r| r.bits() as f64,
+            |r| r.max_abs_error as f64,
+            None,
+        ),
+    ];
+    for ((file, x_label, y_label, log_x, x, y, on_front), title) in charts.into_iter().zip(&titles)
+    {
         let points: Vec<plot::Point> = rows
             .iter()
             .map(|r| plot::Point {
                 x: x(r),
-                y: r.rmse,
+                y: y(r),
                 scene: index(r),
                 marker: marker(r),
             })
@@ -407,19 +449,22 @@ pub fn write(rows: &[Row], out: &StagedDir) -> Result<()> {
         let fronts: Vec<Vec<(f64, f64)>> = scene_names
             .iter()
             .map(|s| {
-                let mut f: Vec<(f64, f64)> = rows
-                    .iter()
-                    .filter(|r| r.scene == *s && on_front(r))
-                    .map(|r| (x(r), r.rmse))
-                    .collect();
-                f.sort_by(|a, b| a.0.total_cmp(&b.0));
-                f
+                let of_scene = rows.iter().filter(|r| r.scene == *s);
+                match on_front {
+                    Some(on) => {
+                        let mut f: Vec<(f64, f64)> =
+                            of_scene.filter(|r| on(r)).map(|r| (x(r), y(r))).collect();
+                        f.sort_by(|a, b| a.0.total_cmp(&b.0));
+                        f
+                    }
+                    None => pareto::front(&of_scene.map(|r| (x(r), y(r))).collect::<Vec<_>>()),
+                }
             })
             .collect();
         let chart = plot::Chart {
             title,
             x_label,
-            y_label: "RMSE (LSB), sphere image",
+            y_label,
             log_x,
             scenes: &scene_names,
             points: &points,

@@ -26,3 +26,40 @@ pub fn mark_pareto(rows: &mut [Row]) {
         r.pareto_speed = speed;
     }
 }
+
+/// The points (cost, error) of one scene that no other is at least as good as in both, in
+/// cost order: the front a chart draws for a measure the rows do not mark (the largest error).
+pub fn front(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let mut f: Vec<(f64, f64)> = points
+        .iter()
+        .copied()
+        .filter(|&(x, y)| {
+            !points
+                .iter()
+                .any(|&(a, b)| a <= x && b <= y && (a < x || b < y))
+        })
+        .collect();
+    f.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    f.dedup();
+    f
+}
+
+#[cfg(test)]
+mod tests {
+    use super::front;
+
+    #[test]
+    fn the_front_keeps_what_nothing_beats_in_both() {
+        let p = [
+            (3.0, 5.0),
+            (1.0, 9.0),
+            (2.0, 5.0),
+            (2.0, 5.0),
+            (4.0, 1.0),
+            (5.0, 1.0),
+            (1.5, 9.5),
+        ];
+        assert_eq!(front(&p), vec![(1.0, 9.0), (2.0, 5.0), (4.0, 1.0)]);
+        assert!(front(&[]).is_empty());
+    }
+}

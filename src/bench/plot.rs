@@ -10,7 +10,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::sync::OnceLock;
 
-/// One point: x, y, scene index, marker (0 sampled cube map, 1 fitted, 2 octahedral).
+/// One point: x, y, scene index, marker (0 sampled cube map, 1 fitted, 2 octahedral, 3 fitted
+/// with a loaded compensation table).
 #[derive(Clone, Copy, Debug)]
 pub struct Point {
     pub x: f64,
@@ -113,7 +114,13 @@ where
                     });
                 }
             }
-            for p in c.points {
+            // The loaded-table points last, on top of the others at about the same memory.
+            let order = c
+                .points
+                .iter()
+                .filter(|p| p.marker != 3)
+                .chain(c.points.iter().filter(|p| p.marker == 3));
+            for p in order {
                 let col = colour(p.scene);
                 let xy = (p.x, p.y);
                 match p.marker {
@@ -122,6 +129,15 @@ where
                         .map_err(e)?,
                     1 => chart
                         .draw_series(std::iter::once(TriangleMarker::new(xy, 7, col.filled())))
+                        .map_err(e)?,
+                    3 => chart
+                        .draw_series(std::iter::once(Rectangle::new(
+                            [
+                                (p.x * 0.985, p.y - y1 * 0.012),
+                                (p.x * 1.015, p.y + y1 * 0.012),
+                            ],
+                            col.filled(),
+                        )))
                         .map_err(e)?,
                     _ => chart
                         .draw_series(std::iter::once(Cross::new(xy, 6, col.stroke_width(2))))
