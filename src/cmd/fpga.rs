@@ -137,12 +137,16 @@ fn flow(
     opts: &Options,
 ) -> Result<fpga::FpgaReport> {
     let logs = opts.logs.as_deref().expect("a log directory");
+    // The steps on a terminal: synthesis takes seconds, place and route up to a minute.
+    let steps = super::progress::Steps::new();
+    let step = |what: &str| steps.long_step(what);
     let (what, report) = match (&a.dir, cfg) {
-        (Some(d), _) => (d.display().to_string(), fpga::run_dir(d, opts)?),
+        (Some(d), _) => (d.display().to_string(), fpga::run_dir_with(d, opts, &step)?),
         // Both flows build the design with --target ice40 whatever --target says.
-        (None, Some(cfg)) => (cfg.summary(), fpga::report(cfg, opts)?),
+        (None, Some(cfg)) => (cfg.summary(), fpga::report_with(cfg, opts, &step)?),
         (None, None) => unreachable!("a configuration when there is no --dir"),
     };
+    drop(steps);
     crate::out!("fpga: {what}\n{}", report.summary())?;
     let json = serde_json::to_string_pretty(&report)?;
     let path = logs.join("report.json");

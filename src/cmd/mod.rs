@@ -13,6 +13,7 @@ pub mod maps;
 pub mod mutants;
 pub mod parse;
 pub mod part_args;
+pub mod progress;
 pub mod prove;
 pub mod prove_mult;
 pub mod render;

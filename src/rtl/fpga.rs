@@ -208,13 +208,19 @@ pub fn tools_available(opts: &Options) -> bool {
 /// `cfg.target` says; the standard scene's maps) into a temporary directory and runs the flow
 /// of `opts.family` on it.
 pub fn report(cfg: &Config, opts: &Options) -> Result<FpgaReport> {
+    report_with(cfg, opts, &|_| {})
+}
+
+/// [`report`], telling `step` what it starts: generating, synthesising, placing and routing.
+pub fn report_with(cfg: &Config, opts: &Options, step: &dyn Fn(&str)) -> Result<FpgaReport> {
     cfg.validate()?;
     let cfg = &cfg.for_target(Target::Ice40);
+    step(&format!("generating {}", cfg.summary()));
     let tmp = crate::output::Scratch::new()?;
     let out = StagedDir::new(&tmp.path().join("rtl"), &Default::default())?;
     super::write_design(&crate::design::Design::standard(cfg)?, &out, None)?;
     let dir = out.commit()?;
-    run_dir(&dir, opts)
+    run_dir_with(&dir, opts, step)
 }
 
 /// The signal a netlist cell of Yosys/nextpnr belongs to: its name up to the first suffix
@@ -378,7 +384,23 @@ const DOES_NOT_FIT: [&str; 3] = [
 /// Runs the flow on a generated directory (it needs `manifest.json` and the `.v` and `.hex`
 /// files `generate` writes there): [`synthesise`], then [`place`].
 pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
-    place(&synthesise(dir, opts)?, opts)
+    run_dir_with(dir, opts, &|_| {})
+}
+
+/// [`run_dir`], telling `step` what it starts: the synthesis, then place and route.
+pub fn run_dir_with(dir: &Path, opts: &Options, step: &dyn Fn(&str)) -> Result<FpgaReport> {
+    step(&format!(
+        "synthesising with Yosys {}",
+        opts.family.synth_pass()
+    ));
+    let syn = synthesise(dir, opts)?;
+    step(&format!(
+        "placing and routing: {}, seed {}, {} MHz",
+        part_of(opts),
+        opts.seed,
+        opts.freq_mhz
+    ));
+    place(&syn, opts)
 }
 
 /// A design synthesised for a family, ready to be placed with any seed ([`place`]): what

@@ -308,3 +308,47 @@ fn ice40_report_gives_a_missed_target_as_a_figure() {
     assert!(c.logic_ns + c.routing_ns > 1000.0 / 500.0, "{c:?}");
     assert!(r.summary().contains("FAIL at 500 MHz"), "{}", r.summary());
 }
+
+/// `fpga` says what it is doing on a terminal (its steps under a pseudo-terminal made by
+/// util-linux's `script`) and nothing on stderr in a script.
+#[test]
+fn fpga_shows_its_steps_on_a_terminal_only() {
+    if !fpga_tools() || !rmapgen::toolchain::installed("script") {
+        return;
+    }
+    let tmp = helpers::tempdir();
+    let dir = tmp.path().join("d");
+    let mut flags = hdl::narrowest_flags();
+    flags.extend(["--target".to_string(), "ice40".to_string()]);
+    hdl::generate(&dir, &hdl::strs(&flags), 1);
+    let logs = tmp.path().join("logs");
+    let command = format!(
+        "{} fpga --dir {} --logs {}",
+        env!("CARGO_BIN_EXE_rmapgen"),
+        dir.display(),
+        logs.display()
+    );
+    let o = std::process::Command::new("script")
+        .args(["-qec", &command, "/dev/null"])
+        .output()
+        .unwrap();
+    let tty = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{tty}");
+    for step in [
+        "synthesising with Yosys synth_ice40",
+        "placing and routing: nextpnr-ice40 --hx8k",
+    ] {
+        assert!(tty.contains(step), "{step}: {tty}");
+    }
+    let o = helpers::run(&[
+        "fpga",
+        "--dir",
+        dir.to_str().unwrap(),
+        "--logs",
+        logs.to_str().unwrap(),
+        "--force",
+    ]);
+    assert!(o.status.success());
+    assert_eq!(String::from_utf8_lossy(&o.stderr), "");
+    assert!(!String::from_utf8_lossy(&o.stdout).contains("placing and routing"));
+}
