@@ -139,7 +139,7 @@ fn flow(
     let logs = opts.logs.as_deref().expect("a log directory");
     // The steps on a terminal: synthesis takes seconds, place and route up to a minute.
     let steps = super::progress::Steps::new();
-    let step = |what: &str| steps.long_step(what);
+    let step = |what: &str| steps.step(what);
     let (what, report) = match (&a.dir, cfg) {
         (Some(d), _) => (d.display().to_string(), fpga::run_dir_with(d, opts, &step)?),
         // Both flows build the design with --target ice40 whatever --target says.
