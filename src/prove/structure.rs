@@ -655,12 +655,18 @@ mod tests {
     }
 
     /// A `$dff` holding its own value is never loaded; one with a reset that loads it
-    /// (`$adff`) is defined, and a register loaded from elsewhere is not flagged.
+    /// (`$adff`) is defined, and a register loaded from elsewhere is not flagged. The report
+    /// names the register by its `_q` net, before a shorter net that is exactly its output
+    /// and before Yosys's `$` names.
     #[test]
     fn only_registers_without_a_reset_that_hold_themselves_are_never_loaded() {
         let m = Module {
             ports: HashMap::new(),
-            netnames: HashMap::from([("u.hold_q".to_string(), vec![Some(5)])]),
+            netnames: HashMap::from([
+                ("u.hold_q".to_string(), vec![Some(5)]),
+                ("u.h".to_string(), vec![Some(5)]),
+                ("$auto$5".to_string(), vec![Some(5)]),
+            ]),
             cells: vec![reg("$dff", 5, 5), reg("$adff", 6, 6), reg("$dff", 7, 8)],
         };
         let v = never_loaded(&m);
