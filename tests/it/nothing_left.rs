@@ -273,6 +273,13 @@ fn a_signal_to_prove_or_fpga_ends_their_tools() {
     let work = helpers::tempdir();
     let dir = work.path().join("n");
     hdl::generate_config(&dir, &grid::narrowest(), 5);
+    // fpga --dir places only a design made for the family (a generic one is refused after
+    // synthesis), so it gets one; its part check runs nextpnr for a moment first, which the
+    // wait may or may not catch: either way nextpnr runs when the signal comes.
+    let ice40 = work.path().join("i");
+    let mut flags = hdl::narrowest_flags();
+    flags.extend(["--target".to_string(), "ice40".to_string()]);
+    hdl::generate(&ice40, &hdl::strs(&flags), 5);
     let b = work.path().join("B");
     for (args, tools, sig) in [
         (
@@ -281,7 +288,7 @@ fn a_signal_to_prove_or_fpga_ends_their_tools() {
             libc::SIGKILL,
         ),
         (
-            vec!["fpga", "--dir", s(&dir), "--logs", s(&b)],
+            vec!["fpga", "--dir", s(&ice40), "--logs", s(&b)],
             &["nextpnr-ice40"][..],
             libc::SIGTERM,
         ),
