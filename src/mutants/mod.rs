@@ -132,22 +132,42 @@ fn yosys(dir: &Path, script: &str, log: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Refuses a `--select` that is not one Yosys selection (it is written into the draw's
+/// script).
+pub fn check_select(s: &str) -> Result<()> {
+    ensure!(
+        !s.trim().is_empty() && !s.contains(['\n', ';', '#']),
+        "--select {s:?}: one Yosys selection (modules, cells or wires), no commands"
+    );
+    Ok(())
+}
+
 /// Draws `count` Verilog mutants of design `d` with Yosys's `mutate -list` (seed `seed`),
 /// working in `work`.
-pub fn draw_verilog(d: &DesignDir, count: usize, seed: u64, work: &Path) -> Result<Vec<Change>> {
+pub fn draw_verilog(
+    d: &DesignDir,
+    count: usize,
+    seed: u64,
+    select: Option<&str>,
+    work: &Path,
+) -> Result<Vec<Change>> {
     ensure!(
         count <= MAX_MUTANTS,
         "--count {count}: at most {MAX_MUTANTS} mutants a run"
     );
+    if let Some(s) = select {
+        check_select(s)?;
+    }
     if count == 0 {
         return Ok(Vec::new());
     }
     crate::disk::create_dir_all(work)?;
     let list = work.join("mutations.ys");
     let script = format!(
-        "{}mutate -list {count} -seed {seed} -o {}\n",
+        "{}mutate -list {count} -seed {seed} -o {} {}\n",
         read_script(d),
-        list.display()
+        list.display(),
+        select.unwrap_or("")
     );
     yosys(d.path(), &script, &work.join("list.log"))?;
     let text = std::fs::read_to_string(&list)
@@ -265,7 +285,9 @@ fn split_modules(text: &str) -> Vec<(String, String)> {
 /// `proc`, the mutation, every undefined multiplexer input replaced by the other input
 /// (`opt_expr -mux_undef`, a refinement of `x`: `proc` writes `x` for defaults no path of
 /// the design selects, a mutant may select them, and its meaning must not depend on how a
-/// simulator or the front's gates read `x`), then flattened but for the front modules and written back: the top's
+/// simulator or the front's gates read `x`), then flattened but for the front modules and
+/// written back, with nothing removed (no `opt_clean`: a mutant that leaves a signal unused
+/// keeps it, so that a harness that probes it by name, the formal one, still finds it): the top's
 /// file holds the flat top (its memories' contents written in, its file parameters declared
 /// for the harnesses that set them), the front modules' files the front as Yosys wrote it
 /// when the mutation is in one of them.
@@ -301,7 +323,7 @@ pub fn materialise(d: &DesignDir, m: &Mutant, to: &Path) -> Result<()> {
                 _ => String::new(),
             };
             let script = format!(
-                "{}{mutation}opt_expr -mux_undef\nsetattr -mod -set keep_hierarchy 1 {}\nflatten\nopt_clean\nwrite_verilog -noattr mutant.v\n",
+                "{}{mutation}opt_expr -mux_undef\nsetattr -mod -set keep_hierarchy 1 {}\nflatten\nwrite_verilog -noattr mutant.v\n",
                 read_script(d),
                 front.join(" ")
             );
@@ -370,6 +392,14 @@ pub enum Method {
     /// nothing else: the ground truth where `--direct` cannot drive every gradient (a
     /// sample, so "equivalent" means no difference found).
     Stream,
+    /// `formal/run_formal.py`: the SymbiYosys proof of a handshake top's flow control and map
+    /// buffers (`make formal`), on the mutant.
+    Formal,
+    /// `formal/run_formal.py --miter`: the ground truth of [`Method::Formal`], a bounded
+    /// search from reset for a difference between the mutant and the design in what the
+    /// harness speaks of (ready_o, valid_o, the tag, the map buffers read and written), not
+    /// in the datapath's results.
+    Flow,
 }
 
 impl Method {
@@ -380,12 +410,23 @@ impl Method {
             Method::Sim => "sim",
             Method::Gate => "gate",
             Method::Stream => "stream",
+            Method::Formal => "formal",
+            Method::Flow => "flow",
         }
     }
 
     /// Whether it can be a run's ground truth (every mutant is judged by it first).
     pub fn is_truth(self) -> bool {
-        matches!(self, Method::Direct | Method::Stream)
+        matches!(self, Method::Direct | Method::Stream | Method::Flow)
+    }
+
+    /// The proof that ground truth `self` judges: a non-equivalent mutant it passes is a
+    /// soundness bug. `prove` for the datapath's truths, the formal harness for the flow's.
+    pub fn proof(self) -> Method {
+        match self {
+            Method::Flow | Method::Formal => Method::Formal,
+            _ => Method::Prove,
+        }
     }
 
     fn args(self, plan: &Plan) -> Vec<String> {
@@ -395,11 +436,18 @@ impl Method {
             Method::Sim => vec!["sim", "--verilator"],
             Method::Gate => vec!["sim", "--gate"],
             Method::Stream => vec!["sim"],
+            // run_formal.py's, after its script (see `check`).
+            Method::Formal => vec!["--reference"],
+            Method::Flow => vec!["--miter"],
         };
         let mut v: Vec<String> = v.into_iter().map(String::from).collect();
         match self {
             Method::Sim => v.extend(["--stream".to_string(), plan.sim_stream.to_string()]),
             Method::Stream => v.extend(["--stream".to_string(), plan.truth_stream.to_string()]),
+            Method::Formal | Method::Flow => {
+                let f = plan.formal.as_ref().expect("a formal plan names its tools");
+                v.push(f.reference.display().to_string());
+            }
             _ => {}
         }
         v
@@ -445,11 +493,18 @@ pub fn check(method: Method, dir: &Path, build: &Path, log: &Path, plan: &Plan) 
     // The running binary itself (Linux's /proc/self/exe), not its path: a campaign of an
     // hour judges every mutant with the rmapgen it started with, even if a build replaces
     // target/release/rmapgen meanwhile (which once stopped one with "cannot start").
-    let exe = own_binary()?;
+    let mut c = match (method, &plan.formal) {
+        (Method::Formal | Method::Flow, Some(f)) => {
+            let mut c = Command::new(&f.python);
+            c.arg(&f.script);
+            c
+        }
+        (Method::Formal | Method::Flow, None) => bail!("{} needs the formal tools", method.name()),
+        _ => Command::new(own_binary()?),
+    };
     let out =
         std::fs::File::create(log).with_context(|| format!("cannot write {}", log.display()))?;
     let err = out.try_clone()?;
-    let mut c = Command::new(exe);
     c.args(method.args(plan))
         .arg("--build")
         .arg(build)
@@ -490,9 +545,18 @@ impl Outcome {
             .map(|(_, v)| *v == Verdict::Passed)
     }
 
-    /// A non-equivalent mutant that the factored proof passed: a soundness bug.
+    /// The ground truth that ran on it.
+    pub fn truth(&self) -> Option<Method> {
+        self.verdicts.iter().map(|(m, _)| *m).find(|m| m.is_truth())
+    }
+
+    /// A non-equivalent mutant that the proof its ground truth judges passed (the factored
+    /// proof; the formal harness under the flow truth): a soundness bug.
     pub fn unsound(&self) -> bool {
-        self.equivalent() == Some(false) && self.verdict(Method::Prove) == Some(&Verdict::Passed)
+        let Some(truth) = self.truth() else {
+            return false;
+        };
+        self.equivalent() == Some(false) && self.verdict(truth.proof()) == Some(&Verdict::Passed)
     }
 }
 
@@ -509,6 +573,18 @@ pub struct Plan {
     /// sample of `truth_stream` random gradients) for designs `--direct` cannot take.
     pub truth: Method,
     pub truth_stream: u64,
+    /// The formal tools, for [`Method::Formal`] and [`Method::Flow`].
+    pub formal: Option<FormalTools>,
+}
+
+/// How the formal harness runs on a mutant: `python script --reference REF|--miter REF
+/// --build B MUTANT` (`formal/run_formal.py` with the project venv's Python).
+pub struct FormalTools {
+    pub python: PathBuf,
+    pub script: PathBuf,
+    /// The design the mutants are drawn from (absolute): the harness reads its parameters
+    /// there, and the flow miter compares each mutant with it.
+    pub reference: PathBuf,
 }
 
 /// Judges mutant `m` of design `d` in `work/m<id>` (design, builds, logs).
@@ -538,7 +614,7 @@ pub fn judge(d: &DesignDir, m: &Mutant, plan: &Plan, work: &Path) -> Result<Outc
         Ok(v)
     };
     if plan.quick {
-        if run(Method::Prove)? == Verdict::Passed {
+        if run(plan.truth.proof())? == Verdict::Passed {
             run(plan.truth)?;
         }
     } else {
@@ -697,6 +773,42 @@ mod tests {
             (d.judged, d.equivalent, d.non_equivalent, d.killed),
             (5, 1, 4, 4)
         );
+    }
+
+    #[test]
+    fn under_the_flow_truth_the_formal_harness_is_the_proof_judged() {
+        use Method::*;
+        use Verdict::*;
+        assert_eq!(
+            [Direct, Stream, Flow].map(Method::proof),
+            [Prove, Prove, Formal]
+        );
+        assert!(Flow.is_truth() && !Formal.is_truth());
+        // A flow difference the harness passed is a soundness bug of the harness; prove
+        // passing it says nothing (the flow truth does not judge prove).
+        let unsound = outcome(1, &[(Flow, Failed), (Formal, Passed)]);
+        let killed = outcome(2, &[(Flow, Failed), (Formal, Refused)]);
+        let equivalent = outcome(3, &[(Flow, Passed), (Formal, Passed)]);
+        let not_judged = outcome(4, &[(Flow, Failed), (Prove, Passed)]);
+        assert!(unsound.unsound());
+        assert!(!killed.unsound() && !equivalent.unsound() && !not_judged.unsound());
+        assert_eq!(unsound.truth(), Some(Flow));
+        assert!(!outcome(5, &[(Formal, Failed)]).unsound());
+        let t = tally(Formal, &[unsound, killed, equivalent]);
+        assert_eq!(
+            (
+                t.judged,
+                t.equivalent,
+                t.non_equivalent,
+                t.killed,
+                t.survived
+            ),
+            (3, 1, 2, 1, 1)
+        );
+        assert!(check_select("rmap_top pipe_delay").is_ok());
+        for bad in ["", " ", "a; shell rm", "a\nshell", "a # b"] {
+            assert!(check_select(bad).is_err(), "{bad:?}");
+        }
     }
 
     #[test]

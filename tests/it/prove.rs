@@ -458,6 +458,62 @@ fn bad_input_is_one_line_and_exit_2() {
         "--truth-stream 0",
     );
     assert!(!build.exists(), "nothing written");
+    // The flow ground truth judges the formal harness, on the designs it takes; each check
+    // is judged against its own truth; a memory changes no flow signal.
+    let flow = |d: &Path, more: &[&str]| {
+        let mut a = vec!["mutants", s(d), "--build", s(&build), "--truth", "flow"];
+        a.extend_from_slice(more);
+        helpers::run(&a)
+    };
+    helpers::assert_error(
+        &flow(&g12, &[]),
+        "--truth flow: the formal harness takes a --handshake --axis design",
+    );
+    let hs = tmp.path().join("hs");
+    hdl::generate(
+        &hs,
+        &[
+            "--handshake",
+            "--axis",
+            "--grad-bits",
+            "8",
+            "--red-bits",
+            "6",
+        ],
+        0,
+    );
+    helpers::assert_error(
+        &flow(&hs, &["--method", "prove"]),
+        "--method prove: judged against --truth direct or stream, not --truth flow",
+    );
+    helpers::assert_error(
+        &helpers::run(&[
+            "mutants",
+            s(&g12),
+            "--build",
+            s(&build),
+            "--method",
+            "formal",
+        ]),
+        "--method formal: judged against --truth flow, not --truth direct",
+    );
+    helpers::assert_error(
+        &flow(&hs, &["--method", "formal,flow"]),
+        "--method flow: a ground truth runs on every mutant already",
+    );
+    helpers::assert_error(
+        &flow(&hs, &["--memories", "2"]),
+        "--memories 2: under --truth flow a memory's contents change no flow signal",
+    );
+    helpers::assert_error(
+        &flow(&hs, &["--python", "no/python"]),
+        "--python no/python: not found",
+    );
+    helpers::assert_error(
+        &flow(&hs, &["--select", "rmap_top; shell"]),
+        "--select \"rmap_top; shell\": one Yosys selection",
+    );
+    assert!(!build.exists(), "nothing written");
     // A file that is not a report.
     let junk = tmp.path().join("junk.json");
     std::fs::write(&junk, "{}").unwrap();
