@@ -643,6 +643,19 @@ impl Config {
         }
     }
 
+    /// Every field as `name=value`, with the names of a `--config` file (`grad_bits=12
+    /// red_bits=8 ...`), in the file's order: what `generate` says it wrote. The empty prefix
+    /// is left out.
+    pub fn fields(&self) -> String {
+        let text = toml::to_string(self).unwrap_or_default();
+        text.lines()
+            .filter_map(|l| l.split_once(" = "))
+            .filter(|(k, v)| !(*k == "prefix" && *v == "\"\""))
+            .map(|(k, v)| format!("{k}={}", v.trim_matches('"')))
+            .collect::<Vec<_>>()
+            .join(" ")
+    }
+
     /// One line naming every field but the prefix; the target only when it is not generic
     /// (the default), so a default design's summary reads as before the field existed.
     pub fn summary(&self) -> String {

@@ -3,7 +3,7 @@
 //! z; within an axis, address 0 upwards, so write k of an axis is address k, line k of its
 //! `map_<axis>.hex`). The top testbench loads its second map in this order too.
 //!
-//! Formats (README.md, "rmapgen maps"):
+//! Formats (docs/USAGE.md, "Host map stream"):
 //! - **hex**: header lines starting with `//`, then one write per line, `axis address data` in
 //!   lower-case hex, zero-padded to 1, ceil(A/4) and ceil(M/4) digits, single spaces.
 //!   `$readmemh` reads it as 3 words per write.

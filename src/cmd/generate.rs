@@ -54,16 +54,17 @@ pub fn run(a: &GenerateArgs) -> Result<()> {
     };
     let (p, manifest) = write_dir(&cfg, &scene, &a.out, &policy, vectors, &[], Keep::Nothing)?;
     let replaced = match before {
-        Some(old) if old != cfg => format!(", replacing its {} design", old.summary_full()),
+        Some(old) if old != cfg => format!(" (replacing a design of {})", old.fields()),
         _ => String::new(),
     };
+    // The fields by their --config names, spelled out (rmapgen generate --help says each).
     crate::errln!(
-        "rmapgen: wrote {} ({} modules, latency {}, {} memory bits) to {}{replaced}",
-        cfg.summary_full(),
+        "rmapgen: wrote {}: {} modules, latency {} clocks, {} memory bits{replaced}\n  {}",
+        p.display(),
         manifest.modules.len(),
         manifest.latency,
         manifest.memory_bits,
-        p.display()
+        cfg.fields()
     );
     Ok(())
 }

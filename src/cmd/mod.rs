@@ -92,7 +92,7 @@ mod limits_in_help {
 
     #[test]
     fn doc_figures_match() {
-        // Figures quoted in doc comments and README.md.
+        // Figures quoted in doc comments and docs/USAGE.md.
         assert_eq!(crate::volume::MAX_VOXELS, 214_748_364);
         assert_eq!(crate::volume::MEMORY_BUDGET, 2 << 30);
         assert_eq!(crate::volume::load::MAX_READ_BYTES, 4 << 30);

@@ -61,7 +61,7 @@ pub fn netlist(logs: &Path, top: &str) -> PathBuf {
 /// `LOGS/<top>.json` for nextpnr and the same netlist as Verilog ([`netlist`], `write_verilog
 /// -noattr`: no source attributes, so it is a third of the size and simulators read only
 /// cells), `yosys.log` and the statistics `yosys_stat.txt` go to `logs`. The flow `rmapgen
-/// fpga`, bench and `fit --cost cells` measure (figures in README.md come from it), and the
+/// fpga`, bench and `fit --cost cells` measure (figures in docs/RESULTS.md come from it), and the
 /// netlist `rmapgen sim --gate` simulates: the one that is placed and routed, from the same
 /// run. Writing the Verilog costs no measurable time beside the synthesis (8 s for the default
 /// design).

@@ -213,7 +213,9 @@ fn other_commands_given_a_design_take_its_configuration() {
         &["generate", "--vectors", "10", "--out", "ip10"],
     ));
     assert!(
-        said.contains("to ip10, replacing its G10 R8 W10 F8 I4 P3 M8 comp=1 interp=1 color=1 depth=2 handshake=1 prefix=vr_ design"),
+        said.contains("wrote ip10: ")
+            && said.contains("(replacing a design of grad_bits=10 red_bits=8 recip_bits=10 frac_bits=8 index_bits=4 interp_bits=3 map_bits=8 compensation=true interpolation=true color=true pipeline_depth=2 handshake=true prefix=vr_)")
+            && said.contains("\n  grad_bits=12 "),
         "{said}"
     );
     // ... and nothing when the configuration is the same.

@@ -1,6 +1,6 @@
 //! Bounded resources (issue 12 §2): a request the machine cannot serve is refused up front
 //! with one line (exit 2) and nothing written, never an abort, an endless run or a full disk.
-//! Every bound of the README's "Limits" table has a test here; the NRRD and raw loaders are
+//! Every bound of docs/USAGE.md's "Limits" table has a test here; the NRRD and raw loaders are
 //! also fed random and mutated input under a counting allocator (tests/it/alloc.rs).
 
 use crate::alloc::peak_during;
@@ -800,12 +800,12 @@ proptest! {
 }
 
 #[test]
-fn readme_limits_table_quotes_the_constants() {
-    let readme = std::fs::read_to_string(helpers::root().join("README.md")).unwrap();
-    let table = readme
+fn usage_limits_table_quotes_the_constants() {
+    let usage = std::fs::read_to_string(helpers::root().join("docs/USAGE.md")).unwrap();
+    let table = usage
         .split("## Limits")
         .nth(1)
-        .expect("README has a Limits section")
+        .expect("docs/USAGE.md has a Limits section")
         .split("\n## ")
         .next()
         .unwrap();
@@ -849,7 +849,7 @@ fn readme_limits_table_quotes_the_constants() {
     ] {
         assert!(
             table.contains(&want),
-            "README Limits table should quote {want}"
+            "docs/USAGE.md's Limits table should quote {want}"
         );
     }
     assert!(table.contains(&format!(

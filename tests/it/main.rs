@@ -31,6 +31,7 @@ mod nothing_left;
 mod output_safety;
 mod prefix;
 mod prove;
+mod readme;
 mod render;
 mod rtl_generate;
 mod rtl_in_loop;
