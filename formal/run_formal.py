@@ -331,7 +331,9 @@ def prove(design, build, depth, bmc, solver, pool, one_query=False, stop=False, 
 # valid_o, side_o (the tag) while valid_o is high, the map buffer that the sample entering
 # map_lookup reads (while that stage's input is valid), and the buffer a host write goes to
 # (while wr_en_i; the last two probed inside each top, as the harness does; a missing probe
-# is an error, not a pass). The outputs i_o and zero_o are not compared: the datapath is
+# is an error, not a pass), and whether i_o and zero_o change across an edge that stalled a
+# result (the harness's a_hold). Their values are not compared, and as in the harness the
+# datapath is cut at the output register's input (each side's out_i and out_zero free): it is
 # `rmapgen prove`'s claim, not the harness's. A difference within the depth is a
 # real trace from reset (a counterexample in the sby directory); none within it says only that
 # (a bounded check, the ground truth of `rmapgen mutants --truth flow`).
@@ -362,6 +364,17 @@ module rmap_miter #(parameter G = 8, WA = 7, M = 6, SD = 4) (
     .gz_i(gz_i), .swap_i(swap_i), .wr_en_i(wr_en_i), .wr_axis_i(wr_axis_i),
     .wr_addr_i(wr_addr_i), .wr_data_i(wr_data_i), .side_i(side_i), .ready_i(ready_i),
     .ready_o(m_ready), .valid_o(m_valid), .zero_o(m_zero), .i_o(m_i), .side_o(m_side));
+  // Each side's results across an edge with a result stalled (valid_o && !ready_i).
+  reg          stall_q = 1'b0;
+  reg  [M-1:0] r_i_q, m_i_q;
+  reg          r_zero_q, m_zero_q;
+  always @(posedge clk_i) begin
+    stall_q  <= r_valid && !ready_i && rst_ni;
+    r_i_q    <= r_i;
+    m_i_q    <= m_i;
+    r_zero_q <= r_zero;
+    m_zero_q <= m_zero;
+  end
   // Probes of each top's buffer selection, connected by the script (connect -set).
   wire r_in_v, m_in_v, r_rd, m_rd, r_wrbuf, m_wrbuf;
   // The first clock is in reset (as the harness assumes); rst_ni is free after it.
@@ -375,6 +388,8 @@ module rmap_miter #(parameter G = 8, WA = 7, M = 6, SD = 4) (
     f_in:    assert (r_in_v == m_in_v);
     f_rd:    assert (!r_in_v || r_rd == m_rd);
     f_wr:    assert (!wr_en_i || r_wrbuf == m_wrbuf);
+    f_hold:  assert (!(stall_q && rst_ni) || ((r_i != r_i_q) == (m_i != m_i_q)
+                                              && (r_zero != r_zero_q) == (m_zero != m_zero_q)));
   end
 endmodule
 """
@@ -432,6 +447,7 @@ hierarchy -top rmap_miter {chparam}
 proc
 flatten
 {connects}
+cutpoint w:u_ref.out_i w:u_ref.out_zero w:u_mut.out_i w:u_mut.out_zero
 prep -top rmap_miter
 
 [files]

@@ -41,6 +41,10 @@ pub struct Key {
     pub truth_stream: u64,
     /// The whole draw (not only the mutants a run selects with `--only`).
     pub draw: Vec<Mutant>,
+    /// The formal tools' files and their SHA-256 (every file of the directory of
+    /// `run_formal.py`: the script and its harness), when the formal harness judges.
+    #[serde(default)]
+    pub tools: Vec<(String, String)>,
 }
 
 impl Key {
@@ -51,6 +55,19 @@ impl Key {
             files.push((name.clone(), stamp::digest(&path)?));
         }
         files.sort();
+        let mut tools = Vec::new();
+        if let Some(f) = &plan.formal {
+            let dir = f.script.parent().unwrap_or(Path::new("."));
+            for e in
+                std::fs::read_dir(dir).with_context(|| format!("cannot read {}", dir.display()))?
+            {
+                let p = e?.path();
+                if p.is_file() {
+                    tools.push((p.display().to_string(), stamp::digest(&p)?));
+                }
+            }
+            tools.sort();
+        }
         Ok(Key {
             format: FORMAT.to_string(),
             binary: stamp::digest(&own_binary()?)?,
@@ -62,6 +79,7 @@ impl Key {
             truth: plan.truth,
             truth_stream: plan.truth_stream,
             draw: draw.to_vec(),
+            tools,
         })
     }
 
@@ -71,6 +89,8 @@ impl Key {
             Some("another rmapgen binary judged them")
         } else if self.files != now.files {
             Some("the design's files have changed")
+        } else if self.tools != now.tools {
+            Some("the formal tools' files have changed")
         } else if self.draw != now.draw {
             Some("another draw (seed, count or memories)")
         } else if (&self.methods, self.quick, self.timeout_s, self.sim_stream)
@@ -230,6 +250,7 @@ mod tests {
                     },
                 })
                 .collect(),
+            tools: Vec::new(),
         }
     }
 
@@ -315,6 +336,13 @@ mod tests {
                     ..key("b1", 0)
                 },
                 "files have changed",
+            ),
+            (
+                Key {
+                    tools: vec![("formal/run_formal.py".into(), "02".into())],
+                    ..key("b1", 0)
+                },
+                "formal tools' files have changed",
             ),
         ] {
             // Written afresh under `other`, then read back under `k`: nothing kept.

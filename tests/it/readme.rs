@@ -55,7 +55,10 @@ fn the_quick_start_runs_as_written() {
     assert!(dir.join("my_design/rmap_top.v").is_file());
     assert!(dir.join("my_design/README.md").is_file());
     assert!(out.contains("sim: all passed"), "{out}");
-    assert!(err.contains("my_scene.toml"), "roms --update names the scene: {err}");
+    assert!(
+        err.contains("my_scene.toml"),
+        "roms --update names the scene: {err}"
+    );
     assert!(out.contains("PASSED"), "{out}");
     assert!(
         out.contains(&format!("{} of", 1u64 << 24)),
