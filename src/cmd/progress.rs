@@ -26,6 +26,11 @@ impl Steps {
     pub fn step(&self, what: &str) {
         self.bar.set_message(what.to_string());
     }
+
+    /// Runs `f` with the line cleared, for output to the same terminal (stdout).
+    pub fn suspend<R>(&self, f: impl FnOnce() -> R) -> R {
+        self.bar.suspend(f)
+    }
 }
 
 impl Default for Steps {

@@ -79,6 +79,13 @@ pub fn run(a: &ProveMultArgs) -> Result<ExitCode> {
         known_trees(&jobs, &a.tree)?;
         engines(&jobs, a.engine)?;
         need_yosys()?;
+        let steps = super::progress::Steps::new();
+        steps.step(&format!(
+            "proving {} multiplier{} of {}",
+            jobs.len(),
+            if jobs.len() == 1 { "" } else { "s" },
+            design.path().display()
+        ));
         let proof = prove(
             &design,
             &a.logs,
@@ -86,6 +93,7 @@ pub fn run(a: &ProveMultArgs) -> Result<ExitCode> {
             a.engine,
             &a.tree,
         )?;
+        drop(steps);
         crate::out!("{}", proof.stdout)?;
         crate::err!("{}", proof.stderr);
         !proof.passed
@@ -286,9 +294,12 @@ fn matrix(a: &ProveMultArgs, rows: &[GridRow]) -> Result<bool> {
         .min(rows.len())
         .max(1);
     let next = AtomicUsize::new(0);
+    let done = AtomicUsize::new(0);
     let out: Mutex<Vec<Option<Result<Proof>>>> =
         Mutex::new((0..rows.len()).map(|_| None).collect());
     let start = Instant::now();
+    let steps = super::progress::Steps::new();
+    steps.step(&format!("proving the multipliers of {} rows", rows.len()));
     std::thread::scope(|s| {
         for _ in 0..workers {
             s.spawn(|| loop {
@@ -306,14 +317,17 @@ fn matrix(a: &ProveMultArgs, rows: &[GridRow]) -> Result<bool> {
                     let mut all =
                         format!("==== {}: {} ({})\n", r.name, r.config.summary(), r.covers);
                     all += &p.stdout;
-                    crate::out!("{all}")?;
-                    crate::err!("{}", p.stderr);
+                    steps.suspend(|| crate::out!("{all}"))?;
+                    steps.suspend(|| crate::err!("{}", p.stderr));
+                    let k = done.fetch_add(1, Ordering::Relaxed) + 1;
+                    steps.step(&format!("{k} of {} rows proved", rows.len()));
                     Ok(p)
                 });
                 out.lock().expect("no worker panics")[i] = Some(proof);
             });
         }
     });
+    drop(steps);
     let mut failed = Vec::new();
     let (mut cases, mut inputs, mut cpu) = (0usize, 0u128, 0.0f64);
     for (r, p) in rows.iter().zip(out.into_inner().expect("no worker panics")) {

@@ -177,16 +177,35 @@ fn simulate(design: &DesignDir, a: &SimArgs, opts: &Options) -> Result<Outcome> 
         ),
     )?;
     // The first line that cannot be printed stops nothing of the run, but is its error.
-    let mut printed = Ok(());
-    let result = sim::run(design, &build, &absolute(&target), opts, &mut |l| {
-        if printed.is_ok() {
-            printed = crate::outln!("{l}");
-        }
-    });
+    let mut report = Lines {
+        steps: super::progress::Steps::new(),
+        printed: Ok(()),
+    };
+    let result = sim::run(design, &build, &absolute(&target), opts, &mut report);
+    let Lines { steps, printed } = report;
+    drop(steps);
     printed?;
     let (_, outcome) = staged.commit_with(result)?;
     crate::out!("{}", outcome.summary(design))?;
     Ok(outcome)
+}
+
+/// The run's lines on stdout, and the step under way on a terminal's stderr.
+struct Lines {
+    steps: super::progress::Steps,
+    printed: Result<()>,
+}
+
+impl sim::Report for Lines {
+    fn say(&mut self, line: &str) {
+        if self.printed.is_ok() {
+            self.printed = self.steps.suspend(|| crate::outln!("{line}"));
+        }
+    }
+
+    fn starting(&mut self, step: &str) {
+        self.steps.step(step);
+    }
 }
 
 /// Every selected row of the grid: generated into DIR/<row>, then simulated. Whether any

@@ -44,7 +44,17 @@ pub fn run(a: &SynthArgs) -> Result<ExitCode> {
     };
     let staged = StagedDir::new(&a.logs, &a.force.policy(&[Some(design.path())]))?;
     let logs = absolute(staged.path());
+    let steps = super::progress::Steps::new();
+    steps.step(&format!(
+        "synthesising {} with Yosys {}",
+        design.top,
+        match flow {
+            Flow::Ice40 => "synth_ice40",
+            Flow::Generic => "synth (generic)",
+        }
+    ));
     let result = yosys::check(design.path(), &design.top, design.file_names(), &logs, flow);
+    drop(steps);
     let (logs_shown, check) = staged.commit_with(result)?;
     let logs_shown = absolute(&logs_shown);
     let log = logs_shown.join(yosys::LOG);

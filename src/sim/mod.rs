@@ -152,16 +152,31 @@ pub fn passed_count(verdict: &str) -> Option<u64> {
     n.parse().ok().filter(|&n| n > 0)
 }
 
+/// Where a run reports: the lines of each finished step, and the step now starting (for a
+/// progress display; nothing by default).
+pub trait Report {
+    fn say(&mut self, line: &str);
+    fn starting(&mut self, _step: &str) {}
+}
+
+/// A closure that takes the lines (and no progress).
+impl<F: FnMut(&str)> Report for F {
+    fn say(&mut self, line: &str) {
+        self(line)
+    }
+}
+
 /// Runs what `opts` asks for on `design`, with build products and logs in `build` (created if
 /// missing); `shown` is the name messages give `build` (where it will be moved to). Each step
-/// is reported through `say`, a line at a time; a failed simulation is in the outcome, an
-/// error only what stops the runs (a file that cannot be written, a tool that cannot start).
+/// is reported through `say`, a line at a time, and announced as it starts; a failed
+/// simulation is in the outcome, an error only what stops the runs (a file that cannot be
+/// written, a tool that cannot start).
 pub fn run(
     design: &DesignDir,
     build: &Path,
     shown: &Path,
     opts: &Options,
-    say: &mut dyn FnMut(&str),
+    say: &mut dyn Report,
 ) -> Result<Outcome> {
     // The shading pipeline's top (inside rmap_axis with `axis`): its testbench takes the
     // long stream and the C++ harness drives it.
@@ -292,13 +307,13 @@ struct Runner<'a> {
     design: &'a DesignDir,
     build: PathBuf,
     shown: String,
-    say: &'a mut dyn FnMut(&str),
+    say: &'a mut dyn Report,
     outcome: Outcome,
 }
 
 impl Runner<'_> {
     fn say(&mut self, line: &str) {
-        (self.say)(line)
+        self.say.say(line)
     }
 
     /// `text` with the build directory named as it will be after the run.
@@ -347,6 +362,7 @@ impl Runner<'_> {
             Some(n) => n.to_path_buf(),
             None => {
                 let name = "gate yosys synth_ice40";
+                self.say.starting(name);
                 let t0 = std::time::Instant::now();
                 match yosys::synth_ice40(design.path(), &design.top, design.file_names(), &dir) {
                     Ok(st) => self.say(&format!(
@@ -397,6 +413,7 @@ impl Runner<'_> {
 
     /// A build step: its run if it succeeded, None (reported) if not.
     fn step(&mut self, name: &str, cmd: &mut Command, log: &Path) -> Result<Option<Ran>> {
+        self.say.starting(name);
         let ran = toolchain::run_logged(cmd, log)?;
         if ran.success() {
             return Ok(Some(ran));
@@ -407,6 +424,7 @@ impl Runner<'_> {
 
     /// A simulation, judged by its exit and its verdict line; whether it passed.
     fn simulation(&mut self, name: &str, mut cmd: Command, log: &Path) -> Result<bool> {
+        self.say.starting(name);
         let ran = toolchain::run_logged(&mut cmd, log)?;
         if name.ends_with("(C++)") {
             for l in ran.output.lines().filter(|l| l.contains("vectors/s")) {

@@ -594,3 +594,70 @@ fn bad_input_is_one_line_and_exit_2_with_nothing_written() {
     );
     assert!(!other.exists());
 }
+
+/// `sim` shows the step under way on a terminal (under util-linux's `script`), and its stderr
+/// is empty in a script, its stdout the same lines either way.
+#[test]
+fn sim_shows_its_steps_on_a_terminal_only() {
+    if !require("iverilog") || !rmapgen::toolchain::installed("script") {
+        return;
+    }
+    let tmp = helpers::tempdir();
+    let dir = tmp.path().join("d");
+    hdl::generate_config(&dir, &grid::narrowest(), 5);
+    let build = tmp.path().join("b");
+    let command = format!(
+        "{} sim --icarus --only zero_detect --build {} {}",
+        env!("CARGO_BIN_EXE_rmapgen"),
+        build.display(),
+        dir.display()
+    );
+    let o = std::process::Command::new("script")
+        .args(["-qec", &command, "/dev/null"])
+        .output()
+        .unwrap();
+    let tty = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{tty}");
+    // The spinner's line: the elapsed time, then the step (compile, then the run).
+    assert!(tty.contains("icarus zero_detect_tb (compile)"), "{tty}");
+    assert!(tty.contains("00:00:0"), "{tty}");
+    assert!(tty.contains("ok:   icarus zero_detect_tb: "), "{tty}");
+    let o = helpers::run(&[
+        "sim",
+        "--icarus",
+        "--only",
+        "zero_detect",
+        "--build",
+        s(&build),
+        "--force",
+        s(&dir),
+    ]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    assert_eq!(err, "");
+    assert!(!out.contains("(compile)"), "{out}");
+    assert!(out.contains("ok:   icarus zero_detect_tb: "), "{out}");
+    // synth, one Yosys run: its step on a terminal, nothing on stderr in a script.
+    if require("yosys") {
+        let logs = tmp.path().join("logs");
+        let command = format!(
+            "{} synth --logs {} {}",
+            env!("CARGO_BIN_EXE_rmapgen"),
+            logs.display(),
+            dir.display()
+        );
+        let o = std::process::Command::new("script")
+            .args(["-qec", &command, "/dev/null"])
+            .output()
+            .unwrap();
+        let tty = String::from_utf8_lossy(&o.stdout);
+        assert!(o.status.success(), "{tty}");
+        assert!(
+            tty.contains("synthesising rmap_top with Yosys synth_ice40"),
+            "{tty}"
+        );
+        let o = helpers::run(&["synth", "--logs", s(&logs), "--force", s(&dir)]);
+        assert!(o.status.success());
+        assert_eq!(text(&o).1, "");
+    }
+}
