@@ -31,6 +31,28 @@ run: build
 	$(RMAPGEN) generate --out $(OUT)
 	$(RMAPGEN) render --scene $(SCENE) --out out/sphere
 
+# The manual pages and shell completions, from the command line's own definitions (rmapgen
+# man, rmapgen completions), into build/man; `make install` puts the binary, the pages and the
+# completions under PREFIX (default ~/.local: bin/, share/man/man1/, and the bash, zsh and
+# fish completion directories).
+PREFIX ?= $(HOME)/.local
+.PHONY: man install
+man: build
+	$(RMAPGEN) man --out build/man/man1 --force
+	mkdir -p build/man/completions
+	$(RMAPGEN) completions bash > build/man/completions/rmapgen.bash
+	$(RMAPGEN) completions zsh > build/man/completions/_rmapgen
+	$(RMAPGEN) completions fish > build/man/completions/rmapgen.fish
+
+install: man
+	install -d $(PREFIX)/bin $(PREFIX)/share/man/man1 $(PREFIX)/share/bash-completion/completions \
+	  $(PREFIX)/share/zsh/site-functions $(PREFIX)/share/fish/vendor_completions.d
+	install -m 755 $(RMAPGEN) $(PREFIX)/bin/rmapgen
+	install -m 644 build/man/man1/*.1 $(PREFIX)/share/man/man1/
+	install -m 644 build/man/completions/rmapgen.bash $(PREFIX)/share/bash-completion/completions/rmapgen
+	install -m 644 build/man/completions/_rmapgen $(PREFIX)/share/zsh/site-functions/_rmapgen
+	install -m 644 build/man/completions/rmapgen.fish $(PREFIX)/share/fish/vendor_completions.d/rmapgen.fish
+
 # Installs iverilog, verilator, yosys, nextpnr-ice40 and icestorm with apt-get when missing
 # (a fresh machine has none).
 tools:

@@ -91,6 +91,11 @@ enum Command {
     /// (`prove --direct`) and by the checks; exit 1 if the factored proof passes a mutant
     /// whose outputs differ.
     Mutants(cmd::mutants::MutantsArgs),
+    /// Write the manual pages (roff: `rmapgen.1` and one page per command) into a directory;
+    /// `make man` and `make install` use it.
+    Man(cmd::manual::ManArgs),
+    /// Print the completion script of a shell (bash, zsh, fish, elvish, powershell) on stdout.
+    Completions(cmd::manual::CompletionsArgs),
 }
 
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
@@ -120,6 +125,8 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Lint(a) => cmd::lint::run(&a),
         Command::Prove(a) => cmd::prove::run(&a),
         Command::Mutants(a) => cmd::mutants::run(&a),
+        Command::Man(a) => done(cmd::manual::man(Cli::command(), &a)),
+        Command::Completions(a) => done(cmd::manual::completions(Cli::command(), &a)),
     }
 }
 

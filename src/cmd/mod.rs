@@ -8,6 +8,7 @@ pub mod force;
 pub mod fpga;
 pub mod generate;
 pub mod lint;
+pub mod manual;
 pub mod map_args;
 pub mod maps;
 pub mod mutants;

@@ -22,6 +22,7 @@ mod init_files;
 mod lanes;
 mod layout;
 mod limits;
+mod manual;
 mod map_fit;
 mod map_flags;
 mod map_stream;
