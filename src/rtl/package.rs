@@ -84,6 +84,11 @@ struct Readme {
     frac_bits: u32,
     interp_bits: u32,
     interpolation: bool,
+    /// The colour multiply (`color`): the formula of r_o, g_o, b_o.
+    color: bool,
+    grad_bits: u32,
+    /// -2^(grad_bits - 1), the most negative gradient component.
+    grad_min: i64,
     addr_bits: u32,
     /// (name, bits, width, meaning) of each address field.
     addr_fields: Vec<(String, String, u32, String)>,
@@ -349,6 +354,9 @@ pub fn readme(design: &Design) -> Result<String> {
         frac_bits: cfg.frac_bits,
         interp_bits: cfg.interp_bits,
         interpolation: cfg.interpolation,
+        color: cfg.color,
+        grad_bits: cfg.grad_bits,
+        grad_min: -(1i64 << (cfg.grad_bits - 1)),
         addr_bits: cfg.map_addr_bits(),
         addr_fields: map_addr::fields(cfg)
             .iter()
@@ -424,7 +432,7 @@ fn describe(name: &str, note: &str) -> String {
     let base = match name {
         "clk_i" => "clock",
         "rst_ni" => "reset",
-        "gx_i" => "gradient x component",
+        "gx_i" => "gradient x component, G-bit two's complement",
         "gy_i" => "gradient y component, G-bit two's complement",
         "gz_i" => "gradient z component, G-bit two's complement",
         "r_i" | "g_i" | "b_i" => "sample colour channel",
@@ -436,7 +444,9 @@ fn describe(name: &str, note: &str) -> String {
     };
     match (base.is_empty(), note.is_empty()) {
         (true, _) => note.to_string(),
+        // A note the name's description already says is not said twice.
         (false, true) => base.to_string(),
+        (false, false) if base.contains(note) => base.to_string(),
         (false, false) => format!("{base}: {note}"),
     }
 }

@@ -345,3 +345,68 @@ fn probe(handshake: bool) {
     assert_eq!(line("front after reset "), "0");
     assert!(text.contains("Reset makes buffer 0 the\nfront buffer again"));
 }
+
+/// The README's gradient and colour rules, checked against the model: the colour formula it
+/// prints gives the colour multiply's every output (every channel value, every intensity, two
+/// map widths), the most negative gradient shades as its half, as it says, and no port's
+/// description says the same thing twice.
+#[test]
+fn the_readme_states_the_gradient_and_colour_rules_the_model_follows() {
+    use rmapgen::model::Model;
+    use rmapgen::stages::color_mul::model as color_mul;
+    for map_bits in [8, 6] {
+        let cfg = Config {
+            color: true,
+            map_bits,
+            ..Config::default()
+        };
+        let text = readme(&Design::for_scene(&cfg, &Scene::standard()).unwrap()).unwrap();
+        let d = cfg.map_max();
+        assert!(
+            text.contains(&format!("with D = {d} and i the"))
+                && text.contains("`r_o = floor((2 * r_i * i + D) / (2 * D))`"),
+            "the colour formula"
+        );
+        for c in 0..256u32 {
+            for i in 0..=d {
+                let said = (2 * c * i + d) / (2 * d);
+                assert_eq!(
+                    color_mul::eval(&cfg, [c, 0, c], i),
+                    [said, 0, said],
+                    "c {c} i {i}"
+                );
+            }
+        }
+        for l in text.lines().filter(|l| l.starts_with("| `")) {
+            let cells: Vec<&str> = l.split('|').map(str::trim).collect();
+            if let Some(desc) = cells.get(4) {
+                if let Some((a, b)) = desc.split_once(": ") {
+                    assert!(!a.contains(b), "said twice: {l}");
+                }
+            }
+        }
+    }
+    let cfg = Config::default();
+    let text = readme(&Design::for_scene(&cfg, &Scene::standard()).unwrap()).unwrap();
+    let min = -(1i32 << (cfg.grad_bits - 1));
+    assert!(text.contains(&format!(
+        "Every 12-bit\nvalue is a legal input, {min} included"
+    )));
+    assert!(text.contains("density volume's gradient points into the material, so negate it"));
+    let model = Model::new(&cfg);
+    let maps = Scene::standard().maps(&cfg);
+    for g in [
+        [min, 5, 7],
+        [min, min, 1],
+        [3, min, -9],
+        [min, min, min],
+        [-77, 1000, min],
+    ] {
+        let half = g.map(|c| c.signum() * (c.abs() >> 1));
+        assert_eq!(
+            model.intensity(&maps, g),
+            model.intensity(&maps, half),
+            "{g:?} shades as {half:?}"
+        );
+    }
+}
