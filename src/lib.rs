@@ -15,6 +15,7 @@ pub mod map_stream;
 pub mod model;
 pub mod mutants;
 pub mod output;
+pub mod plotting;
 pub mod prove;
 pub mod reference;
 pub mod render;

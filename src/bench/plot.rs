@@ -2,13 +2,13 @@
 //! per map kind, each scene's Pareto front as a line; drawn once into an SVG string and once
 //! into an RGB buffer saved as PNG with `image`.
 //!
-//! Text needs a font: the first of a few common system TrueType fonts is registered with
-//! plotters; without one the plots are drawn without captions and labels.
+//! Text needs a font ([`crate::plotting::font`]); without one the plots are drawn without
+//! captions and labels.
 
+use crate::plotting::font;
 use anyhow::{anyhow, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use std::sync::OnceLock;
 
 /// One point: x, y, scene index, marker (0 sampled cube map, 1 fitted, 2 octahedral, 3 fitted
 /// with a loaded compensation table, drawn last as an outlined bar).
@@ -32,29 +32,6 @@ pub struct Chart<'a> {
 }
 
 const SIZE: (u32, u32) = (900, 600);
-const FONT_PATHS: &[&str] = &[
-    "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
-    "/usr/share/fonts/truetype/liberation2/LiberationSans-Regular.ttf",
-    "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf",
-    "/usr/share/fonts/TTF/DejaVuSans.ttf",
-];
-
-/// Registers a system font as "sans-serif" once; whether one was found.
-fn font() -> bool {
-    static FOUND: OnceLock<bool> = OnceLock::new();
-    *FOUND.get_or_init(|| {
-        for p in FONT_PATHS {
-            if let Ok(bytes) = std::fs::read(p) {
-                let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
-                if plotters::style::register_font("sans-serif", FontStyle::Normal, bytes).is_ok() {
-                    return true;
-                }
-            }
-        }
-        false
-    })
-}
-
 fn colour(scene: usize) -> RGBColor {
     [
         RGBColor(31, 119, 180),

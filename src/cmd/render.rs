@@ -26,8 +26,9 @@ pub struct RenderArgs {
     /// unless the RTL image equals the model image pixel for pixel.
     #[arg(long)]
     pub rtl: bool,
-    /// Output directory for reference.png, model.png, error50.png and metrics.json (replaced
-    /// whole on success).
+    /// Output directory for reference.png, model.png, error50.png, metrics.json and the
+    /// pictures highlight.png, error_signed.png, profile.png and histogram.png (replaced whole
+    /// on success).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     #[command(flatten)]

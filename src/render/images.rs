@@ -35,6 +35,14 @@ pub fn grey(size: u32, pixels: &[Pixel], values: impl IntoIterator<Item = u8>) -
     img
 }
 
+/// An RGB image encoded as PNG.
+pub fn png_rgb(img: &image::RgbImage) -> Result<Vec<u8>> {
+    let mut buf = Cursor::new(Vec::new());
+    img.write_to(&mut buf, ImageFormat::Png)
+        .context("cannot encode PNG")?;
+    Ok(buf.into_inner())
+}
+
 /// The image encoded as PNG.
 pub fn png(img: &GrayImage) -> Result<Vec<u8>> {
     let mut buf = Cursor::new(Vec::new());

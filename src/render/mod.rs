@@ -8,6 +8,7 @@
 
 pub mod images;
 pub mod metrics;
+pub mod pictures;
 pub mod sphere;
 
 use crate::config::Config;
@@ -69,6 +70,14 @@ pub fn model_intensities(model: &Model, maps: &Maps, gradients: &[[i32; 3]]) -> 
         .map(|&g| model.intensity(maps, g))
         .collect()
 }
+
+/// The pictures' file names, in the order [`Render::pictures`] gives them.
+pub const PICTURES: [&str; 4] = [
+    "highlight.png",
+    "error_signed.png",
+    "profile.png",
+    "histogram.png",
+];
 
 /// A finished render: every inside pixel and its values from each source.
 #[derive(Clone, Debug)]
@@ -183,13 +192,42 @@ impl Render {
         Some(rtl.iter().zip(&self.model).filter(|(a, b)| a != b).count())
     }
 
-    /// File names of the images, in the order [`Render::images`] gives them.
+    /// File names of the images, in the order [`Render::images`] gives them, then the
+    /// pictures of [`Render::pictures`].
     pub fn image_names(&self) -> Vec<&'static str> {
         let mut v = vec!["reference.png", "model.png", "error50.png"];
         if self.rtl.is_some() {
             v.push("rtl.png");
         }
+        v.extend(PICTURES);
         v
+    }
+
+    /// What the pictures are drawn from.
+    pub fn picture_source<'a>(&'a self, grey: &'a dyn Fn(u32) -> u8) -> pictures::Source<'a> {
+        pictures::Source {
+            size: self.options.size,
+            pixels: &self.pixels,
+            reference: &self.reference,
+            model: &self.model,
+            grey,
+            worst: self.metrics.worst_index,
+            range: self.metrics.max_abs_error.max(1),
+        }
+    }
+
+    /// The pictures ([`pictures`]): the highlight zoomed, the signed error with its scale,
+    /// the profile through the worst pixel and the error histogram, by file name.
+    pub fn pictures(&self) -> Result<Vec<(&'static str, image::RgbImage)>> {
+        let m = self.cfg.map_bits;
+        let grey = move |v: u32| images::display8(v, m);
+        let s = self.picture_source(&grey);
+        Ok(vec![
+            (PICTURES[0], s.highlight()),
+            (PICTURES[1], s.error_signed()?),
+            (PICTURES[2], s.profile(self.cfg.map_max())?),
+            (PICTURES[3], s.histogram()?),
+        ])
     }
 
     /// The images by file name.
@@ -241,6 +279,9 @@ impl Render {
     pub fn write(&self, out: &StagedDir) -> Result<()> {
         for (name, img) in self.images() {
             out.write_bytes(name, &images::png(&img)?)?;
+        }
+        for (name, img) in self.pictures()? {
+            out.write_bytes(name, &images::png_rgb(&img)?)?;
         }
         out.write_text("metrics.json", &self.metrics_json()?)
     }
@@ -304,6 +345,62 @@ mod tests {
         }
         .validate(&c)
         .unwrap();
+    }
+
+    /// The pictures show the render's own values where they say: the worst pixel at the
+    /// centre of the highlight's crops (its model grey, its error saturated), in the signed
+    /// error image, and counted in the histogram, whose counts are every pixel once.
+    #[test]
+    fn the_pictures_show_the_worst_pixel_where_they_say() {
+        let c = Config::default();
+        let r = render(
+            &c,
+            &Scene::standard(),
+            Options {
+                size: 96,
+                shrink: 0,
+            },
+            None,
+        )
+        .unwrap();
+        let w = r.metrics.worst_index.unwrap();
+        let (x, y, _) = r.pixels[w];
+        let pics = r.pictures().unwrap();
+        assert_eq!(
+            pics.iter().map(|p| p.0).collect::<Vec<_>>(),
+            PICTURES.to_vec()
+        );
+        let names = r.image_names();
+        assert!(PICTURES.iter().all(|p| names.contains(p)));
+        let m = c.map_bits;
+        let grey = move |v: u32| images::display8(v, m);
+        let s = r.picture_source(&grey);
+        let e = r.model[w] as i64 - r.reference[w] as i64;
+        let saturated = pictures::signed_colour(e, r.metrics.max_abs_error as i64);
+        assert!(saturated == image::Rgb([255, 0, 0]) || saturated == image::Rgb([0, 0, 255]));
+        // The highlight: three panels of the crop, the worst pixel's block in each.
+        let h = &pics[0].1;
+        let (x0, y0, side) = pictures::crop_origin(96, x, y);
+        let panel = side * pictures::ZOOM;
+        assert_eq!(h.dimensions(), (3 * panel + 2 * pictures::GAP, panel));
+        let block = |k: u32| {
+            let px = k * (panel + pictures::GAP) + (x - x0) * pictures::ZOOM + pictures::ZOOM / 2;
+            *h.get_pixel(px, (y - y0) * pictures::ZOOM + pictures::ZOOM / 2)
+        };
+        let g = |v: u32| image::Rgb([grey(v); 3]);
+        assert_eq!(block(0), g(r.reference[w]));
+        assert_eq!(block(1), g(r.model[w]));
+        assert_eq!(block(2), saturated);
+        // The signed error image: the same colour at the same place.
+        assert_eq!(*pics[1].1.get_pixel(x, y), saturated);
+        // The histogram: every pixel once, the worst error among them.
+        let counts = s.histogram_counts();
+        assert_eq!(
+            counts.iter().map(|c| c.1).sum::<u64>(),
+            r.pixels.len() as u64
+        );
+        assert!(counts.iter().any(|&(v, n)| v == e && n > 0));
+        assert_eq!(counts.len() as u32, 2 * r.metrics.max_abs_error + 1);
     }
 
     #[test]

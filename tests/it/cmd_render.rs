@@ -32,8 +32,12 @@ fn writes_images_and_metrics() {
         [
             ".rmapgen-files",
             "error50.png",
+            "error_signed.png",
+            "highlight.png",
+            "histogram.png",
             "metrics.json",
             "model.png",
+            "profile.png",
             "reference.png"
         ]
     );
