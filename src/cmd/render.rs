@@ -27,8 +27,8 @@ pub struct RenderArgs {
     #[arg(long)]
     pub rtl: bool,
     /// Output directory for reference.png, model.png, error50.png, metrics.json and the
-    /// pictures highlight.png, error_signed.png, profile.png and histogram.png (replaced whole
-    /// on success).
+    /// pictures highlight.png, error_signed.png, profile.png and histogram.png, and report.html
+    /// showing them all (replaced whole on success).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     #[command(flatten)]

@@ -9,6 +9,7 @@
 pub mod images;
 pub mod metrics;
 pub mod pictures;
+pub mod report;
 pub mod sphere;
 
 use crate::config::Config;
@@ -277,12 +278,17 @@ impl Render {
 
     /// Writes the images and `metrics.json`.
     pub fn write(&self, out: &StagedDir) -> Result<()> {
+        let mut files = Vec::new();
         for (name, img) in self.images() {
-            out.write_bytes(name, &images::png(&img)?)?;
+            files.push((name, images::png(&img)?));
         }
         for (name, img) in self.pictures()? {
-            out.write_bytes(name, &images::png_rgb(&img)?)?;
+            files.push((name, images::png_rgb(&img)?));
         }
+        for (name, png) in &files {
+            out.write_bytes(name, png)?;
+        }
+        out.write_text("report.html", &report::html(self, &files)?)?;
         out.write_text("metrics.json", &self.metrics_json()?)
     }
 

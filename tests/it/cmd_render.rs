@@ -38,7 +38,8 @@ fn writes_images_and_metrics() {
             "metrics.json",
             "model.png",
             "profile.png",
-            "reference.png"
+            "reference.png",
+            "report.html"
         ]
     );
     assert_eq!(
@@ -208,4 +209,69 @@ fn failure_keeps_an_existing_output() {
     );
     assert_eq!(std::fs::read(out.join("metrics.json")).unwrap(), before);
     assert_eq!(crate::helpers::entries(tmp.path()), ["o"]);
+}
+
+/// Standard base64 decoding (the test's own, against the report's encoder).
+fn unbase64(s: &str) -> Vec<u8> {
+    let val = |c: u8| match c {
+        b'A'..=b'Z' => c - b'A',
+        b'a'..=b'z' => c - b'a' + 26,
+        b'0'..=b'9' => c - b'0' + 52,
+        b'+' => 62,
+        b'/' => 63,
+        _ => panic!("not base64: {c}"),
+    } as u32;
+    let mut out = Vec::new();
+    for q in s.as_bytes().chunks(4) {
+        let pad = q.iter().filter(|&&c| c == b'=').count();
+        let n = q
+            .iter()
+            .map(|&c| if c == b'=' { 0 } else { val(c) })
+            .fold(0u32, |n, v| n << 6 | v);
+        out.extend_from_slice(&n.to_be_bytes()[1..4 - pad]);
+    }
+    out
+}
+
+/// report.html shows every image the render wrote, byte for byte, and the figures of
+/// metrics.json.
+#[test]
+fn the_report_embeds_every_image_and_the_figures() {
+    let tmp = tempdir();
+    let out = tmp.path().join("sphere");
+    let o = run(&["render", "--size", "64", "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let page = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let metrics: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
+    let names: Vec<&str> = metrics["images"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_str().unwrap())
+        .collect();
+    assert_eq!(names.len(), 7, "{names:?}");
+    let mut shown = 0;
+    for part in page.split("<img alt=\"").skip(1) {
+        let (name, rest) = part.split_once('"').unwrap();
+        let data = rest
+            .split_once("src=\"data:image/png;base64,")
+            .unwrap()
+            .1
+            .split('"')
+            .next()
+            .unwrap();
+        let bytes = unbase64(data);
+        assert_eq!(bytes, std::fs::read(out.join(name)).unwrap(), "{name}");
+        image::load_from_memory(&bytes).expect("a PNG");
+        assert!(names.contains(&name));
+        shown += 1;
+    }
+    assert_eq!(shown, names.len());
+    let max = metrics["max_abs_error"].as_u64().unwrap();
+    assert!(
+        page.contains(&format!("<th>largest error</th><td>{max} LSB</td>")),
+        "{page}"
+    );
+    assert!(page.starts_with("<!DOCTYPE html>") && page.ends_with("</html>\n"));
 }
