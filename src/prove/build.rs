@@ -3,6 +3,7 @@
 //! wrapper written here) and the design's top, both from the generated files themselves.
 
 use super::front::FRONT;
+use crate::config::Config;
 use crate::design_dir::DesignDir;
 use crate::stages::TOP;
 use crate::toolchain::{run_logged, verilator};
@@ -26,8 +27,7 @@ pub const FRONT_LANES: usize = 4;
 /// `g{x,y,z}<k>_i`, with `valid` its valid bit on `<name>_valid_o` (copy 0's: all move together) and its
 /// other outputs packed into `<name><k>_o`, the first output field in the low bits (the order
 /// [`super::front::pack`] uses). Not part of the design: it only gives the harness ports.
-pub fn front_wrapper(d: &DesignDir, copies: usize, valid: bool) -> String {
-    let cfg = &d.config;
+pub fn front_wrapper(cfg: &Config, copies: usize, valid: bool) -> String {
     let g = cfg.grad_bits;
     let mut ports = vec![
         "  input  wire clk_i".to_string(),
@@ -152,7 +152,7 @@ pub fn front(d: &DesignDir, build: &Path) -> Result<PathBuf> {
     let dir = build.join("front");
     crate::disk::create_dir_all(&dir)?;
     let wrapper = dir.join(format!("{FRONT_MODULE}.v"));
-    crate::disk::write(&wrapper, front_wrapper(d, FRONT_LANES, true))?;
+    crate::disk::write(&wrapper, front_wrapper(&d.config, FRONT_LANES, true))?;
     let harness = dir.join("prove_front.cpp");
     crate::disk::write(&harness, FRONT_HARNESS)?;
     crate::disk::write(&dir.join("prove_front_lanes.h"), front_lanes_header())?;
@@ -188,4 +188,97 @@ pub fn top(d: &DesignDir, build: &Path) -> Result<PathBuf> {
         &d.path().join("tb"),
         &d.top_files()?,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::prove::front::{pack, widths};
+
+    /// The wrapper's lines for copy `k` of module `name`: its instance and connections.
+    fn instance<'a>(v: &'a str, name: &str, k: usize) -> &'a str {
+        let head = format!("u_{name}{k} (");
+        let at = v.find(&head).unwrap_or_else(|| panic!("no {head} in\n{v}"));
+        let end = at + v[at..].find(");").unwrap();
+        &v[at..end]
+    }
+
+    #[test]
+    fn the_wrapper_packs_each_copy_as_the_model_packs_it() {
+        let cfg = Config {
+            grad_bits: 8,
+            red_bits: 6,
+            ..Config::default()
+        };
+        let v = front_wrapper(&cfg, 2, true);
+        for k in 0..2 {
+            for c in ["gx", "gy", "gz"] {
+                assert!(
+                    v.contains(&format!("input  wire [7:0] {c}{k}_i")),
+                    "{c}{k}\n{v}"
+                );
+            }
+        }
+        for unit in FRONT {
+            let name = unit.name();
+            let w = widths(unit, &cfg);
+            let total: u32 = w.iter().map(|(_, b)| b).sum();
+            assert!(v.contains(&format!("output wire {name}_valid_o")), "{v}");
+            for k in 0..2 {
+                assert!(v.contains(&format!("output wire [{}:0] {name}{k}_o", total - 1)));
+                let inst = instance(&v, name, k);
+                assert!(inst.contains(&format!(".gx_i    (gx{k}_i)")), "{inst}");
+                assert!(inst.contains(&format!(".gz_i    (gz{k}_i)")), "{inst}");
+                let valid = if k == 0 {
+                    format!("{name}_valid_o")
+                } else {
+                    String::new()
+                };
+                assert!(inst.contains(&format!(".valid_o ({valid})")), "{inst}");
+                // Each output field's slice holds what pack puts there: a field of all ones
+                // alone packs to exactly the slice's bits.
+                let fields: Vec<_> = unit
+                    .fields(&cfg)
+                    .into_iter()
+                    .filter(|f| f.dir == Dir::Out)
+                    .collect();
+                for (i, f) in fields.iter().enumerate() {
+                    let mut values = vec![0u64; w.len()];
+                    values[i] = (1 << f.bits) - 1;
+                    let word = pack(&values, &w);
+                    let (lsb, msb) = (word.trailing_zeros(), 63 - word.leading_zeros());
+                    let port = unit.port(f).unwrap_or_else(|| format!("{}_o", f.name));
+                    let conn = format!(".{port} ({name}{k}_o[{msb}:{lsb}])");
+                    assert!(inst.contains(&conn), "{conn} not in {inst}");
+                }
+            }
+        }
+        // Without the valid outputs, no copy drives one.
+        let v = front_wrapper(&cfg, 1, false);
+        assert!(!v.contains("_valid_o"), "{v}");
+        assert!(instance(&v, FRONT[0].name(), 0).contains(".valid_o ()"));
+    }
+
+    #[test]
+    fn the_lanes_header_applies_and_collects_every_lane() {
+        let h = front_lanes_header();
+        let [zero, sort] = FRONT.map(|u| u.name());
+        assert!(
+            h.contains(&format!("#define RP_LANES {FRONT_LANES}\n")),
+            "{h}"
+        );
+        for k in 0..FRONT_LANES {
+            let apply = format!(
+                " t.gx{k}_i = g[{}]; t.gy{k}_i = g[{}]; t.gz{k}_i = g[{}];",
+                3 * k,
+                3 * k + 1,
+                3 * k + 2
+            );
+            assert!(h.contains(&apply), "{apply}\n{h}");
+            assert!(h.contains(&format!(" z[{k}] = t.{zero}{k}_o;")), "{h}");
+            assert!(h.contains(&format!(" s[{k}] = t.{sort}{k}_o;")), "{h}");
+        }
+        assert!(h.contains(&format!("#define RP_ZERO_VALID(t) (t.{zero}_valid_o)")));
+        assert!(h.contains(&format!("#define RP_SORT_VALID(t) (t.{sort}_valid_o)")));
+    }
 }

@@ -150,3 +150,86 @@ pub fn check(
     }
     Ok(())
 }
+
+/// A chunk holds at least one group of the wrapper's lanes (each call advances).
+const _: () = assert!(CHUNK >= super::build::FRONT_LANES);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cfg8() -> Config {
+        Config {
+            grad_bits: 8,
+            red_bits: 6,
+            ..Config::default()
+        }
+    }
+
+    #[test]
+    fn widths_are_the_output_fields_in_order() {
+        let cfg = cfg8();
+        assert_eq!(widths(FRONT[0], &cfg), vec![("zero", 1)]);
+        assert_eq!(
+            widths(FRONT[1], &cfg),
+            vec![
+                ("axis", 2),
+                ("s_max", 1),
+                ("s_u", 1),
+                ("s_v", 1),
+                ("m", 6),
+                ("a", 6),
+                ("b", 6)
+            ]
+        );
+    }
+
+    #[test]
+    fn pack_puts_the_first_field_in_the_low_bits() {
+        let w = [("p", 1), ("q", 3), ("r", 5)];
+        assert_eq!(
+            pack(&[1, 0b101, 0b10011], &w),
+            1 | 0b101 << 1 | 0b10011 << 4
+        );
+        assert_eq!(pack(&[0, 0, 1], &w), 1 << 4);
+        // The sort & shift fields of one state, against the fields placed by hand.
+        let cfg = cfg8();
+        let sw = widths(FRONT[1], &cfg);
+        let s = sort_shift::eval(&cfg, [-3, 100, -57]);
+        let v = stages::sort_shift::outputs(&s);
+        let mut want = 0;
+        for (k, shift) in [0, 2, 3, 4, 5, 11, 17].into_iter().enumerate() {
+            want += v[k] << shift;
+        }
+        assert_eq!(pack(&v, &sw), want);
+    }
+
+    #[test]
+    fn differences_name_each_differing_field_with_both_values() {
+        let w = [("p", 1), ("q", 3), ("r", 5)];
+        let want = pack(&[1, 0b101, 0b10011], &w);
+        assert_eq!(differences(want, want, &w), "");
+        let got = pack(&[1, 0b011, 0b10010], &w);
+        assert_eq!(
+            differences(want, got, &w),
+            "q expected 0x5, got 0x3, r expected 0x13, got 0x12"
+        );
+        let got = pack(&[0, 0b101, 0b10011], &w);
+        assert_eq!(differences(want, got, &w), "p expected 0x1, got 0x0");
+        // Bits above the last field are not a field's.
+        assert_eq!(differences(want, want | 1 << 9, &w), "");
+    }
+
+    #[test]
+    fn an_index_is_gx_then_gy_then_gz() {
+        let cfg = cfg8();
+        assert_eq!(gradient(&cfg, 0x03_02_01), [1, 2, 3]);
+        assert_eq!(gradient(&cfg, 0xff_80_7f), [0x7f, 0x80, 0xff]);
+        assert_eq!(gradient(&cfg, (1 << 24) - 1), [0xff; 3]);
+        let msg = missing_state(&cfg, 0x03_02_01);
+        assert!(
+            msg.starts_with("front: gradient [1, 2, 3]: its sort & shift state"),
+            "{msg}"
+        );
+    }
+}

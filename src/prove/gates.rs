@@ -83,7 +83,7 @@ pub fn build(d: &DesignDir, build: &Path) -> Result<GateFront> {
         no_undefined_literal(&d.path().join(u.file(&d.config)))?;
     }
     let wrapper = dir.join(format!("{}.v", build::FRONT_MODULE));
-    crate::disk::write(&wrapper, build::front_wrapper(d, 1, false))?;
+    crate::disk::write(&wrapper, build::front_wrapper(&d.config, 1, false))?;
     let transparent = dir.join(crate::rtl::mult_proof::TRANSPARENT_FILE);
     crate::disk::write(&transparent, crate::rtl::mult_proof::TRANSPARENT)?;
     let mut files: Vec<String> = FRONT

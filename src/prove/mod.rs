@@ -500,5 +500,76 @@ mod tests {
             }
             assert_eq!(at, total);
         }
+        assert!(Shard::parse("1/3").unwrap().is_first());
+        assert!(!Shard::parse("2/3").unwrap().is_first());
+    }
+
+    #[test]
+    fn failures_count_every_one_and_keep_the_first_few() {
+        let mut f = Failures::default();
+        for k in 0..KEEP_FAILURES + 5 {
+            f.add(format!("f{k}"));
+        }
+        assert_eq!(f.count, KEEP_FAILURES as u64 + 5);
+        assert_eq!(f.kept.len(), KEEP_FAILURES);
+        assert_eq!(f.kept[0], "f0");
+        assert_eq!(f.kept[KEEP_FAILURES - 1], format!("f{}", KEEP_FAILURES - 1));
+    }
+
+    #[test]
+    fn an_engine_is_named_as_its_flag() {
+        use clap::ValueEnum;
+        for e in FrontEngine::value_variants() {
+            assert_eq!(e.name(), e.to_possible_value().unwrap().get_name());
+        }
+    }
+
+    #[test]
+    fn a_part_counts_its_inputs_over_every_pass() {
+        let passes = PASSES.len() as u64;
+        assert_eq!(passes, 4);
+        assert_eq!(part_total("structure", 8, 99), 1);
+        assert_eq!(part_total("zero", 8, 99), 1);
+        assert_eq!(part_total("front", 8, 99), 1 << 24);
+        assert_eq!(part_total("front", 12, 99), 1 << 36);
+        assert_eq!(part_total("direct", 8, 0), 4 << 24);
+        assert_eq!(part_total("states", 8, 99), 4 * 99);
+        assert_eq!(part_total("states", 8, 1 << 20), 4 << 20);
+    }
+
+    #[test]
+    fn a_run_takes_only_the_parts_of_its_kind() {
+        let opts = |direct: bool, parts: &[&str]| Options {
+            shard: Shard { index: 1, count: 1 },
+            direct,
+            front_engine: FrontEngine::Gates,
+            parts: parts.iter().map(|p| p.to_string()).collect(),
+        };
+        for ok in [
+            &[][..],
+            &["front"],
+            &["structure", "states", "zero", "front"],
+        ] {
+            assert!(check_options(&opts(false, ok)).is_ok(), "{ok:?}");
+        }
+        assert!(check_options(&opts(true, &["direct", "structure"])).is_ok());
+        for (direct, bad, says) in [
+            (
+                false,
+                "direct",
+                "--part direct: a factored run has the parts structure, states, zero, front",
+            ),
+            (
+                true,
+                "front",
+                "--part front: a --direct run has the parts structure, direct",
+            ),
+            (false, "fronts", "--part fronts: a factored run"),
+        ] {
+            let e = check_options(&opts(direct, &["structure", bad]))
+                .unwrap_err()
+                .to_string();
+            assert!(e.starts_with(says), "{e}");
+        }
     }
 }
