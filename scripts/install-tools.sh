@@ -2,7 +2,8 @@
 # Installs the simulators and synthesis tools from Debian's packages when any is missing (and
 # ccache, which the Makefile's Verilator builds share their runtime objects through);
 # WITH_FPGA=1 also nextpnr-ice40 and fpga-icestorm (place and route, make fpga); WITH_FORMAL=1
-# also z3 (the SMT solver of make formal's SymbiYosys runs); WITH_VOLPACK=1 also
+# also z3 (the SMT solver of make formal's SymbiYosys runs); WITH_DOCS=1 also linkchecker (make
+# docs) and chromium (make report-browser, driven by Playwright); WITH_VOLPACK=1 also
 # libvolpack1-dev (VolPack and its example MRI head, for make bench-volume only).
 # Fails loudly (exit 1) when it cannot: the tests must never skip a simulator silently.
 set -euo pipefail
@@ -14,6 +15,10 @@ done
 if [ "${WITH_FPGA:-0}" = 1 ]; then
   command -v nextpnr-ice40 >/dev/null 2>&1 || need+=(nextpnr-ice40)
   command -v icepack >/dev/null 2>&1 || need+=(fpga-icestorm)
+fi
+if [ "${WITH_DOCS:-0}" = 1 ]; then
+  command -v linkchecker >/dev/null 2>&1 || need+=(linkchecker)
+  [ -x /usr/bin/chromium ] || need+=(chromium)
 fi
 if [ "${WITH_FORMAL:-0}" = 1 ]; then
   command -v z3 >/dev/null 2>&1 || need+=(z3)
@@ -37,6 +42,7 @@ DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${need[@]}" >/dev/n
 check=(iverilog vvp verilator yosys ccache)
 [ "${WITH_FPGA:-0}" = 1 ] && check+=(nextpnr-ice40 icepack)
 [ "${WITH_FORMAL:-0}" = 1 ] && check+=(z3)
+[ "${WITH_DOCS:-0}" = 1 ] && check+=(linkchecker chromium)
 if [ "${WITH_VOLPACK:-0}" = 1 ] && [ ! -f /usr/include/volpack.h ]; then
   echo "install-tools: libvolpack1-dev still missing after install" >&2; exit 1
 fi
