@@ -71,14 +71,15 @@ docs: $(MDBOOK)
 	scripts/check-links.sh build/book
 	@echo "docs: build/book/index.html, every link checked"
 
-# ---- render's report.html in a real browser: a small sphere rendered, its report opened in
+# ---- render's report.html in a real browser: a small sphere rendered by a --color design (so
+# the colour images too), its report opened in
 # Debian's headless chromium by Playwright (tests/browser/check_report.py): every image decodes
 # at its PNG's size and the figures are shown; --self-test first shows the check refuse a
 # corrupt image, a missing one and a page without its table.
 REPORT_OUT ?= build/report-browser
 .PHONY: report-browser
 report-browser: build venv
-	$(RMAPGEN) render --scene $(SCENE) --size 128 --out $(REPORT_OUT) --force
+	$(RMAPGEN) render --color --scene $(SCENE) --size 128 --out $(REPORT_OUT) --force
 	$(VENV)/bin/python tests/browser/check_report.py $(REPORT_OUT)/report.html --metrics $(REPORT_OUT)/metrics.json --self-test
 
 tools:

@@ -6,6 +6,7 @@
 //! design) plugs in through [`IntensitySource`]: it adds `rtl.png` and the `rtl_equals_model`
 //! and `rtl_mismatches` fields of `metrics.json`.
 
+pub mod color;
 pub mod images;
 pub mod metrics;
 pub mod pictures;
@@ -80,6 +81,13 @@ pub const PICTURES: [&str; 4] = [
     "histogram.png",
 ];
 
+/// The colour images of a `--color` design, in the order [`Render::color_images`] gives them.
+pub const COLOR_IMAGES: [&str; 3] = [
+    "color_reference.png",
+    "color_model.png",
+    "color_error50.png",
+];
+
 /// A finished render: every inside pixel and its values from each source.
 #[derive(Clone, Debug)]
 pub struct Render {
@@ -93,6 +101,8 @@ pub struct Render {
     pub rtl: Option<Vec<u32>>,
     /// The model against the reference.
     pub metrics: Metrics,
+    /// A `--color` design's colour render ([`color`]).
+    pub color: Option<color::ColorRender>,
 }
 
 /// The pixel with the largest model error, as written to `metrics.json`.
@@ -120,6 +130,9 @@ struct Report<'a> {
     rtl_equals_model: Option<bool>,
     #[serde(skip_serializing_if = "Option::is_none")]
     rtl_mismatches: Option<usize>,
+    /// A `--color` design's colour figures (8-bit channels).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    color: Option<&'a color::ColorStats>,
     images: Vec<&'static str>,
     config: &'a Config,
     scene: &'a Scene,
@@ -157,6 +170,7 @@ pub fn render(
         }
     };
     let metrics = metrics(&model, &reference, cfg.map_max());
+    let color = color::render(cfg, scene, options.size, &pixels, &model);
     Ok(Render {
         cfg: cfg.clone(),
         scene: scene.clone(),
@@ -166,6 +180,7 @@ pub fn render(
         reference,
         rtl,
         metrics,
+        color,
     })
 }
 
@@ -201,6 +216,9 @@ impl Render {
             v.push("rtl.png");
         }
         v.extend(PICTURES);
+        if self.color.is_some() {
+            v.extend(COLOR_IMAGES);
+        }
         v
     }
 
@@ -258,6 +276,32 @@ impl Render {
         v
     }
 
+    /// A `--color` design's colour images: the reference, the design and their largest
+    /// channel difference times 50 (grey), by file name; empty for another design.
+    pub fn color_images(&self) -> Vec<(&'static str, image::RgbImage)> {
+        let Some(c) = &self.color else {
+            return Vec::new();
+        };
+        let n = self.options.size;
+        let err: Vec<[u32; 3]> = c
+            .model
+            .iter()
+            .zip(&c.reference)
+            .map(|(a, b)| {
+                let e = (0..3)
+                    .map(|k| images::error50(a[k], b[k]))
+                    .max()
+                    .unwrap_or(0);
+                [e as u32; 3]
+            })
+            .collect();
+        vec![
+            (COLOR_IMAGES[0], color::image(n, &self.pixels, &c.reference)),
+            (COLOR_IMAGES[1], color::image(n, &self.pixels, &c.model)),
+            (COLOR_IMAGES[2], color::image(n, &self.pixels, &err)),
+        ]
+    }
+
     /// `metrics.json`.
     pub fn metrics_json(&self) -> Result<String> {
         let mismatches = self.rtl_mismatches();
@@ -269,6 +313,7 @@ impl Render {
             worst: self.worst(),
             rtl_equals_model: mismatches.map(|n| n == 0),
             rtl_mismatches: mismatches,
+            color: self.color.as_ref().map(|c| &c.stats),
             images: self.image_names(),
             config: &self.cfg,
             scene: &self.scene,
@@ -282,7 +327,7 @@ impl Render {
         for (name, img) in self.images() {
             files.push((name, images::png(&img)?));
         }
-        for (name, img) in self.pictures()? {
+        for (name, img) in self.pictures()?.into_iter().chain(self.color_images()) {
             files.push((name, images::png_rgb(&img)?));
         }
         for (name, png) in &files {
@@ -304,6 +349,12 @@ impl Render {
             e = m.max_abs_error,
             r = m.rmse
         );
+        if let Some(c) = &self.color {
+            s.push_str(&format!(
+                "; colour ({}): max abs error {} LSB, RMSE {:.3} LSB of 8-bit channels",
+                c.stats.source, c.stats.max_abs_error, c.stats.rmse
+            ));
+        }
         if let Some(n) = self.rtl_mismatches() {
             s.push_str(&format!(
                 "; RTL {}",

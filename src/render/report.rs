@@ -65,6 +65,21 @@ pub fn html(r: &Render, files: &[(&str, Vec<u8>)]) -> Result<String> {
             ),
         ));
     }
+    if let Some(c) = &r.color {
+        rows.push((
+            "colour (8-bit channels)".to_string(),
+            format!(
+                "sample colour from the {}: largest error {} LSB, RMS {:.3} LSB",
+                if c.stats.source == "scene" {
+                    "scene"
+                } else {
+                    "ramp across the image"
+                },
+                c.stats.max_abs_error,
+                c.stats.rmse
+            ),
+        ));
+    }
     if let Some(n) = r.rtl_mismatches() {
         rows.push((
             "RTL against the model".to_string(),

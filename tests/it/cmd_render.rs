@@ -275,3 +275,84 @@ fn the_report_embeds_every_image_and_the_figures() {
     );
     assert!(page.starts_with("<!DOCTYPE html>") && page.ends_with("</html>\n"));
 }
+
+/// A `--color` design renders in colour: the reference, the design and their error as RGB
+/// images, the colour figures in metrics.json and on the page; a scene's colour is used
+/// uniformly.
+#[test]
+fn a_colour_design_renders_in_colour() {
+    let tmp = tempdir();
+    let out = tmp.path().join("sphere");
+    let o = run(&[
+        "render",
+        "--color",
+        "--size",
+        "64",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("colour (ramp): max abs error"));
+    for name in [
+        "color_reference.png",
+        "color_model.png",
+        "color_error50.png",
+    ] {
+        let img = image::open(out.join(name)).unwrap();
+        assert_eq!(img.color(), image::ColorType::Rgb8, "{name}");
+        assert_eq!((img.width(), img.height()), (64, 64), "{name}");
+    }
+    let model = image::open(out.join("color_model.png")).unwrap().to_rgb8();
+    assert!(model.pixels().any(|p| p[0] != p[2]), "a ramp of colours");
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(j["color"]["source"], "ramp");
+    let cmax = j["color"]["max_abs_error"].as_u64().unwrap();
+    assert!(
+        cmax > 0 && cmax <= j["max_abs_error"].as_u64().unwrap() + 1,
+        "{j}"
+    );
+    assert!(j["images"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|v| v == "color_model.png"));
+    let page = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(page.contains("<img alt=\"color_model.png\""));
+    assert!(
+        page.contains(&format!("largest error {cmax} LSB")),
+        "{page}"
+    );
+
+    // A scene's colour: every pixel of the sphere carries it.
+    let scene = tmp.path().join("orange.toml");
+    std::fs::write(
+        &scene,
+        format!("color = [1.0, 0.5, 0.0]\n{MATERIAL}[[light]]\ndirection = [0.0, 0.0, 1.0]\n"),
+    )
+    .unwrap();
+    let out = tmp.path().join("orange");
+    let o = run(&[
+        "render",
+        "--color",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--size",
+        "32",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let reference = image::open(out.join("color_reference.png"))
+        .unwrap()
+        .to_rgb8();
+    let lit: Vec<_> = reference.pixels().filter(|p| p[0] > 0).collect();
+    assert!(!lit.is_empty());
+    for p in lit {
+        assert_eq!(p[2], 0, "no blue in an orange scene");
+        assert!(p[1].abs_diff(p[0] / 2) <= 1, "green half of red: {p:?}");
+    }
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(j["color"]["source"], "scene");
+}
