@@ -165,8 +165,8 @@ mod tests {
         );
         let c = render(&cfg, &scene, size, &pixels, &model).unwrap();
         // Each channel is the multiplier's result on the model's intensity.
-        for k in 0..pixels.len() {
-            assert_eq!(c.model[k], color_mul::eval(&cfg, c.rgb[k], model[k]));
+        for ((out, &rgb), &i) in c.model.iter().zip(&c.rgb).zip(&model) {
+            assert_eq!(*out, color_mul::eval(&cfg, rgb, i));
         }
         assert_eq!(c.stats.source, "ramp");
         // The intensity's error, scaled by a colour of at most 255 over 2^M - 1, plus rounding.
