@@ -168,6 +168,8 @@ pub fn run(a: &FitArgs) -> Result<()> {
         if !*s && start.elapsed() > Duration::from_secs(1) {
             *s = true;
             bar.set_draw_target(ProgressDrawTarget::stderr());
+            // The clock moves while one candidate is synthesised or measured for long.
+            bar.enable_steady_tick(Duration::from_millis(250));
         }
     });
     bar.finish_and_clear();

@@ -240,13 +240,7 @@ impl Render {
     pub fn pictures(&self) -> Result<Vec<(&'static str, image::RgbImage)>> {
         let m = self.cfg.map_bits;
         let grey = move |v: u32| images::display8(v, m);
-        let s = self.picture_source(&grey);
-        Ok(vec![
-            (PICTURES[0], s.highlight()),
-            (PICTURES[1], s.error_signed()?),
-            (PICTURES[2], s.profile(self.cfg.map_max())?),
-            (PICTURES[3], s.histogram()?),
-        ])
+        self.picture_source(&grey).all(self.cfg.map_max())
     }
 
     /// The images by file name.

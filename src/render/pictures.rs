@@ -61,6 +61,18 @@ pub struct Source<'a> {
 }
 
 impl Source<'_> {
+    /// Every picture by file name, in the order of [`super::PICTURES`]; `max` is the largest
+    /// intensity (the profile's scale).
+    pub fn all(&self, max: u32) -> Result<Vec<(&'static str, RgbImage)>> {
+        let p = super::PICTURES;
+        Ok(vec![
+            (p[0], self.highlight()),
+            (p[1], self.error_signed()?),
+            (p[2], self.profile(max)?),
+            (p[3], self.histogram()?),
+        ])
+    }
+
     fn at(&self) -> Vec<Option<usize>> {
         let mut at = vec![None; (self.size * self.size) as usize];
         for (i, &(x, y, _)) in self.pixels.iter().enumerate() {

@@ -273,7 +273,41 @@ impl VolumeRender {
         if self.rtl.is_some() {
             v.push("rtl.png");
         }
+        if self.reference.is_some() {
+            v.extend(crate::render::PICTURES);
+        }
         v
+    }
+
+    /// The sphere render's pictures ([`crate::render::pictures`]) of the covered pixels: the
+    /// highlight around the worst pixel, the signed error with its scale, the profile through
+    /// the worst pixel's row and the error histogram; none without the reference.
+    pub fn pictures(&self) -> Result<Vec<(&'static str, image::RgbImage)>> {
+        let (Some(reference), Some(m)) = (&self.reference, &self.metrics) else {
+            return Ok(Vec::new());
+        };
+        let n = self.opts.size;
+        let inside: Vec<usize> = (0..self.covered.len())
+            .filter(|&i| self.covered[i])
+            .collect();
+        let pixels: Vec<crate::render::Pixel> = inside
+            .iter()
+            .map(|&i| ((i as u32 % n), (i as u32 / n), [0; 3]))
+            .collect();
+        let model: Vec<u32> = inside.iter().map(|&i| self.model[i]).collect();
+        let reference: Vec<u32> = inside.iter().map(|&i| reference[i]).collect();
+        let bits = self.cfg.map_bits;
+        let grey = move |v: u32| crate::render::images::display8(v, bits);
+        crate::render::pictures::Source {
+            size: n,
+            pixels: &pixels,
+            reference: &reference,
+            model: &model,
+            grey: &grey,
+            worst: m.worst_index,
+            range: m.max_abs_error.max(1),
+        }
+        .all(self.cfg.map_max())
     }
 
     /// The images by file name: intensities in [`VolumeRender::format`] (background black
@@ -329,6 +363,9 @@ impl VolumeRender {
     pub fn write(&self, out: &StagedDir) -> Result<()> {
         for (name, img) in self.images() {
             out.write_bytes(name, &picture::png(&img)?)?;
+        }
+        for (name, img) in self.pictures()? {
+            out.write_bytes(name, &picture::png(&DynamicImage::ImageRgb8(img))?)?;
         }
         out.write_text("metrics.json", &self.metrics_json()?)
     }

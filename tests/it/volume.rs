@@ -43,10 +43,25 @@ fn synthetic_writes_images_and_metrics() {
         [
             ".rmapgen-files",
             "error50.png",
+            "error_signed.png",
+            "highlight.png",
+            "histogram.png",
             "metrics.json",
             "model.png",
+            "profile.png",
             "reference.png"
         ]
+    );
+    // The sphere render's pictures, of the volume's covered pixels.
+    for name in ["highlight.png", "error_signed.png", "profile.png", "histogram.png"] {
+        let img = image::open(out.join(name)).unwrap();
+        assert_eq!(img.color(), image::ColorType::Rgb8, "{name}");
+    }
+    let highlight = image::open(out.join("highlight.png")).unwrap();
+    assert_eq!(
+        highlight.width(),
+        3 * rmapgen::render::pictures::CROP * rmapgen::render::pictures::ZOOM
+            + 2 * rmapgen::render::pictures::GAP
     );
     assert_eq!(
         crate::helpers::entries(tmp.path()),
