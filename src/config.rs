@@ -50,7 +50,7 @@ pub struct Config {
     pub prefix: String,
     /// AXI4-Stream ports: the design's top becomes `rmap_axis` (src/stages/rmap_axis), which
     /// wraps the handshake top in `s_axis_*` / `m_axis_*` ports with byte-aligned `tdata`
-    /// ([`crate::stages::rmap_axis::Packing`]) and passes `tlast` (and `tuser`, when
+    /// (`Packing`, in `stages::rmap_axis`) and passes `tlast` (and `tuser`, when
     /// [`Config::axis_user`] > 0) through with each sample. Needs `handshake` (refused
     /// without it, not implied: the configuration says what is built). Left out of the TOML
     /// and JSON when off, so a design without it is written as before it existed.

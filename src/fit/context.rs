@@ -1,6 +1,6 @@
 //! What measuring a candidate shares across a search ([`Ctx`]): the test image, the cache of
 //! maps ([`MapCache`]) and the pixels that rejected recent candidates ([`Killers`]). Separate
-//! because both the search and the lowest-error search ([`super::best`]) measure through it.
+//! because both the search and the lowest-error search (`fit::best`) measure through it.
 
 use super::measure::{self, Errors, Limits, TestImage};
 use super::outcome::Candidate;

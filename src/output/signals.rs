@@ -214,7 +214,7 @@ pub fn install_guardian() {
 /// Starts the guardian: this very binary (through `/proc/self/exe` if it was removed
 /// meanwhile) in a process group of its own (a Ctrl-C to the terminal's group
 /// leaves it to see the cleanup through), reading the registrations on its stdin. It is the
-/// one child not started through [`crate::toolchain::child`]: it must outlive rmapgen, and
+/// one child not started through `toolchain::child`: it must outlive rmapgen, and
 /// it exits by itself when rmapgen's end closes the pipe.
 fn start_guardian() -> Guardian {
     use std::os::unix::process::CommandExt;

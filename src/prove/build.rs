@@ -22,6 +22,9 @@ pub const FRONT_MODULE: &str = "prove_front";
 /// them all, which spreads its fixed cost (about a fifth of the time at one copy).
 pub const FRONT_LANES: usize = 4;
 
+/// A chunk of the front's check holds at least one group of the lanes (each call advances).
+const _: () = assert!(super::front::CHUNK >= FRONT_LANES);
+
 /// The front wrapper: `copies` copies of each module of [`FRONT`] as the design
 /// instantiates it (enable high, the gradient on its gradient ports), copy k's gradient on
 /// `g{x,y,z}<k>_i`, with `valid` its valid bit on `<name>_valid_o` (copy 0's: all move together) and its

@@ -53,7 +53,12 @@ fn synthetic_writes_images_and_metrics() {
         ]
     );
     // The sphere render's pictures, of the volume's covered pixels.
-    for name in ["highlight.png", "error_signed.png", "profile.png", "histogram.png"] {
+    for name in [
+        "highlight.png",
+        "error_signed.png",
+        "profile.png",
+        "histogram.png",
+    ] {
         let img = image::open(out.join(name)).unwrap();
         assert_eq!(img.color(), image::ColorType::Rgb8, "{name}");
     }

@@ -54,7 +54,7 @@ pub const POLISH_MOVES_PER_ENTRY: usize = 8;
 /// How close to the quadrant's bound the RMS polish may bring a pair's largest error (LSB):
 /// a pair already nearer keeps its error as its limit. 0.5 keeps `--map-fit minimax`'s peak
 /// on the sphere (9 LSB on the standard scene; at 0 it rose to 10, lsq's) and still lowers
-/// its RMS (48.15 → 48.49 dB). The fitted table's maps ([`super::table_fit`]) take 0: every
+/// its RMS (48.15 → 48.49 dB). The fitted table's maps (`map_fit::table_fit`) take 0: every
 /// pair up to the bound (standard scene, P4: 50.35 dB against 50.12 at 0.5).
 pub const RMS_SLACK: f64 = 0.5;
 
@@ -159,7 +159,7 @@ impl MinimaxFit {
     }
 
     /// The fit for given position ranges (a compensation table other than the atan one,
-    /// whose ranges its caller knows: [`super::table_fit`]).
+    /// whose ranges its caller knows: `map_fit::table_fit`).
     pub fn with_ranges(cfg: &Config, range: Vec<Option<(f64, f64)>>) -> MinimaxFit {
         assert_eq!(range.len(), cfg.pos_max() as usize + 1);
         MinimaxFit {

@@ -1,6 +1,6 @@
 //! The sideband delay line: q_o is d_i of DEPTH enabled clocks ago. The top instantiates one
 //! per sideband signal (axis and signs, read buffer, zero flag, colour), each DEPTH from its
-//! own [`crate::stages::rmap_top::SidebandDelays`].
+//! own `SidebandDelays` (in `stages::rmap_top`).
 
 use super::unit::{Head, Unit};
 use crate::config::Config;

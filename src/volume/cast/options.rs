@@ -45,7 +45,7 @@ pub enum CasterKind {
     /// apart; its cost grows with the image.
     #[default]
     Ray,
-    /// Shear-warp ([`crate::volume::shear`]): slices composited at voxel resolution, then
+    /// Shear-warp (`volume::shear`): slices composited at voxel resolution, then
     /// one 2D warp; its cost grows with the volume's visible voxels.
     ShearWarp,
 }
