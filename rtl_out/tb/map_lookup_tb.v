@@ -30,7 +30,7 @@
 
 module map_lookup_tb;
 
-  localparam LATENCY    = 4;  // rmapgen::rtl::latency of map_lookup
+  localparam LATENCY    = 4;  // the latency of map_lookup (its register plan, src/stages)
   localparam DEPTH      = 16;  // ring of vectors read but not yet checked (> LATENCY + 2)
   localparam DL         = 4;  // log2(DEPTH)
   localparam NFIELDS    = 13;

@@ -33,7 +33,7 @@
 
 module {= t.module =}_tb;
 
-  localparam LATENCY    = {= t.latency =};  // rmapgen::rtl::latency of {= t.module =}
+  localparam LATENCY    = {= t.latency =};  // the latency of {= t.module =} (its register plan, src/stages)
   localparam DEPTH      = {= t.depth =};  // ring of vectors read but not yet checked (> LATENCY + 2)
   localparam DL         = {= t.depth_bits =};  // log2(DEPTH)
   localparam NFIELDS    = {= t.fields.len() =};

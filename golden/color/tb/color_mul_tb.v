@@ -24,7 +24,7 @@
 
 module color_mul_tb;
 
-  localparam LATENCY    = 5;  // rmapgen::rtl::latency of color_mul
+  localparam LATENCY    = 5;  // the latency of color_mul (its register plan, src/stages)
   localparam DEPTH      = 16;  // ring of vectors read but not yet checked (> LATENCY + 2)
   localparam DL         = 4;  // log2(DEPTH)
   localparam NFIELDS    = 7;

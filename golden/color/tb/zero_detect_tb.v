@@ -24,7 +24,7 @@
 
 module zero_detect_tb;
 
-  localparam LATENCY    = 1;  // rmapgen::rtl::latency of zero_detect
+  localparam LATENCY    = 1;  // the latency of zero_detect (its register plan, src/stages)
   localparam DEPTH      = 16;  // ring of vectors read but not yet checked (> LATENCY + 2)
   localparam DL         = 4;  // log2(DEPTH)
   localparam NFIELDS    = 4;

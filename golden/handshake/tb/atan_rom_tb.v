@@ -26,7 +26,7 @@
 
 module atan_rom_tb;
 
-  localparam LATENCY    = 2;  // rmapgen::rtl::latency of atan_rom
+  localparam LATENCY    = 2;  // the latency of atan_rom (its register plan, src/stages)
   localparam DEPTH      = 16;  // ring of vectors read but not yet checked (> LATENCY + 2)
   localparam DL         = 4;  // log2(DEPTH)
   localparam NFIELDS    = 4;

@@ -24,7 +24,7 @@
 
 module interpolate_tb;
 
-  localparam LATENCY    = 7;  // rmapgen::rtl::latency of interpolate
+  localparam LATENCY    = 7;  // the latency of interpolate (its register plan, src/stages)
   localparam DEPTH      = 16;  // ring of vectors read but not yet checked (> LATENCY + 2)
   localparam DL         = 4;  // log2(DEPTH)
   localparam NFIELDS    = 7;

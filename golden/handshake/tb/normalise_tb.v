@@ -27,7 +27,7 @@
 
 module normalise_tb;
 
-  localparam LATENCY    = 6;  // rmapgen::rtl::latency of normalise
+  localparam LATENCY    = 6;  // the latency of normalise (its register plan, src/stages)
   localparam DEPTH      = 16;  // ring of vectors read but not yet checked (> LATENCY + 2)
   localparam DL         = 4;  // log2(DEPTH)
   localparam NFIELDS    = 5;

@@ -30,7 +30,7 @@
 
 module rmap_top_tb;
 
-  localparam LATENCY    = 24;  // rmapgen::rtl::latency of rmap_top
+  localparam LATENCY    = 24;  // the latency of rmap_top (its register plan, src/stages)
   localparam DEPTH      = 32;  // ring of vectors read but not yet checked (> LATENCY + 2)
   localparam DL         = 5;  // log2(DEPTH)
   localparam NFIELDS    = 6;

@@ -26,7 +26,7 @@
 
 module sort_shift_tb;
 
-  localparam LATENCY    = 4;  // rmapgen::rtl::latency of sort_shift
+  localparam LATENCY    = 4;  // the latency of sort_shift (its register plan, src/stages)
   localparam DEPTH      = 16;  // ring of vectors read but not yet checked (> LATENCY + 2)
   localparam DL         = 4;  // log2(DEPTH)
   localparam NFIELDS    = 10;
