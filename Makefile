@@ -383,9 +383,9 @@ mutants-default:
 
 # ---- cargo-mutants over the Rust that issues verdicts (issue 31, part 2; figures in
 # docs/VERIFICATION.md): `make rust-mutants RUST_MUTANTS_GROUP=G` with G one of
-#   engines  the multiplier proof and its engines src/rtl/{mult_proof,algebra,netlist}.rs
-#   aig      the and-inverter graphs src/rtl/aig.rs (the multiplier proof's and prove's gates)
-#   prove    src/prove (parts, shards, reports, --merge)
+#   engines  the multiplier proof and its engines src/prove/mult/{mod,algebra,netlist}.rs
+#   aig      the and-inverter graphs src/prove/aig.rs (the multiplier proof's and prove's gates)
+#   prove    src/prove but its engines (parts, shards, reports, --merge)
 #   output   src/output (what rmapgen writes and removes)
 #   model    src/model (the golden model)
 # Each mutant is built in the `mutants` profile (opt-level 1: a 3-6 s rebuild, against 23 s
@@ -400,11 +400,11 @@ RUST_MUTANTS_SHARD ?= 0/1
 RUST_MUTANTS_ARGS  ?=
 # The multiplier proof's engines are used by `prove-mult` alone (the tests of mult_proof, 37 s
 # with the unit tests on 2 cores); aig.rs also by prove's gate-level front (129 s with prove's).
-RUST_MUTANTS_FILES_engines := -f src/rtl/mult_proof.rs -f src/rtl/algebra.rs -f src/rtl/netlist.rs
+RUST_MUTANTS_FILES_engines := -f src/prove/mult/mod.rs -f src/prove/mult/algebra.rs -f src/prove/mult/netlist.rs
 RUST_MUTANTS_TESTS_engines := mult_proof
-RUST_MUTANTS_FILES_aig     := -f src/rtl/aig.rs
+RUST_MUTANTS_FILES_aig     := -f src/prove/aig.rs
 RUST_MUTANTS_TESTS_aig     := mult_proof|prove
-RUST_MUTANTS_FILES_prove   := -f 'src/prove/**'
+RUST_MUTANTS_FILES_prove   := -f 'src/prove/**' -e 'src/prove/mult/**' -e src/prove/aig.rs
 RUST_MUTANTS_TESTS_prove   := prove|errors
 RUST_MUTANTS_FILES_output  := -f 'src/output/**'
 RUST_MUTANTS_TESTS_output  := output_safety|nothing_left|init_files|stdout
@@ -422,7 +422,7 @@ rust-mutants:
 	  $(RUST_MUTANTS_ARGS) \
 	  -- -E 'kind(lib) | (binary(it) & test(/^($(RUST_MUTANTS_TESTS_$(RUST_MUTANTS_GROUP)))::/))'
 
-# ---- Multipliers (rmapgen prove-mult, src/rtl/mult_proof.rs): every adder tree of a
+# ---- Multipliers (rmapgen prove-mult, src/prove/mult/mod.rs): every adder tree of a
 # generated design equals the product its plan states (a * b + c) on every input. The
 # default design ($(OUT), 5 trees) under engine auto (every input evaluated, ~10 s), then
 # every row of the parameter grid (src/grid.rs, 36 rows, 249 trees, generated into

@@ -1,7 +1,7 @@
 //! `rmapgen prove-mult`: the formal proof that every adder tree of a generated design
 //! equals the plain product its plan says it builds (`a * b + c`), on every input, with
 //! Yosys's SAT solver or by evaluating the cut miter on every input, on the generated modules
-//! ([`crate::rtl::mult_proof`]).
+//! ([`crate::prove::mult`]).
 //!
 //! Exit 0 when every tree is proved, 1 when any is not (each failure names the stage, the
 //! tree and the first failing case), 2 for bad input.
@@ -12,7 +12,7 @@ use super::sim::{generate_row, selected_rows};
 use crate::design_dir::DesignDir;
 use crate::grid::GridRow;
 use crate::output::{absolute, Policy, StagedDir};
-use crate::rtl::mult_proof::{self, Engine, EngineChoice, Job};
+use crate::prove::mult::{self as mult_proof, Engine, EngineChoice, Job};
 use crate::toolchain::{self, yosys};
 use anyhow::{bail, Context, Result};
 use clap::Args;

@@ -26,7 +26,7 @@ use super::{build, Failures, Progress};
 use crate::config::Config;
 use crate::design_dir::DesignDir;
 use crate::model::{sort_shift, zero_detect};
-use crate::rtl::aig::{self, Aig};
+use crate::prove::aig::{self, Aig};
 use crate::stages;
 use crate::toolchain::yosys;
 use crate::vectors::inputs::dec_grad;
@@ -84,8 +84,8 @@ pub fn build(d: &DesignDir, build: &Path) -> Result<GateFront> {
     }
     let wrapper = dir.join(format!("{}.v", build::FRONT_MODULE));
     crate::disk::write(&wrapper, build::front_wrapper(&d.config, 1, false))?;
-    let transparent = dir.join(crate::rtl::mult_proof::TRANSPARENT_FILE);
-    crate::disk::write(&transparent, crate::rtl::mult_proof::TRANSPARENT)?;
+    let transparent = dir.join(crate::prove::mult::TRANSPARENT_FILE);
+    crate::disk::write(&transparent, crate::prove::mult::TRANSPARENT)?;
     let mut files: Vec<String> = FRONT
         .iter()
         .map(|u| crate::toolchain::quoted(&d.path().join(u.file(&d.config)).to_string_lossy()))
@@ -94,7 +94,7 @@ pub fn build(d: &DesignDir, build: &Path) -> Result<GateFront> {
     let (aag, map) = yosys::aig(
         build::FRONT_MODULE,
         &files,
-        crate::rtl::mult_proof::TRANSPARENT_FILE,
+        crate::prove::mult::TRANSPARENT_FILE,
         &dir,
     )?;
     let read = |p: &Path| std::fs::read_to_string(p).with_context(|| format!("{}", p.display()));

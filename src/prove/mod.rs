@@ -16,10 +16,12 @@
 //! one shard of N ([`Shard`]): each part's inputs are split into N contiguous ranges, and
 //! [`report::merge`] combines the shards' reports into one verdict.
 
+pub mod aig;
 pub mod build;
 pub mod ffi;
 pub mod front;
 pub mod gates;
+pub mod mult;
 pub mod report;
 pub mod states;
 pub mod structure;

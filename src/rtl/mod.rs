@@ -4,13 +4,9 @@
 //! in code, and everything here walks them.
 
 pub mod adder_tree;
-pub mod aig;
-pub mod algebra;
 pub mod fpga;
 pub mod infer;
 pub mod manifest;
-pub mod mult_proof;
-pub mod netlist;
 pub mod package;
 pub mod ports;
 pub mod tb;

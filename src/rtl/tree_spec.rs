@@ -1,6 +1,6 @@
 //! What an adder tree stands for, stated by the plan that builds it: a sum of products
 //! `a * b << shift` plus a rounding constant, over the tree's own input signals. The formal
-//! proof of the multipliers (`rmapgen prove-mult`, `rtl::mult_proof`) reads this and
+//! proof of the multipliers (`rmapgen prove-mult`, `prove::mult`) reads this and
 //! writes it as plain Verilog arithmetic (`a * b + c`), never as the tree's terms or nodes,
 //! so a term left out or a node built wrong cannot hide in the specification.
 

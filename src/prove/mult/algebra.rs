@@ -605,7 +605,7 @@ mod tests {
     /// Widths outside 1..=64 are refused (64 is taken); and the half adders' exclusions
     /// drop the terms that vanish as they appear, so the polynomial of the 4 x 3 product
     /// never holds more than 24 terms (without the rule it holds more: the rule is what
-    /// keeps inferred multipliers tractable, src/rtl/algebra.rs `Poly::vanishes`).
+    /// keeps inferred multipliers tractable, src/prove/mult/algebra.rs `Poly::vanishes`).
     #[test]
     fn widths_are_bounded_and_vanishing_terms_are_dropped_early() {
         let c = products(None);

@@ -1,7 +1,7 @@
 //! A gate-level netlist read from Yosys's `write_json` after `techmap`: the simple gates of
 //! Yosys's internal library (`$_AND_`, `$_XOR_`, `$_MUX_`, ...) between the module's input
 //! ports and any named net. The algebraic engine of `rmapgen prove-mult`
-//! (`rtl::algebra`) reads its miters this way rather than as AIGER, because the JSON
+//! (`mult::algebra`) reads its miters this way rather than as AIGER, because the JSON
 //! names every bit of every public wire, constants included: Yosys 0.23's AIGER map leaves
 //! constant outputs out and numbers two outputs on one net with one index.
 //!

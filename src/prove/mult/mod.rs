@@ -14,17 +14,20 @@
 //!   ([`crate::rtl::tree_spec::Split`]); markers in the log (`rmapgen-mult: tree M T`)
 //!   attribute every result to its tree;
 //! - exhaustive: the miter is written as an and-inverter graph and evaluated on every input
-//!   ([`super::aig`]), case by case;
-//! - algebra: the miter is written as a gate netlist ([`super::netlist`]) and the sum and the
-//!   specification are shown equal as polynomials ([`super::algebra`]), case by case.
+//!   ([`crate::prove::aig`]), case by case;
+//! - algebra: the miter is written as a gate netlist ([`netlist`]) and the sum and the
+//!   specification are shown equal as polynomials ([`algebra`]), case by case.
 
-use super::aig::{self, Aig};
-use super::algebra::{self, Verdict};
-use super::netlist::Netlist;
-use super::tree_spec::{Factor, TreeSpec};
+pub mod algebra;
+pub mod netlist;
+
 use crate::config::Config;
+use crate::prove::aig::{self, Aig};
+use crate::rtl::tree_spec::{Factor, TreeSpec};
 use crate::stages;
+use algebra::Verdict;
 use anyhow::{bail, Result};
+use netlist::Netlist;
 use rayon::prelude::*;
 
 /// How the trees are proved (`prove-mult --engine`).
