@@ -162,7 +162,7 @@ sim-all: sim-gen
 sim-matrix: build
 	$(SIM) --matrix $(if $(MATRIX_ROWS),--row $(MATRIX_ROWS)) --icarus --verilator --stream $(SIM_STREAM) $(MATRIX_OUT)
 
-# ---- Design (src/rtl, templates/): the default design into $(OUT); Verilator lint of its
+# ---- Design (src/emit, src/stages, templates/): the default design into $(OUT); Verilator lint of its
 # .v files (rmapgen lint: testbenches excluded; any warning fails); Yosys synthesis of rmap_top
 # for the iCE40 (rmapgen synth: any latch fails; prints cells, memory bits and SB_RAM40_4K;
 # logs in $(SYNTH_DIR)).
@@ -439,7 +439,7 @@ formal-mult: build
 	YOSYS=$(YOSYS) $(RMAPGEN) prove-mult $(OUT) --logs $(MULT_BUILD)/$(notdir $(OUT))
 	YOSYS=$(YOSYS) $(RMAPGEN) prove-mult $(MULT_GRID) --matrix --engine algebra --logs $(MULT_BUILD)/grid
 
-# ---- FPGA (src/rtl/fpga.rs): Yosys synth_ice40 and nextpnr-ice40 on the default design built
+# ---- FPGA (src/flow/fpga.rs): Yosys synth_ice40 and nextpnr-ice40 on the default design built
 # for the iCE40 (--target ice40; rtl_out/ is the portable --target generic): post-route Fmax,
 # logic cells, block RAMs, critical path; fails if a ROM or map bank is not in block RAM (a
 # missed timing target is only reported). fpga-check also fails below $(FPGA_FREQ) MHz.

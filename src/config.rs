@@ -123,12 +123,12 @@ impl CompTable {
 #[serde(rename_all = "lowercase")]
 pub enum Mult {
     /// Adder trees of partial products, one LUT level and one carry chain per level
-    /// (src/rtl/adder_tree.rs): for devices without multipliers (iCE40 HX).
+    /// (src/hdl/adder_tree.rs): for devices without multipliers (iCE40 HX).
     #[default]
     Tree,
     /// Plain `a * b` products with explicit widths, registered in front of the sum so that a
     /// DSP block (ECP5 MULT18X18D, iCE40 UltraPlus SB_MAC16) absorbs the product and its
-    /// register (src/rtl/infer.rs).
+    /// register (src/hdl/infer.rs).
     Infer,
 }
 
@@ -548,7 +548,7 @@ impl Config {
         (1 << self.map_bits) - 1
     }
 
-    // Widths and constants of the generated RTL (src/rtl, templates/). Each is defined here
+    // Widths and constants of the generated RTL (src/stages, src/hdl, templates/). Each is defined here
     // once; the templates only name them.
 
     /// Width of sort & shift's left-shift count, which runs 0..grad_bits-1.

@@ -3,7 +3,7 @@
 //! `manifest.json` lists, and the testbenches in its `tb/`.
 
 use crate::config::Config;
-use crate::rtl::manifest::{self, VectorsInfo};
+use crate::emit::manifest::{self, VectorsInfo};
 use crate::scene::Scene;
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
@@ -120,14 +120,14 @@ impl DesignDir {
     /// The file parameters of testbench `tb` (`<module>_tb`) set to absolute paths in this
     /// directory, and its vector file: what a simulator run from elsewhere needs.
     pub fn testbench_files(&self, tb: &str) -> Result<(Vec<(String, String)>, PathBuf)> {
-        let (files, vectors) = crate::rtl::tb::testbench_files(&self.config, tb)?;
+        let (files, vectors) = crate::emit::tb::testbench_files(&self.config, tb)?;
         let params = files.into_iter().map(|f| (f.param, f.default)).collect();
         Ok((self.absolute(params)?, self.path.join(vectors)))
     }
 
     /// The top's init-file parameters set to absolute paths in this directory.
     pub fn top_files(&self) -> Result<Vec<(String, String)>> {
-        let params = crate::rtl::tb::top_files(&self.config)
+        let params = crate::emit::tb::top_files(&self.config)
             .into_iter()
             .map(|f| (f.param, f.default))
             .collect();

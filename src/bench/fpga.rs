@@ -4,7 +4,7 @@
 //! step that runs outside tools.
 
 use crate::config::Config;
-use crate::rtl::fpga::{self, Family, FpgaReport};
+use crate::flow::fpga::{self, Family, FpgaReport};
 use anyhow::Result;
 use rayon::prelude::*;
 

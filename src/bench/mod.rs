@@ -21,13 +21,13 @@ pub mod throughput;
 mod timing;
 
 use crate::config::Config;
+use crate::flow::fpga::Family;
 use crate::model::fast::FastShader;
 use crate::model::map_fit::{self, LsqFit, MapFit};
 use crate::model::Model;
 use crate::output::StagedDir;
 use crate::reference::Reference;
 use crate::render::{self, metrics, sphere_gradients};
-use crate::rtl::fpga::Family;
 use crate::scene::Scene;
 use anyhow::Result;
 use fpga::{figures, Flow};

@@ -1,7 +1,7 @@
 //! One measured row of the bench ([`Row`]): a design on a scene with one map fit, its error,
 //! speed and cost. Separate because the Pareto marking, the tables and the plots all read it.
 
-use crate::rtl::fpga::Family;
+use crate::flow::fpga::Family;
 use serde::Serialize;
 
 /// One measured row.

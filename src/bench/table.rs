@@ -6,7 +6,7 @@
 //! Fmax: DSP blocks and samples/s = lanes x Fmax.
 
 use super::row::Row;
-use crate::rtl::fpga::Family;
+use crate::flow::fpga::Family;
 
 /// The family and lane count of the rows' FPGA columns (every row of a run has the same),
 /// and whether they are the default's.

@@ -23,8 +23,8 @@
 //! hours) still leaves the rows it finished (see [`run`]).
 
 use crate::config::{Config, Mult, Target};
+use crate::flow::fpga::{self, Family, FpgaReport};
 use crate::output::StagedDir;
-use crate::rtl::fpga::{self, Family, FpgaReport};
 use anyhow::{Context, Result};
 use serde::Serialize;
 use std::path::Path;
@@ -160,9 +160,9 @@ fn configuration(
     let tmp = crate::output::Scratch::new()?;
     let rtl = StagedDir::new(&tmp.path().join("rtl"), &Default::default())?;
     let design = crate::design::Design::standard(cfg)?;
-    crate::rtl::write_design(&design, &rtl, None)?;
+    crate::emit::write_design(&design, &rtl, None)?;
     let dir = rtl.commit()?;
-    let memories = crate::rtl::manifest::memories(cfg);
+    let memories = crate::emit::manifest::memories(cfg);
     let memory_bits: u64 = memories.iter().map(|m| m.bits).sum();
     let mut opts = options(family, sweep.freq_mhz);
     opts.logs = Some(logs.to_path_buf());

@@ -60,7 +60,7 @@ pub struct BenchArgs {
     /// family each configuration is placed on (its default part: iCE40 HX8K, ECP5-85F)
     /// [default: ice40].
     #[arg(long, value_enum, value_delimiter = ',')]
-    pub family: Vec<crate::rtl::fpga::Family>,
+    pub family: Vec<crate::flow::fpga::Family>,
     /// Multiplier styles of the throughput sweep [default: tree,infer].
     #[arg(long, value_enum, value_delimiter = ',', requires = "throughput")]
     pub mult: Vec<crate::config::Mult>,

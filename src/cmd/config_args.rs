@@ -215,7 +215,7 @@ impl ConfigArgs {
                 "{}: {} (its {}); a command given a design takes the design's configuration: drop the contradicting flags, or generate the design again",
                 dir.display(),
                 diffs.join("; "),
-                crate::rtl::manifest::FILE
+                crate::emit::manifest::FILE
             );
         }
         Ok(design.clone())

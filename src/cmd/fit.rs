@@ -5,10 +5,10 @@ use super::generate;
 use super::map_args::MapArgs;
 use super::parse;
 use crate::config::Config;
+use crate::emit::manifest::VectorsInfo;
 use crate::fit::outcome::Outcome;
 use crate::fit::target::Target;
 use crate::fit::{self, CostKind, Options};
-use crate::rtl::manifest::VectorsInfo;
 use anyhow::Result;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -119,7 +119,7 @@ pub fn run(a: &FitArgs) -> Result<()> {
     // The part is checked (nextpnr knows the device and package) before the search.
     let part = a.part.options()?;
     if a.part.given() {
-        crate::rtl::fpga::check(None, &part)?;
+        crate::flow::fpga::check(None, &part)?;
     }
     let max_size = crate::render::MAX_SIZE;
     anyhow::ensure!(
@@ -203,7 +203,7 @@ pub fn run(a: &FitArgs) -> Result<()> {
         match d.cost {
             CostKind::Bits => "ROM + map bits".to_string(),
             CostKind::Cells => match d.family {
-                crate::rtl::fpga::Family::Ice40 => "Yosys cells".to_string(),
+                crate::flow::fpga::Family::Ice40 => "Yosys cells".to_string(),
                 f => format!("Yosys cells ({} synthesis)", f.title()),
             },
         }

@@ -5,8 +5,8 @@
 //! reported, not an error.
 
 use super::config_args::ConfigArgs;
+use crate::flow::fpga::{self, Family, Options};
 use crate::output::StagedDir;
-use crate::rtl::fpga::{self, Family, Options};
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;

@@ -7,10 +7,10 @@ use super::map_args::MapArgs;
 use crate::config::Config;
 use crate::design::Design;
 use crate::design_dir::DesignDir;
+use crate::emit::manifest::VectorsInfo;
+use crate::emit::Manifest;
+use crate::emit::{self, tb};
 use crate::output::{Policy, StagedDir};
-use crate::rtl::manifest::VectorsInfo;
-use crate::rtl::Manifest;
-use crate::rtl::{self, tb};
 use crate::scene::Scene;
 use crate::vectors;
 use anyhow::Result;
@@ -97,7 +97,7 @@ pub fn write_dir(
     // Built once: the design's init files and the vectors see the same maps, this scene's
     // and the alternate scene's that testbenches load through the host port.
     let design = Design::for_scene(cfg, scene)?;
-    let manifest = rtl::write_design(&design, &out, Some(vectors))?;
+    let manifest = emit::write_design(&design, &out, Some(vectors))?;
     vectors::write_all(&design, &out, vectors.random, vectors.seed)?;
     tb::write_all(&design, &out)?;
     for (name, text) in extra {

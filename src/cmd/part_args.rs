@@ -1,7 +1,7 @@
 //! `--family`, `--device` and `--package`: the FPGA part, as `fpga` places on it and `fit`
 //! fits to it.
 
-use crate::rtl::fpga::{Family, Options};
+use crate::flow::fpga::{Family, Options};
 use crate::toolchain::nextpnr;
 use anyhow::Result;
 use clap::Args;

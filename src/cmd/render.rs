@@ -46,7 +46,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let policy = a.force.policy(&[a.cfg.config.as_deref(), a.map.input()]);
     let out = StagedDir::new(&a.out, &policy)?;
     let rtl = if a.rtl {
-        Some(crate::rtl::verilated::VerilatedTop::build(&cfg, &scene)?)
+        Some(crate::sim::verilated::VerilatedTop::build(&cfg, &scene)?)
     } else {
         None
     };

@@ -5,8 +5,8 @@ use super::generate;
 use super::map_args::MapArgs;
 use crate::design::Design;
 use crate::design_dir::DesignDir;
+use crate::emit::manifest;
 use crate::output::StagedDir;
-use crate::rtl::manifest;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -44,7 +44,7 @@ pub fn run(a: &RomsArgs) -> Result<()> {
     let target = a.out.as_ref().context("--out or --update")?;
     let policy = a.force.policy(&[a.cfg.config.as_deref(), a.map.input()]);
     let out = StagedDir::new(target, &policy)?;
-    for (name, text) in crate::rtl::hex_files(&Design::for_scene(&cfg, &scene)?) {
+    for (name, text) in crate::emit::hex_files(&Design::for_scene(&cfg, &scene)?) {
         out.write_text(&name, &text)?;
     }
     let p = out.commit()?;

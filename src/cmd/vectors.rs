@@ -45,7 +45,7 @@ pub fn run(a: &VectorsArgs) -> Result<()> {
     // With --maps DIR of a generated design (it has a manifest) the design's configuration,
     // which the flags may only agree with; a directory of map files alone takes the flags'.
     let cfg = match &a.maps {
-        Some(dir) if dir.join(crate::rtl::manifest::FILE).is_file() => {
+        Some(dir) if dir.join(crate::emit::manifest::FILE).is_file() => {
             a.cfg.for_design(&DesignDir::open(dir)?.config, dir)?
         }
         _ => a.cfg.resolve()?,

@@ -531,7 +531,7 @@ pub fn run(a: &VolumeArgs) -> Result<()> {
     let p = Prepared::try_new(&vol, cfg.grad_bits, opts.brick)?;
     let prepare_ms = t.elapsed().as_secs_f64() * 1e3;
     let rtl = if a.rtl {
-        Some(crate::rtl::verilated::VerilatedTop::build(
+        Some(crate::sim::verilated::VerilatedTop::build(
             &cfg,
             &vol.shading_scene(&scene),
         )?)

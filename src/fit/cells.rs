@@ -3,7 +3,7 @@
 //! the search's one step that runs outside tools.
 
 use crate::config::Config;
-use crate::rtl::fpga;
+use crate::flow::fpga;
 use crate::scene::Scene;
 use anyhow::{Context, Result};
 
@@ -26,7 +26,7 @@ pub fn on_part(cfg: &Config, scene: &Scene, part: &fpga::Options, check: bool) -
     let cfg = &cfg.for_target(crate::config::Target::Ice40);
     let tmp = crate::output::Scratch::new()?;
     let out = crate::output::StagedDir::new(&tmp.path().join("design"), &Default::default())?;
-    crate::rtl::write_design(&crate::design::Design::for_scene(cfg, scene)?, &out, None)?;
+    crate::emit::write_design(&crate::design::Design::for_scene(cfg, scene)?, &out, None)?;
     let dir = out.commit()?;
     let what = || format!("{} synthesis of {}", part.family.title(), cfg.summary());
     let syn = fpga::synthesise_for(&dir, part, check).with_context(what)?;

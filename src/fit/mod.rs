@@ -52,7 +52,7 @@ pub struct Options {
     pub cost: CostKind,
     /// The part: its family's Yosys synthesis counts the cells (cost in cells); with
     /// `check_part`, the choice and the runners-up must fit it.
-    pub part: crate::rtl::fpga::Options,
+    pub part: crate::flow::fpga::Options,
     /// Whether a passing candidate must fit `part` ([`cells::on_part`] packs it) to be chosen.
     pub check_part: bool,
     /// Passing candidates reported after the choice.

@@ -29,7 +29,7 @@ pub struct Candidate {
 /// The part a search had to fit, and the passing candidates it turned away.
 #[derive(Clone, Debug, Serialize)]
 pub struct Part {
-    pub family: crate::rtl::fpga::Family,
+    pub family: crate::flow::fpga::Family,
     pub device: String,
     pub package: String,
     /// Passing candidates synthesised and packed that do not fit.
@@ -46,7 +46,7 @@ pub struct Decision {
     /// The family whose synthesis counted the cells; left out of fit.json for the iCE40 (the
     /// default), so a default fit writes what it wrote before the flag.
     #[serde(skip_serializing_if = "is_ice40")]
-    pub family: crate::rtl::fpga::Family,
+    pub family: crate::flow::fpga::Family,
     /// With `--family`/`--device`: the part every chosen or listed candidate fits.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub part: Option<Part>,
@@ -71,8 +71,8 @@ pub struct Decision {
     pub seconds: f64,
 }
 
-fn is_ice40(f: &crate::rtl::fpga::Family) -> bool {
-    *f == crate::rtl::fpga::Family::Ice40
+fn is_ice40(f: &crate::flow::fpga::Family) -> bool {
+    *f == crate::flow::fpga::Family::Ice40
 }
 
 /// The lowest error reachable, when nothing meets the target.

@@ -131,9 +131,9 @@ pub struct Report {
 pub fn read_files(d: &DesignDir) -> Vec<String> {
     let cfg = &d.config;
     let mut names: Vec<String> = d.file_names().to_vec();
-    names.push(crate::rtl::manifest::FILE.to_string());
+    names.push(crate::emit::manifest::FILE.to_string());
     names.extend(
-        crate::rtl::tb::top_files(cfg)
+        crate::emit::tb::top_files(cfg)
             .into_iter()
             .map(|f| f.default),
     );

@@ -21,6 +21,8 @@
 //! testbench that ran nothing. A failure is reported with the command and the last lines of
 //! its output, and the other runs go on; [`Outcome::failed`] lists them.
 
+pub mod verilated;
+
 use crate::design_dir::DesignDir;
 use crate::model::map_set::{buffer_names, map_file};
 use crate::stages::TOP;

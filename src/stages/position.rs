@@ -4,9 +4,9 @@
 //! arithmetic and register plans differ.
 
 use crate::config::Config;
+use crate::hdl::ports::{i, o, stage_head, Port};
 use crate::model::Model;
 use crate::rng::SplitMix64;
-use crate::rtl::ports::{i, o, stage_head, Port};
 use crate::vectors::field::Field;
 
 pub fn ports(cfg: &Config) -> Vec<Port> {

@@ -1,4 +1,4 @@
-//! What a testbench template reads ([`TbData`]): built by `rtl::tb` from a stage's ports,
+//! What a testbench template reads ([`TbData`]): built by `emit::tb` from a stage's ports,
 //! fields and latency, rendered by the stage's own `<name>_tb.v` (which extends
 //! `templates/tb/base_tb.v`).
 

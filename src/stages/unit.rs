@@ -8,9 +8,9 @@
 //! folder matches on stage names.
 
 use crate::config::Config;
+use crate::hdl::ports::{self, Port};
 use crate::model::{MapSet, Model};
 use crate::rng::SplitMix64;
-use crate::rtl::ports::{self, Port};
 use crate::stages::testbench::TbData;
 use crate::vectors::field::{Dir, Field};
 use anyhow::Result;
@@ -255,7 +255,7 @@ pub trait Unit: Sync {
 
     /// What each of its adder trees computes, from its plan: the specifications the formal
     /// proof of the multipliers checks the generated trees against (`rmapgen prove-mult`).
-    fn trees(&self, _cfg: &Config) -> Vec<crate::rtl::tree_spec::TreeSpec> {
+    fn trees(&self, _cfg: &Config) -> Vec<crate::hdl::tree_spec::TreeSpec> {
         Vec::new()
     }
 }

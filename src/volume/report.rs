@@ -484,8 +484,12 @@ mod tests {
         assert_eq!(j["rtl_equals_model"], true);
         assert_eq!(j["scene"]["transfer"]["points"][1][0], 1900.0);
         let imgs = r.images();
+        let pictures = r.pictures().unwrap();
         assert_eq!(
-            imgs.iter().map(|i| i.0).collect::<Vec<_>>(),
+            imgs.iter()
+                .map(|i| i.0)
+                .chain(pictures.iter().map(|p| p.0))
+                .collect::<Vec<_>>(),
             r.image_names()
         );
         // Background stays black; the error image is 50 per LSB.

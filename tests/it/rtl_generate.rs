@@ -1,4 +1,4 @@
-//! `rmapgen generate` and the Verilog generator (src/rtl, templates/): the committed rtl_out/
+//! `rmapgen generate` and the Verilog generator (src/emit, src/stages, templates/): the committed rtl_out/
 //! is exactly what the default configuration generates; stages a configuration switches off
 //! are absent; output is byte-reproducible; errors exit 2 and leave nothing behind; the
 //! manifest agrees with the files; and the design lints clean (Verilator -Wall), compiles

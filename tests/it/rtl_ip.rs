@@ -1,4 +1,4 @@
-//! The generated design as IP a team adopts (src/stages/, src/rtl/fpga.rs, package.rs): every
+//! The generated design as IP a team adopts (src/stages/, src/flow/fpga.rs, package.rs): every
 //! pipeline depth passes every testbench; the valid/ready handshake passes under random
 //! backpressure and its testbench catches a broken queue; the FuseSoC core and README list
 //! what the directory holds; +vcd writes a waveform; the iCE40 flow reports a missed target as
@@ -11,8 +11,8 @@
 use crate::hdl::{self, config_of, icarus, last_line, require, sabotage, vvp};
 use crate::helpers;
 use rmapgen::config::Config;
-use rmapgen::rtl::{self, fpga};
 use rmapgen::stages::{self, rmap_top, TOP};
+use rmapgen::{emit, flow::fpga};
 use std::path::Path;
 
 /// Generates a design into `dir` with `flags` and 300 random vectors per stage.
@@ -129,10 +129,10 @@ fn core_and_readme_describe_the_directory() {
         // Named after the top and the configuration, so the two cores differ.
         assert!(core.contains(&format!(
             "name: rmapgen:ip:rmap_top_{}:{}\n",
-            rtl::package::config_hash(&cfg),
+            emit::package::config_hash(&cfg),
             env!("CARGO_PKG_VERSION")
         )));
-        names.push(rtl::package::vlnv(&cfg));
+        names.push(emit::package::vlnv(&cfg));
         assert!(core.contains("toplevel: rmap_top\n") && core.contains("toplevel: rmap_top_tb"));
         // Every module file and every memory's init file, each of which exists.
         for m in stages::modules(&cfg) {
@@ -142,7 +142,7 @@ fn core_and_readme_describe_the_directory() {
                 m.file(&cfg)
             );
         }
-        for mem in rtl::manifest::memories(&cfg) {
+        for mem in emit::manifest::memories(&cfg) {
             let f = &mem.init_file;
             assert!(
                 core.contains(&format!("      - {f}: {{file_type: user, copyto: {f}}}")),
@@ -295,7 +295,7 @@ fn ice40_report_gives_a_missed_target_as_a_figure() {
     );
     // The report is of the design built for the iCE40, whatever the configuration's target.
     let ice40 = cfg.for_target(rmapgen::config::Target::Ice40);
-    assert_eq!(r.memories.len(), rtl::manifest::memories(&ice40).len());
+    assert_eq!(r.memories.len(), emit::manifest::memories(&ice40).len());
     assert!(r.in_logic().is_empty());
     assert_eq!(
         r.block_rams,

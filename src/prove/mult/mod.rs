@@ -11,7 +11,7 @@
 //! docs/VERIFICATION.md for why that covers the pipelined tree). Then one of two engines
 //! ([`Engine`]) shows that the miter's `ok` is 1 on every input:
 //! - SAT: `sat -prove ok 1` runs once per value of the split factor
-//!   ([`crate::rtl::tree_spec::Split`]); markers in the log (`rmapgen-mult: tree M T`)
+//!   ([`crate::hdl::tree_spec::Split`]); markers in the log (`rmapgen-mult: tree M T`)
 //!   attribute every result to its tree;
 //! - exhaustive: the miter is written as an and-inverter graph and evaluated on every input
 //!   ([`crate::prove::aig`]), case by case;
@@ -22,8 +22,8 @@ pub mod algebra;
 pub mod netlist;
 
 use crate::config::Config;
+use crate::hdl::tree_spec::{Factor, TreeSpec};
 use crate::prove::aig::{self, Aig};
-use crate::rtl::tree_spec::{Factor, TreeSpec};
 use crate::stages;
 use algebra::Verdict;
 use anyhow::{bail, Result};
@@ -247,7 +247,7 @@ pub fn jobs(cfg: &Config) -> Vec<Job> {
             let input_ports: Vec<String> = u
                 .ports(cfg)
                 .iter()
-                .filter(|p| p.dir == crate::rtl::Dir::Input)
+                .filter(|p| p.dir == crate::hdl::Dir::Input)
                 .map(|p| p.name.to_string())
                 .collect();
             u.trees(cfg).into_iter().map(move |spec| Job {

@@ -10,9 +10,9 @@ use super::position;
 use super::testbench::TbData;
 use super::unit::{file_param, Head, Memory, Unit, Vectors};
 use crate::config::Config;
+use crate::hdl::ports::{i, Port};
 use crate::model::{MapSet, Model};
 use crate::rng::SplitMix64;
-use crate::rtl::ports::{i, Port};
 use crate::vectors::field::Field;
 use askama::Template;
 
@@ -92,7 +92,7 @@ impl Unit for AtanRom {
                 .expect("an output");
             let mut tail = v.split_off(at);
             v.push(i("rd_buf_i", 1, "buffer this sample reads"));
-            v.extend(crate::rtl::ports::host_write(cfg));
+            v.extend(crate::hdl::ports::host_write(cfg));
             v.append(&mut tail);
         }
         v

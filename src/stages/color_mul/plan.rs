@@ -5,9 +5,9 @@
 
 use super::model::constants;
 use crate::config::{Config, Mult, COLOR_BITS};
-use crate::rtl::adder_tree::{self, registered, registered_at, Sig, Step, Sum, Term, Tree};
-use crate::rtl::infer::{self, Mul};
-use crate::rtl::tree_spec::{Factor, Product, TreeSpec};
+use crate::hdl::adder_tree::{self, registered, registered_at, Sig, Step, Sum, Term, Tree};
+use crate::hdl::infer::{self, Mul};
+use crate::hdl::tree_spec::{Factor, Product, TreeSpec};
 
 pub struct Plan {
     pub steps: Vec<Step>,

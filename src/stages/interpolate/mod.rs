@@ -7,10 +7,10 @@ mod plan;
 use super::testbench::TbData;
 use super::unit::{Head, Unit, Vectors};
 use crate::config::Config;
+use crate::hdl::adder_tree::Step;
+use crate::hdl::ports::{i, o, stage_head, Port};
 use crate::model::{MapSet, Model};
 use crate::rng::SplitMix64;
-use crate::rtl::adder_tree::Step;
-use crate::rtl::ports::{i, o, stage_head, Port};
 use crate::vectors::field::Field;
 use crate::vectors::inputs::corner_traces;
 use askama::Template;
@@ -84,7 +84,7 @@ impl Unit for Interpolate {
         Some(self)
     }
 
-    fn trees(&self, cfg: &Config) -> Vec<crate::rtl::tree_spec::TreeSpec> {
+    fn trees(&self, cfg: &Config) -> Vec<crate::hdl::tree_spec::TreeSpec> {
         Plan::new(cfg).specs
     }
 }

@@ -5,11 +5,11 @@
 //! products (`mult = tree`), or inferred products and their sum (`mult = infer`).
 
 use crate::config::{Config, Mult};
-use crate::rtl::adder_tree::{
+use crate::hdl::adder_tree::{
     self, clock_q, registered, registered_at, Sig, Step, Sum, Term, Tree,
 };
-use crate::rtl::infer::{self, Mul};
-use crate::rtl::tree_spec::{Factor, Product, Split, TreeSpec};
+use crate::hdl::infer::{self, Mul};
+use crate::hdl::tree_spec::{Factor, Product, Split, TreeSpec};
 
 pub struct Plan {
     pub in_reg: bool,

@@ -8,10 +8,10 @@ use super::position;
 use super::testbench::TbData;
 use super::unit::{Head, Unit, Vectors};
 use crate::config::Config;
+use crate::hdl::adder_tree::Step;
+use crate::hdl::ports::Port;
 use crate::model::{MapSet, Model};
 use crate::rng::SplitMix64;
-use crate::rtl::adder_tree::Step;
-use crate::rtl::ports::Port;
 use crate::vectors::field::Field;
 use askama::Template;
 pub use plan::Plan;
@@ -75,7 +75,7 @@ impl Unit for LinearIndex {
         Some(self)
     }
 
-    fn trees(&self, cfg: &Config) -> Vec<crate::rtl::tree_spec::TreeSpec> {
+    fn trees(&self, cfg: &Config) -> Vec<crate::hdl::tree_spec::TreeSpec> {
         Plan::new(cfg).specs
     }
 }

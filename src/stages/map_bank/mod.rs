@@ -7,7 +7,7 @@ pub mod banks;
 
 use super::unit::{Head, Memory, Unit};
 use crate::config::Config;
-use crate::rtl::ports::{i, o, Port};
+use crate::hdl::ports::{i, o, Port};
 use askama::Template;
 
 pub struct MapBank;

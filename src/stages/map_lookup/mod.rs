@@ -8,10 +8,10 @@ use super::map_bank::{banks, MapBank};
 use super::testbench::TbData;
 use super::unit::{port_of, Head, Memory, Unit, Vectors};
 use crate::config::Config;
+use crate::hdl::adder_tree::clock_q;
+use crate::hdl::ports::{i, o, stage_head, Port};
 use crate::model::{MapSet, Model};
 use crate::rng::SplitMix64;
-use crate::rtl::adder_tree::clock_q;
-use crate::rtl::ports::{i, o, stage_head, Port};
 use crate::vectors::field::Field;
 use crate::vectors::inputs::{corner_traces, position_corners};
 use askama::Template;
@@ -88,7 +88,7 @@ impl Unit for MapLookup {
         v.push(i("pu_i", pos, "position along u"));
         v.push(i("pv_i", pos, "position along v"));
         v.push(i("rd_buf_i", 1, "buffer this sample reads"));
-        v.extend(crate::rtl::ports::host_write(cfg));
+        v.extend(crate::hdl::ports::host_write(cfg));
         v.push(o("valid_o", 1, ""));
         v.push(o("e00_o", mb, "entry (base_u, base_v)"));
         if cfg.interpolation {

@@ -9,10 +9,10 @@ use super::recip_rom::{self, RecipRom};
 use super::testbench::TbData;
 use super::unit::{param_overrides, Head, Memory, Unit, Vectors};
 use crate::config::Config;
+use crate::hdl::adder_tree::Step;
+use crate::hdl::ports::{i, o, stage_head, Port};
 use crate::model::{MapSet, Model};
 use crate::rng::SplitMix64;
-use crate::rtl::adder_tree::Step;
-use crate::rtl::ports::{i, o, stage_head, Port};
 use crate::vectors::field::Field;
 use askama::Template;
 pub use plan::Plan;
@@ -127,7 +127,7 @@ impl Unit for Normalise {
         Some(self)
     }
 
-    fn trees(&self, cfg: &Config) -> Vec<crate::rtl::tree_spec::TreeSpec> {
+    fn trees(&self, cfg: &Config) -> Vec<crate::hdl::tree_spec::TreeSpec> {
         Plan::new(cfg).specs
     }
 }

@@ -5,11 +5,11 @@
 //! register. The template renders this plan and the latency counts it.
 
 use crate::config::{Config, Mult};
-use crate::rtl::adder_tree::{
+use crate::hdl::adder_tree::{
     self, clock_q, registered, registered_at, Built, Sig, Step, Sum, Term, Tree,
 };
-use crate::rtl::infer::{self, Mul};
-use crate::rtl::tree_spec::{Factor, Product, TreeSpec};
+use crate::hdl::infer::{self, Mul};
+use crate::hdl::tree_spec::{Factor, Product, TreeSpec};
 
 pub struct Plan {
     pub rom_reg: bool,

@@ -4,7 +4,7 @@
 
 use super::unit::{Head, Unit};
 use crate::config::Config;
-use crate::rtl::ports::{i, Dir, Port, Width};
+use crate::hdl::ports::{i, Dir, Port, Width};
 use askama::Template;
 
 pub struct PipeDelay;

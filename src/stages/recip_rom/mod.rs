@@ -7,7 +7,7 @@ pub mod model;
 
 use super::unit::{file_param, Head, Memory, Unit};
 use crate::config::Config;
-use crate::rtl::ports::{i, o, Port};
+use crate::hdl::ports::{i, o, Port};
 use askama::Template;
 
 pub struct RecipRom;

@@ -13,7 +13,7 @@ use super::rmap_top::{top_latency, RmapTop};
 use super::unit::{Head, Memory, Unit};
 use super::TOP;
 use crate::config::Config;
-use crate::rtl::ports::{i, o, Dir, Port, Width};
+use crate::hdl::ports::{i, o, Dir, Port, Width};
 use crate::vectors::field;
 use askama::Template;
 use serde::Serialize;
@@ -397,7 +397,7 @@ mod tests {
     fn the_readme_prints_the_packing_only_with_axis() {
         let cfg = axis(true, 3);
         let text =
-            crate::rtl::package::readme(&crate::design::Design::standard(&cfg).unwrap()).unwrap();
+            crate::emit::package::readme(&crate::design::Design::standard(&cfg).unwrap()).unwrap();
         assert!(text.contains("## AXI4-Stream"), "{text}");
         for (bus, p) in [
             ("s_axis_tdata", packing(&cfg, field::Dir::In)),
@@ -415,7 +415,7 @@ mod tests {
             }
         }
         assert!(text.contains("| `s_axis_tuser` | in | 3 |"));
-        let plain = crate::rtl::package::readme(
+        let plain = crate::emit::package::readme(
             &crate::design::Design::standard(&Config::default()).unwrap(),
         )
         .unwrap();

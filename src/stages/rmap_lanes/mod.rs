@@ -38,7 +38,7 @@ use super::rmap_top::{top_latency, RmapTop};
 use super::unit::{param_overrides, Head, Memory, Unit, Vectors};
 use super::TOP;
 use crate::config::Config;
-use crate::rtl::ports::{Dir, Port, Width};
+use crate::hdl::ports::{Dir, Port, Width};
 use askama::Template;
 use serde::Serialize;
 

@@ -16,7 +16,7 @@ use super::sort_shift::SortShift;
 use super::unit::{param_overrides, Head, Memory, Unit, Vectors};
 use super::zero_detect::ZeroDetect;
 use crate::config::{Config, COLOR_BITS};
-use crate::rtl::ports::{i, o, Port};
+use crate::hdl::ports::{i, o, Port};
 use askama::Template;
 pub use latency::{
     pipeline, position, sideband_delays, top_latency, SidebandDelays, OUTPUT_LATENCY,

@@ -2,8 +2,8 @@
 //! the configuration, the modules in instantiation order with their ports and latencies, the
 //! top's latency, the memories and every file written.
 
-use super::ports;
 use crate::config::Config;
+use crate::hdl::ports;
 use crate::scene::Scene;
 use crate::stages;
 use crate::stages::rmap_axis::AxisInfo;

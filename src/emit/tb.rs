@@ -14,9 +14,9 @@
 
 use crate::config::Config;
 use crate::design::Design;
+use crate::hdl::ports::{self, Width};
 use crate::model::map_set::{buffer_names, map_file, TABLE};
 use crate::output::StagedDir;
-use crate::rtl::ports::{self, Width};
 use crate::stages::recip_rom::{self, RecipRom};
 use crate::stages::rmap_top::top_latency;
 use crate::stages::testbench::{FieldView, Map2File, Sig, TbData, TbFile};

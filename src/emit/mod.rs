@@ -3,17 +3,12 @@
 //! and `manifest.json`. docs/ARCHITECTURE.md is the specification; the units are its tables
 //! in code, and everything here walks them.
 
-pub mod adder_tree;
-pub mod fpga;
-pub mod infer;
 pub mod manifest;
 pub mod package;
-pub mod ports;
 pub mod tb;
-pub mod tree_spec;
-pub mod verilated;
 
 use crate::design::Design;
+pub use crate::hdl::{Dir, Port, Width};
 use crate::hexfile;
 use crate::model::map_set::{map_file, AXES, TABLE};
 use crate::output::StagedDir;
@@ -21,7 +16,6 @@ use crate::stages::map_bank::banks;
 use crate::stages::{self, Head};
 use anyhow::{Context, Result};
 pub use manifest::Manifest;
-pub use ports::{Dir, Port, Width};
 
 /// Every `$readmemh` file of a design: recip_rom.hex, atan_rom.hex (with compensation), the
 /// scene's logical maps map_<axis>.hex, the second map map2_<axis>.hex (the alternate scene's,

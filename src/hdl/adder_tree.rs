@@ -73,7 +73,7 @@ pub struct Step {
 
 /// A registered level `k` carries each rider through a node `<base>_l<k>` of its own; the
 /// rider is then read from that node's register. Shared by both builders (this one and
-/// `rtl::infer`), so riders line up with the products whichever builds the stage.
+/// `hdl::infer`), so riders line up with the products whichever builds the stage.
 pub(super) fn carry_riders(riders: &mut [(&str, Sig)], k: u32, nodes: &mut Vec<Node>) {
     for (base, r) in riders.iter_mut() {
         let name = format!("{base}_l{k}");

@@ -6,10 +6,11 @@
 //! The core's name ([`vlnv`]) differs between configurations: it carries the top's module
 //! name (with the prefix) and a hash of the configuration.
 
-use super::{manifest, Dir, Width};
+use super::manifest;
 use crate::config::Config;
 use crate::design::Design;
 use crate::geometry::{face_tangent, place};
+use crate::hdl::{Dir, Width};
 use crate::map_stream;
 use crate::model::map_addr;
 use crate::model::map_set::{map_file, AXES};

@@ -45,7 +45,7 @@ pub fn o(name: &'static str, bits: u32, note: &'static str) -> Port {
 }
 
 /// The clock port of every stage and top: the one clock the FPGA flows time
-/// (`rtl::fpga` checks nextpnr's Fmax is for it).
+/// (`flow::fpga` checks nextpnr's Fmax is for it).
 pub const CLOCK: &str = "clk_i";
 
 /// The host write port of a stage with writable memories (map_lookup's banks, and atan_rom's

@@ -30,8 +30,8 @@ impl VerilatedTop {
         let design = dir.path().join("design");
         let staged = StagedDir::new(&design, &Default::default())?;
         let d = crate::design::Design::for_scene(cfg, scene)?;
-        super::write_design(&d, &staged, None)?;
-        crate::rtl::tb::write_all(&d, &staged)?;
+        crate::emit::write_design(&d, &staged, None)?;
+        crate::emit::tb::write_all(&d, &staged)?;
         staged.commit()?;
         let harness = dir.path().join("top_apply.cpp");
         crate::disk::write(&harness, HARNESS)?;

@@ -19,9 +19,9 @@
 //! `rmapgen fpga` and `make fpga` (`make fpga-ecp5`) print the report; `rmapgen bench` calls
 //! [`report`] for its FPGA columns, and `bench --throughput` [`synthesise`] and [`place`].
 
-use super::manifest;
-use super::ports::CLOCK;
 use crate::config::{Config, Target};
+use crate::emit::manifest;
+use crate::hdl::ports::CLOCK;
 use crate::output::StagedDir;
 pub use crate::toolchain::nextpnr::Family;
 use crate::toolchain::{self, complaint, nextpnr, yosys};
@@ -218,7 +218,7 @@ pub fn report_with(cfg: &Config, opts: &Options, step: &dyn Fn(&str)) -> Result<
     step(&format!("generating {}", cfg.summary()));
     let tmp = crate::output::Scratch::new()?;
     let out = StagedDir::new(&tmp.path().join("rtl"), &Default::default())?;
-    super::write_design(&crate::design::Design::standard(cfg)?, &out, None)?;
+    crate::emit::write_design(&crate::design::Design::standard(cfg)?, &out, None)?;
     let dir = out.commit()?;
     run_dir_with(&dir, opts, step)
 }
