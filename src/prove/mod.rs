@@ -506,6 +506,43 @@ mod tests {
         assert!(!Shard::parse("2/3").unwrap().is_first());
     }
 
+    /// A design of `cfg` written into a scratch directory, opened as `prove` opens one.
+    fn design(cfg: &Config) -> (crate::output::Scratch, DesignDir) {
+        let tmp = crate::output::Scratch::new().unwrap();
+        let out =
+            crate::output::StagedDir::new(&tmp.path().join("d"), &Default::default()).unwrap();
+        crate::emit::write_design(&crate::design::Design::standard(cfg).unwrap(), &out, None)
+            .unwrap();
+        let dir = out.commit().unwrap();
+        let d = DesignDir::open(&dir).unwrap();
+        (tmp, d)
+    }
+
+    #[test]
+    fn a_design_is_taken_within_the_bounds_of_its_run() {
+        let g8 = Config {
+            grad_bits: 8,
+            red_bits: 6,
+            ..Config::default()
+        };
+        let (_t, d) = design(&g8);
+        assert!(check_design(&d, false).is_ok());
+        assert!(check_design(&d, true).is_ok());
+        let (_t, d) = design(&Config::default());
+        assert!(check_design(&d, false).is_ok());
+        let e = check_design(&d, true).unwrap_err().to_string();
+        assert!(
+            e.starts_with("--direct drives all 2^(3 grad_bits) gradients"),
+            "{e}"
+        );
+        let (_t, d) = design(&Config { lanes: 2, ..g8 });
+        let e = check_design(&d, false).unwrap_err().to_string();
+        assert!(
+            e.starts_with("rmapgen prove proves one rmap_top; this design has lanes = 2"),
+            "{e}"
+        );
+    }
+
     #[test]
     fn failures_count_every_one_and_keep_the_first_few() {
         let mut f = Failures::default();
