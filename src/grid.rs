@@ -169,6 +169,26 @@ pub fn narrowest() -> Config {
     }
 }
 
+/// The rows named (all when none is), in the grid's order; an unknown name is an error
+/// listing the rows.
+pub fn selected(names: &[String]) -> anyhow::Result<Vec<GridRow>> {
+    let rows = rows();
+    if let Some(n) = names
+        .iter()
+        .find(|n| !rows.iter().any(|r| r.name == n.as_str()))
+    {
+        let all: Vec<&str> = rows.iter().map(|r| r.name).collect();
+        anyhow::bail!(
+            "--row {n}: no such row in the grid; rows: {}",
+            all.join(", ")
+        );
+    }
+    Ok(rows
+        .into_iter()
+        .filter(|r| names.is_empty() || names.iter().any(|n| n == r.name))
+        .collect())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,7 +1,6 @@
 //! `rmapgen fit`: the cheapest configuration whose error on the scene's test image meets a
 //! target; prints the decision and writes the chosen design as `generate` does.
 
-use super::generate;
 use super::map_args::MapArgs;
 use super::parse;
 use crate::config::Config;
@@ -179,7 +178,7 @@ pub fn run(a: &FitArgs) -> Result<()> {
     };
     let json = serde_json::to_string_pretty(&d)?;
     let cfg = &d.chosen.config;
-    let (p, manifest) = generate::write_dir(
+    let (p, manifest) = crate::emit::dir::write_dir(
         cfg,
         &scene,
         &a.out,
@@ -189,7 +188,7 @@ pub fn run(a: &FitArgs) -> Result<()> {
             seed: a.seed,
         },
         &[("fit.json".to_string(), json)],
-        generate::Keep::Nothing,
+        crate::emit::dir::Keep::Nothing,
     )?;
     crate::outln!(
         "fit: {} ({}), {}x{} sphere ({} pixels), maps {}; target {}; cost {}",

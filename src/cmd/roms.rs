@@ -1,7 +1,6 @@
 //! `rmapgen roms`: the ROM and map contents as `$readmemh` files, nothing else.
 
 use super::config_args::ConfigArgs;
-use super::generate;
 use super::map_args::MapArgs;
 use crate::design::Design;
 use crate::design_dir::DesignDir;
@@ -79,14 +78,14 @@ fn update(a: &RomsArgs, dir: &Path) -> Result<()> {
     })?;
     let before = crate::output::stamp::read(dir).unwrap_or_default();
     let policy = a.force.policy(&[a.cfg.config.as_deref(), a.map.input()]);
-    let (p, _) = generate::write_dir(
+    let (p, _) = crate::emit::dir::write_dir(
         &cfg,
         &scene,
         dir,
         &policy,
         vectors,
         &[],
-        generate::Keep::Others,
+        crate::emit::dir::Keep::Others,
     )?;
     let after = crate::output::stamp::read(&p).unwrap_or_default();
     let changed: Vec<&String> = after

@@ -8,18 +8,15 @@
 //! the tail of its output), 2 for bad input (one line, nothing written).
 
 use super::force::ForceArg;
-use super::generate;
 use super::parse;
 use crate::design_dir::DesignDir;
-use crate::emit::manifest::VectorsInfo;
 use crate::grid::{self, GridRow};
-use crate::output::{absolute, Policy, StagedDir};
-use crate::scene::Scene;
+use crate::output::{absolute, StagedDir};
 use crate::sim::{self, Options, Outcome};
 use crate::vectors::MAX_STREAM_VECTORS;
 use anyhow::{bail, Result};
 use clap::Args;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Args, Debug)]
@@ -101,7 +98,7 @@ pub fn run(a: &SimArgs) -> Result<ExitCode> {
     }
     // Bad input first, then the tools, then the runs.
     let failed = if a.matrix {
-        let rows = selected_rows(&a.row)?;
+        let rows = grid::selected(&a.row)?;
         need_tools(&opts)?;
         matrix(a, &opts, &rows)?
     } else {
@@ -215,7 +212,7 @@ fn matrix(a: &SimArgs, opts: &Options, rows: &[GridRow]) -> Result<bool> {
     let mut failed = Vec::new();
     for r in rows {
         crate::outln!("==== {}: {} ({})", r.name, r.config.summary(), r.covers)?;
-        let design = generate_row(r, &root.join(r.name), &a.force.policy(&[]))?;
+        let design = crate::emit::dir::write_row(r, &root.join(r.name), &a.force.policy(&[]))?;
         if !simulate(&design, a, opts)?.failed.is_empty() {
             failed.push(r.name);
         }
@@ -226,41 +223,4 @@ fn matrix(a: &SimArgs, opts: &Options, rows: &[GridRow]) -> Result<bool> {
         crate::outln!("sim: FAILED: {}", failed.join(" "))?;
     }
     Ok(!failed.is_empty())
-}
-
-/// The rows named (all when none is), in the grid's order; an unknown name is an error
-/// listing the rows.
-pub(crate) fn selected_rows(names: &[String]) -> Result<Vec<GridRow>> {
-    let rows = grid::rows();
-    if let Some(n) = names
-        .iter()
-        .find(|n| !rows.iter().any(|r| r.name == n.as_str()))
-    {
-        let all: Vec<&str> = rows.iter().map(|r| r.name).collect();
-        bail!(
-            "--row {n}: no such row in the grid; rows: {}",
-            all.join(", ")
-        );
-    }
-    Ok(rows
-        .into_iter()
-        .filter(|r| names.is_empty() || names.iter().any(|n| n == r.name))
-        .collect())
-}
-
-/// Generates a row's design (the standard scene, `generate`'s default vectors) into `dir`.
-pub(crate) fn generate_row(r: &GridRow, dir: &Path, policy: &Policy) -> Result<DesignDir> {
-    let (dir, _) = generate::write_dir(
-        &r.config,
-        &Scene::standard(),
-        dir,
-        policy,
-        VectorsInfo {
-            random: generate::DEFAULT_VECTORS,
-            seed: generate::DEFAULT_SEED,
-        },
-        &[],
-        generate::Keep::Nothing,
-    )?;
-    DesignDir::open(&dir)
 }

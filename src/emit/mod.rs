@@ -3,6 +3,7 @@
 //! and `manifest.json`. docs/ARCHITECTURE.md is the specification; the units are its tables
 //! in code, and everything here walks them.
 
+pub mod dir;
 pub mod manifest;
 pub mod package;
 pub mod tb;

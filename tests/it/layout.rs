@@ -234,7 +234,7 @@ fn the_module_graph_has_no_cycles() {
     assert!(mods.len() > 50, "found {} modules", mods.len());
     let g = graph(&mods);
     assert!(
-        g["cmd::generate"].contains("emit") && g["emit::tb"].contains("config"),
+        g["cmd::generate"].contains("emit::dir") && g["emit::tb"].contains("config"),
         "the reader sees the crate's imports: {:?}",
         g["cmd::generate"]
     );
@@ -421,4 +421,50 @@ fn planted_upward_imports_are_found() {
             "stages::sort_shift::model -> stages::normalise"
         ]
     );
+}
+/// Command modules (`cmd::<name>` with a `pub fn run`) that use another command's module: a
+/// command parses its flags and calls the library; shared flag groups (`config_args`,
+/// `force`, ...) and the progress display are not commands.
+fn command_to_command(mods: &BTreeMap<String, String>) -> Vec<String> {
+    let g = graph(mods);
+    let is_command = |m: &str| {
+        m.starts_with("cmd::") && mods.get(m).is_some_and(|code| code.contains("pub fn run("))
+    };
+    let mut out = Vec::new();
+    for (m, deps) in &g {
+        if !is_command(m) {
+            continue;
+        }
+        for d in deps {
+            if is_command(d) {
+                out.push(format!("{m} -> {d}"));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn no_command_calls_another_commands_module() {
+    let mods = modules(&crate::helpers::root().join("src"));
+    let commands = mods
+        .iter()
+        .filter(|(m, c)| m.starts_with("cmd::") && c.contains("pub fn run("))
+        .count();
+    assert!(commands >= 15, "found {commands} commands");
+    assert_eq!(command_to_command(&mods), Vec::<String>::new());
+    // Planted: prove_mult reaching into sim's module is found; a shared flag group is not.
+    let planted: BTreeMap<String, String> = [
+        ("cmd", ""),
+        ("cmd::force", "pub struct ForceArg;\n"),
+        ("cmd::sim", "use super::force::ForceArg;\npub fn run() {}\n"),
+        (
+            "cmd::prove_mult",
+            "use super::force::ForceArg;\nuse super::sim::generate_row;\npub fn run() {}\n",
+        ),
+    ]
+    .into_iter()
+    .map(|(a, b)| (a.to_string(), b.to_string()))
+    .collect();
+    assert_eq!(command_to_command(&planted), ["cmd::prove_mult -> cmd::sim"]);
 }

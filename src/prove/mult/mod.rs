@@ -20,6 +20,7 @@
 
 pub mod algebra;
 pub mod netlist;
+pub mod run;
 
 use crate::config::Config;
 use crate::hdl::tree_spec::{Factor, TreeSpec};
