@@ -331,7 +331,7 @@ pub const DIRECT: [&str; 2] = ["structure", "direct"];
 
 /// Checks the options of a run (the parts named exist), before anything is made.
 pub fn check_options(opts: &Options) -> Result<()> {
-    let names: &[&str] = if opts.direct { &DIRECT } else { &FACTORED };
+    let names = opts.names();
     for p in &opts.parts {
         if !names.contains(&p.as_str()) {
             bail!(
@@ -344,12 +344,46 @@ pub fn check_options(opts: &Options) -> Result<()> {
     Ok(())
 }
 
+/// The pass whose buffers the top holds after every pass: the zero part's samples run on it.
+const LAST_PASS: Pass = PASSES[PASSES.len() - 1];
+
+impl Options {
+    /// The parts of this kind of run, in the order they run.
+    pub fn names(&self) -> &'static [&'static str] {
+        if self.direct {
+            &DIRECT
+        } else {
+            &FACTORED
+        }
+    }
+
+    /// Whether part `name` runs (every part when `--part` names none).
+    pub fn wants(&self, name: &str) -> bool {
+        self.parts.is_empty() || self.parts.iter().any(|p| p == name)
+    }
+
+    /// Whether a part that drives the top runs (the top's Verilated library is built then).
+    pub fn needs_top(&self) -> bool {
+        ["direct", "states", "zero"]
+            .iter()
+            .any(|p| self.names().contains(p) && self.wants(p))
+    }
+}
+
+/// The first file whose hash differs between two hashings of the same files.
+fn changed<'a>(before: &'a [report::FileHash], after: &[report::FileHash]) -> Option<&'a str> {
+    before
+        .iter()
+        .zip(after)
+        .find(|(b, a)| b.sha256 != a.sha256)
+        .map(|(b, _)| b.name.as_str())
+}
+
 /// Runs one shard on design `d`, building in `build` (a directory rmapgen owns).
 pub fn run(d: &DesignDir, build: &Path, opts: &Options, progress: &Progress) -> Result<Report> {
     check_design(d, opts.direct)?;
     check_options(opts)?;
-    let names: &[&str] = if opts.direct { &DIRECT } else { &FACTORED };
-    let wanted = |name: &str| opts.parts.is_empty() || opts.parts.iter().any(|p| p == name);
+    let wanted = |name: &str| opts.wants(name);
     let start = Instant::now();
     // What is proven is the files as they are now: hashed before the run and again after it,
     // so that a file changed meanwhile cannot be certified.
@@ -359,7 +393,7 @@ pub fn run(d: &DesignDir, build: &Path, opts: &Options, progress: &Progress) -> 
     let model = Model::new(cfg);
     let maps = MapSet::from_dir(cfg, d.path())
         .with_context(|| format!("the maps of {}", d.path().display()))?;
-    let total = 1u64 << (3 * cfg.grad_bits);
+    let total = part_total("front", cfg.grad_bits, 0);
     let mut parts = Vec::new();
 
     if wanted("structure") {
@@ -372,11 +406,8 @@ pub fn run(d: &DesignDir, build: &Path, opts: &Options, progress: &Progress) -> 
         }
     }
 
-    let needs_top = ["direct", "states", "zero"]
-        .iter()
-        .any(|p| names.contains(p) && wanted(p));
     let t = report::now();
-    let top_lib = if needs_top {
+    let top_lib = if opts.needs_top() {
         Some(ffi::Library::open(&build::top(d, build)?)?)
     } else {
         None
@@ -431,7 +462,7 @@ pub fn run(d: &DesignDir, build: &Path, opts: &Options, progress: &Progress) -> 
             let range = opts.shard.range(1);
             let mut fails = Failures::default();
             if !range.is_empty() {
-                let front = maps.buffer(PASSES[PASSES.len() - 1].expect);
+                let front = maps.buffer(LAST_PASS.expect);
                 let mut batch = top::Batch::new(top, &model, front, "zero", 0);
                 batch.push(0, [0, 0, 0], &mut fails, progress)?;
                 batch.flush(&mut fails, progress)?;
@@ -459,10 +490,10 @@ pub fn run(d: &DesignDir, build: &Path, opts: &Options, progress: &Progress) -> 
         }
     }
     let after = report::hash_files(d, &file_names)?;
-    if let Some((b, _)) = files.iter().zip(&after).find(|(b, a)| b.sha256 != a.sha256) {
+    if let Some(name) = changed(&files, &after) {
         bail!(
             "{} changed while it was being proven; prove the design again",
-            d.path().join(&b.name).display()
+            d.path().join(name).display()
         );
     }
     Report::new(d, opts, files, parts, start.elapsed().as_secs_f64())
@@ -543,6 +574,49 @@ mod tests {
         );
     }
 
+    fn opts(direct: bool, parts: &[&str]) -> Options {
+        Options {
+            shard: Shard { index: 1, count: 1 },
+            direct,
+            front_engine: FrontEngine::Gates,
+            parts: parts.iter().map(|p| p.to_string()).collect(),
+        }
+    }
+
+    #[test]
+    fn the_parts_run_are_those_named_and_the_top_is_built_for_those_that_drive_it() {
+        let all = opts(false, &[]);
+        assert!(FACTORED.iter().all(|p| all.wants(p)));
+        let front = opts(false, &["front"]);
+        assert!(front.wants("front") && !front.wants("states") && !front.wants("zero"));
+        assert!(!front.needs_top(), "the front alone runs on gates");
+        assert!(!opts(false, &["structure"]).needs_top());
+        for p in ["states", "zero"] {
+            assert!(opts(false, &["front", p]).needs_top(), "{p}");
+        }
+        assert!(all.needs_top() && opts(true, &[]).needs_top());
+        assert!(opts(true, &["direct"]).needs_top());
+        assert!(!opts(true, &["structure"]).needs_top());
+        assert_eq!(opts(true, &[]).names(), DIRECT);
+        assert_eq!(all.names(), FACTORED);
+        // The zero part runs on the buffers as the last pass left them: the second map.
+        assert_eq!(LAST_PASS.label, "buffer 1 written");
+        assert_eq!(LAST_PASS.expect, 1);
+    }
+
+    #[test]
+    fn a_file_changed_between_two_hashings_is_named() {
+        let h = |name: &str, sha: &str| report::FileHash {
+            name: name.into(),
+            sha256: sha.into(),
+            as_generated: true,
+        };
+        let before = [h("a.v", "1"), h("b.hex", "2"), h("c.hex", "3")];
+        assert_eq!(changed(&before, &before.clone()), None);
+        let after = [h("a.v", "1"), h("b.hex", "9"), h("c.hex", "8")];
+        assert_eq!(changed(&before, &after), Some("b.hex"));
+    }
+
     #[test]
     fn failures_count_every_one_and_keep_the_first_few() {
         let mut f = Failures::default();
@@ -578,12 +652,6 @@ mod tests {
 
     #[test]
     fn a_run_takes_only_the_parts_of_its_kind() {
-        let opts = |direct: bool, parts: &[&str]| Options {
-            shard: Shard { index: 1, count: 1 },
-            direct,
-            front_engine: FrontEngine::Gates,
-            parts: parts.iter().map(|p| p.to_string()).collect(),
-        };
         for ok in [
             &[][..],
             &["front"],

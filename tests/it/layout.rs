@@ -466,5 +466,8 @@ fn no_command_calls_another_commands_module() {
     .into_iter()
     .map(|(a, b)| (a.to_string(), b.to_string()))
     .collect();
-    assert_eq!(command_to_command(&planted), ["cmd::prove_mult -> cmd::sim"]);
+    assert_eq!(
+        command_to_command(&planted),
+        ["cmd::prove_mult -> cmd::sim"]
+    );
 }
