@@ -212,20 +212,11 @@ impl Unit for RmapTop {
 
     /// In the order rmap_top.v instantiates them; stages the configuration leaves out are
     /// absent, not bypassed.
+    /// The zero detect beside the pipeline, the stages of [`pipeline`] in order, and the
+    /// sideband delay lines.
     fn children(&self, cfg: &Config) -> Vec<&'static dyn Unit> {
-        let mut v: Vec<&'static dyn Unit> = vec![
-            &ZeroDetect,
-            &SortShift,
-            &Normalise,
-            position(cfg),
-            &MapLookup,
-        ];
-        if cfg.interpolation {
-            v.push(&Interpolate);
-        }
-        if cfg.color {
-            v.push(&ColorMul);
-        }
+        let mut v: Vec<&'static dyn Unit> = vec![&ZeroDetect];
+        v.extend(pipeline(cfg));
         v.push(&PipeDelay);
         v
     }
