@@ -515,10 +515,6 @@ impl Config {
     pub fn recip_entries(&self) -> u32 {
         1 << (self.red_bits - 1)
     }
-    /// Right shift that turns a * recip into a frac_bits fraction.
-    pub fn norm_shift(&self) -> u32 {
-        self.red_bits - 1 + self.recip_bits - self.frac_bits
-    }
     /// Address width of one axis map: {s_max, s_u, i_u, s_v, i_v}.
     pub fn map_addr_bits(&self) -> u32 {
         3 + 2 * self.index_bits
@@ -551,33 +547,17 @@ impl Config {
     // Widths and constants of the generated RTL (src/stages, src/hdl, templates/). Each is defined here
     // once; the templates only name them.
 
-    /// Width of sort & shift's left-shift count, which runs 0..grad_bits-1.
-    pub fn shift_bits(&self) -> u32 {
-        bit_length(self.grad_bits as u64 - 1)
-    }
     /// Reciprocal-ROM address width: the reduced max's bits below its MSB.
     pub fn recip_addr_bits(&self) -> u32 {
         self.red_bits - 1
-    }
-    /// Normalise's rounding constant, half an LSB of the fraction: 2^(norm_shift - 1).
-    pub fn norm_half(&self) -> u64 {
-        1 << (self.norm_shift() - 1)
     }
     /// Entries of the compensation (atan) ROM: one per fraction code.
     pub fn atan_entries(&self) -> u32 {
         1 << self.frac_bits
     }
-    /// The linear index's rounding constant, half a fraction LSB scaled: 2^(frac_bits - 1).
-    pub fn frac_half(&self) -> u64 {
-        1 << (self.frac_bits - 1)
-    }
     /// Largest base entry of an interpolation: the outer entry is never a base.
     pub fn base_max(&self) -> u32 {
         self.entries() - 2
-    }
-    /// Width of the second pass r (before rounding), 0..=map_max * step^2, plus half.
-    pub fn interp_r_bits(&self) -> u32 {
-        self.map_bits + 2 * self.interp_bits
     }
     /// Map RAM banks: four (by the parities of i_u and i_v) with interpolation, else one.
     pub fn bank_count(&self) -> u32 {

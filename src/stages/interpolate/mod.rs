@@ -38,6 +38,11 @@ struct Verilog {
 
 crate::tb_template!(Testbench, "interpolate/interpolate_tb.v");
 
+/// Width of the second pass r (before rounding), 0..=map_max * step^2, plus half.
+pub fn r_bits(cfg: &Config) -> u32 {
+    cfg.map_bits + 2 * cfg.interp_bits
+}
+
 impl Unit for Interpolate {
     fn name(&self) -> &'static str {
         "interpolate"
@@ -71,10 +76,10 @@ impl Unit for Interpolate {
             m: cfg.map_bits,
             p: cfg.interp_bits,
             s: cfg.step(),
-            rw: cfg.interp_r_bits(),
+            rw: r_bits(cfg),
             in_reg: p.in_reg,
             in_q: p.in_q.clone(),
-            sum_r: p.sum_r.expr(cfg.interp_r_bits()),
+            sum_r: p.sum_r.expr(r_bits(cfg)),
             steps: p.steps,
         }
         .render()

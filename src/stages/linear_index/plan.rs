@@ -11,6 +11,11 @@ use crate::hdl::adder_tree::{
 use crate::hdl::infer::{self, Mul};
 use crate::hdl::tree_spec::{Factor, Product, TreeSpec};
 
+/// The rounding constant, half a fraction LSB scaled: 2^(frac_bits - 1).
+pub fn frac_half(cfg: &Config) -> u64 {
+    1 << (cfg.frac_bits - 1)
+}
+
 pub struct Plan {
     pub pre_reg: bool,
     /// The suffix of u' and v' registered (with `pre_reg`); the trees read `_d` without.
@@ -30,7 +35,7 @@ impl Plan {
         let in_q = clock_q(1);
         let sfx = if pre_reg { in_q.as_str() } else { "d" };
         let title = "u' * POS_MAX and v' * POS_MAX";
-        let bound = (cfg.pos_max() as u128) << cfg.frac_bits | cfg.frac_half() as u128;
+        let bound = (cfg.pos_max() as u128) << cfg.frac_bits | frac_half(cfg) as u128;
         let b = match cfg.mult {
             Mult::Tree => {
                 let tree = |name: &str, x: &str| Tree {
@@ -40,7 +45,7 @@ impl Plan {
                             x: Sig::new(format!("{x}_{sfx}"), cfg.frac_bits + 1),
                             shift: cfg.interp_bits + b,
                         })
-                        .chain([Term::Const(cfg.frac_half() as u128)])
+                        .chain([Term::Const(frac_half(cfg) as u128)])
                         .collect(),
                     bound: Some(bound),
                 };
@@ -56,7 +61,7 @@ impl Plan {
                         b: Factor::Const(cfg.pos_max() as u128),
                         shift: 0,
                     }],
-                    constant: cfg.frac_half() as u128,
+                    constant: frac_half(cfg) as u128,
                     bound: Some(bound),
                 };
                 let muls = [mul("su", "ux"), mul("sv", "vx")];
@@ -75,7 +80,7 @@ impl Plan {
                     b: Factor::Const(cfg.pos_max() as u128),
                     shift: 0,
                 }],
-                constant: cfg.frac_half() as u128,
+                constant: frac_half(cfg) as u128,
                 sum: sum.clone(),
                 // u' is u, or 2^F for the all-ones code.
                 at_most: vec![(x, 1u128 << cfg.frac_bits)],

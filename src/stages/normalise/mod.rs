@@ -110,7 +110,7 @@ impl Unit for Normalise {
             w: cfg.recip_bits,
             f: cfg.frac_bits,
             ra: cfg.recip_addr_bits(),
-            sh: cfg.norm_shift(),
+            sh: model::norm_shift(cfg),
             sw,
             rom_reg: p.rom_reg,
             tree_q: p.tree_q.clone(),

@@ -14,6 +14,16 @@ pub struct Normalise {
     pub v: u32,
 }
 
+/// Right shift that turns a * recip into a frac_bits fraction.
+pub fn norm_shift(cfg: &Config) -> u32 {
+    cfg.red_bits - 1 + cfg.recip_bits - cfg.frac_bits
+}
+
+/// The rounding constant, half an LSB of the fraction: 2^(norm_shift - 1).
+pub fn norm_half(cfg: &Config) -> u64 {
+    1 << (norm_shift(cfg) - 1)
+}
+
 /// One multiplier lane: the fraction for component `c` given the max `m` and its reciprocal.
 #[inline]
 pub fn lane(cfg: &Config, c: u32, m: u32, recip: u32) -> u32 {
@@ -21,7 +31,7 @@ pub fn lane(cfg: &Config, c: u32, m: u32, recip: u32) -> u32 {
     if c == m {
         return all_ones;
     }
-    let sh = cfg.norm_shift();
+    let sh = norm_shift(cfg);
     let q = ((c as u64 * recip as u64 + (1u64 << (sh - 1))) >> sh) as u32;
     q.min(all_ones)
 }

@@ -40,7 +40,7 @@ impl Plan {
             ("b_max", Sig::new(format!("b_max_{q}"), 1)),
         ];
         let title = "a * recip and b * recip";
-        let half = cfg.norm_half() as u128;
+        let half = super::model::norm_half(cfg) as u128;
         let Built {
             steps,
             sums,

@@ -92,7 +92,7 @@ impl Unit for SortShift {
             cmp_reg: plan.cmp_reg,
             g,
             r: cfg.red_bits,
-            shw: cfg.shift_bits(),
+            shw: shift_bits(cfg),
             comps: ["x", "y", "z"],
             lz_table: (0..g).rev().map(|bit| (bit, g - 1 - bit)).collect(),
             truncates: cfg.grad_bits > cfg.red_bits,
@@ -107,6 +107,11 @@ impl Unit for SortShift {
 
 /// The module's outputs for the model's result, in the order of the output fields
 /// ([`Vectors::fields`]); `rmapgen prove` packs them without allocating (src/prove/front.rs).
+/// Width of the left-shift count, which runs 0..grad_bits-1.
+pub fn shift_bits(cfg: &Config) -> u32 {
+    crate::config::bit_length(cfg.grad_bits as u64 - 1)
+}
+
 #[inline]
 pub fn outputs(s: &model::SortShift) -> [u64; 7] {
     [s.axis, s.s_max, s.s_u, s.s_v, s.m, s.a, s.b].map(u64::from)
