@@ -43,6 +43,7 @@ pub mod renderer;
 pub mod report;
 pub mod shear;
 pub mod synthetic;
+pub mod timing;
 
 use anyhow::{bail, Result};
 use serde::Serialize;
