@@ -396,6 +396,35 @@ fn every_g8_grid_row_is_proven_with_every_gradient_through_its_top() {
     });
 }
 
+/// A design Verilator cannot build fails the proof with Verilator's first error and the log
+/// named, not an empty message.
+#[test]
+fn a_design_verilator_cannot_build_fails_naming_its_first_error() {
+    if !tools() {
+        return;
+    }
+    let tmp = helpers::tempdir();
+    let dir = tmp.path().join("d");
+    hdl::generate(&dir, &hdl::strs(&hdl::narrowest_flags()), 0);
+    let bad = tmp.path().join("bad");
+    plant(
+        &dir,
+        &bad,
+        "zero_detect.v",
+        "endmodule",
+        "wire ;\nendmodule",
+    );
+    let build = tmp.path().join("build");
+    let o = prove(&bad, &build, &["--part", "states"]);
+    let t = text(&o);
+    assert!(!o.status.success(), "{t}");
+    assert!(t.contains("Verilator could not build rmap_top ("), "{t}");
+    assert!(
+        t.contains("verilator.log): %Error"),
+        "the first error is shown: {t}"
+    );
+}
+
 #[test]
 fn bad_input_is_one_line_and_exit_2() {
     let tmp = helpers::tempdir();
