@@ -71,6 +71,16 @@ docs: $(MDBOOK)
 	scripts/check-links.sh build/book
 	@echo "docs: build/book/index.html, every link checked"
 
+# ---- The README's pictures (docs/images/sphere_*.png): the standard scene rendered at 512 x 512
+# by the default design with the colour multiplier (its intensities are the default design's;
+# its colour ramp gives sphere_color_model.png). tests/it/cmd_render.rs checks the committed
+# pictures equal a fresh render, byte for byte where no font is drawn.
+DOCS_IMAGES = reference model error50 error_signed highlight profile histogram color_model
+.PHONY: docs-images
+docs-images: build
+	$(RMAPGEN) render --color --scene scenes/standard.toml --out build/docs-images --force
+	for f in $(DOCS_IMAGES); do cp build/docs-images/$$f.png docs/images/sphere_$$f.png; done
+
 # ---- render's report.html in a real browser: a small sphere rendered by a --color design (so
 # the colour images too), its report opened in
 # Debian's headless chromium by Playwright (tests/browser/check_report.py): every image decodes

@@ -356,3 +356,41 @@ fn a_colour_design_renders_in_colour() {
         serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
     assert_eq!(j["color"]["source"], "scene");
 }
+
+/// The README's pictures are what `render` writes today (`make docs-images` writes them):
+/// byte for byte where no text is drawn, the same size where a system font draws labels.
+#[test]
+fn the_readme_pictures_are_what_render_writes() {
+    let tmp = tempdir();
+    let out = tmp.path().join("s");
+    let o = run(&[
+        "render",
+        "--color",
+        "--scene",
+        crate::helpers::root()
+            .join("scenes/standard.toml")
+            .to_str()
+            .unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let docs = crate::helpers::root().join("docs/images");
+    for name in ["reference", "model", "error50", "highlight", "color_model"] {
+        let fresh = std::fs::read(out.join(format!("{name}.png"))).unwrap();
+        let committed = std::fs::read(docs.join(format!("sphere_{name}.png"))).unwrap();
+        assert!(
+            fresh == committed,
+            "docs/images/sphere_{name}.png is not what render writes: run make docs-images"
+        );
+    }
+    for name in ["error_signed", "profile", "histogram"] {
+        let fresh = image::open(out.join(format!("{name}.png"))).unwrap();
+        let committed = image::open(docs.join(format!("sphere_{name}.png"))).unwrap();
+        assert_eq!(
+            (fresh.width(), fresh.height()),
+            (committed.width(), committed.height()),
+            "docs/images/sphere_{name}.png: run make docs-images"
+        );
+    }
+}
