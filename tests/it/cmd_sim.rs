@@ -606,18 +606,17 @@ fn sim_shows_its_steps_on_a_terminal_only() {
     let dir = tmp.path().join("d");
     hdl::generate_config(&dir, &grid::narrowest(), 5);
     let build = tmp.path().join("b");
-    let command = format!(
-        "{} sim --icarus --only zero_detect --build {} {}",
-        env!("CARGO_BIN_EXE_rmapgen"),
-        build.display(),
-        dir.display()
-    );
-    let o = std::process::Command::new("script")
-        .args(["-qec", &command, "/dev/null"])
-        .output()
-        .unwrap();
-    let tty = String::from_utf8_lossy(&o.stdout);
-    assert!(o.status.success(), "{tty}");
+    let (ok, tty) = helpers::on_a_terminal(&[
+        "sim",
+        "--icarus",
+        "--only",
+        "zero_detect",
+        "--build",
+        s(&build),
+        s(&dir),
+    ])
+    .expect("script");
+    assert!(ok, "{tty}");
     // The spinner's line: the elapsed time, then the step (compile, then the run).
     assert!(tty.contains("icarus zero_detect_tb (compile)"), "{tty}");
     assert!(tty.contains("00:00:0"), "{tty}");
@@ -640,18 +639,9 @@ fn sim_shows_its_steps_on_a_terminal_only() {
     // synth, one Yosys run: its step on a terminal, nothing on stderr in a script.
     if require("yosys") {
         let logs = tmp.path().join("logs");
-        let command = format!(
-            "{} synth --logs {} {}",
-            env!("CARGO_BIN_EXE_rmapgen"),
-            logs.display(),
-            dir.display()
-        );
-        let o = std::process::Command::new("script")
-            .args(["-qec", &command, "/dev/null"])
-            .output()
-            .unwrap();
-        let tty = String::from_utf8_lossy(&o.stdout);
-        assert!(o.status.success(), "{tty}");
+        let (ok, tty) =
+            helpers::on_a_terminal(&["synth", "--logs", s(&logs), s(&dir)]).expect("script");
+        assert!(ok, "{tty}");
         assert!(
             tty.contains("synthesising rmap_top with Yosys synth_ice40"),
             "{tty}"

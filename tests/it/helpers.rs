@@ -139,3 +139,25 @@ pub fn first_difference(a: &Path, b: &Path) -> Option<String> {
         .find(|name| !ta.contains_key(*name))
         .map(|name| format!("{name} is in {} but not in {}", b.display(), a.display()))
 }
+
+/// rmapgen run with `args` under a pseudo-terminal (util-linux's `script`), as a user at a
+/// terminal runs it: what the terminal showed (stdout and stderr together) and whether it
+/// succeeded. `None` without `script`.
+pub fn on_a_terminal(args: &[&str]) -> Option<(bool, String)> {
+    if !rmapgen::toolchain::installed("script") {
+        return None;
+    }
+    let mut command = env!("CARGO_BIN_EXE_rmapgen").to_string();
+    for a in args {
+        command.push(' ');
+        command.push_str(a);
+    }
+    let o = std::process::Command::new("script")
+        .args(["-qec", &command, "/dev/null"])
+        .output()
+        .expect("script runs");
+    Some((
+        o.status.success(),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+    ))
+}

@@ -322,18 +322,15 @@ fn fpga_shows_its_steps_on_a_terminal_only() {
     flags.extend(["--target".to_string(), "ice40".to_string()]);
     hdl::generate(&dir, &hdl::strs(&flags), 1);
     let logs = tmp.path().join("logs");
-    let command = format!(
-        "{} fpga --dir {} --logs {}",
-        env!("CARGO_BIN_EXE_rmapgen"),
-        dir.display(),
-        logs.display()
-    );
-    let o = std::process::Command::new("script")
-        .args(["-qec", &command, "/dev/null"])
-        .output()
-        .unwrap();
-    let tty = String::from_utf8_lossy(&o.stdout);
-    assert!(o.status.success(), "{tty}");
+    let (ok, tty) = crate::helpers::on_a_terminal(&[
+        "fpga",
+        "--dir",
+        dir.to_str().unwrap(),
+        "--logs",
+        logs.to_str().unwrap(),
+    ])
+    .expect("script");
+    assert!(ok, "{tty}");
     for step in [
         "synthesising with Yosys synth_ice40",
         "placing and routing: nextpnr-ice40 --hx8k",
