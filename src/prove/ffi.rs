@@ -192,3 +192,46 @@ impl Drop for Top {
         unsafe { (self.free)(self.model) }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A library that cannot be loaded is refused with the loader's own reason; a symbol the
+    /// library lacks, with its name and the loader's reason.
+    #[test]
+    fn load_failures_say_why() {
+        let e = Library::open(Path::new("/nonexistent/libnothing.so"))
+            .err()
+            .expect("no such library")
+            .to_string();
+        assert!(
+            e.starts_with("cannot load /nonexistent/libnothing.so: ")
+                && e.contains("No such file or directory"),
+            "{e}"
+        );
+        let not_elf =
+            std::env::temp_dir().join(format!("rmapgen-not-elf-{}.so", std::process::id()));
+        std::fs::write(&not_elf, "not a shared object").unwrap();
+        let e = Library::open(&not_elf)
+            .err()
+            .expect("not a library")
+            .to_string();
+        std::fs::remove_file(&not_elf).unwrap();
+        assert!(
+            e.contains("invalid ELF header") || e.contains("too short"),
+            "{e}"
+        );
+        // libc is in every process, so loading it succeeds; it has no such symbol.
+        let libc = Library::open(Path::new("libc.so.6")).expect("libc loads");
+        let e = libc
+            .symbol("rmapgen_no_such_symbol")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("the harness has no rmapgen_no_such_symbol: ")
+                && e.contains("undefined symbol"),
+            "{e}"
+        );
+    }
+}
