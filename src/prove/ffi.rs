@@ -210,14 +210,14 @@ mod tests {
                 && e.contains("No such file or directory"),
             "{e}"
         );
-        let not_elf =
-            std::env::temp_dir().join(format!("rmapgen-not-elf-{}.so", std::process::id()));
+        // A file the test makes in a directory of its own, removed with the directory.
+        let tmp = tempfile::tempdir().unwrap();
+        let not_elf = tmp.path().join("libnot-elf.so");
         std::fs::write(&not_elf, "not a shared object").unwrap();
         let e = Library::open(&not_elf)
             .err()
             .expect("not a library")
             .to_string();
-        std::fs::remove_file(&not_elf).unwrap();
         assert!(
             e.contains("invalid ELF header") || e.contains("too short"),
             "{e}"
