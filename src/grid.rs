@@ -14,6 +14,7 @@
 //! lanes, for each memory target).
 
 use crate::config::{CompTable, Config, Mult, Target, RANGES};
+use crate::family::Family;
 
 /// One configuration of the grid.
 #[derive(Clone, Debug, PartialEq)]
@@ -45,7 +46,7 @@ macro_rules! grid {
                     compensation: $comp == 1, interpolation: $interp == 1, color: $color == 1,
                     pipeline_depth: $depth, handshake: $hs == 1,
                     prefix: String::new(),
-                    target: match $ice40 { 1 => Target::Ice40, 2 => Target::Ecp5, _ => Target::Generic },
+                    target: match $ice40 { 1 => Target::Family(Family::Ice40), 2 => Target::Family(Family::Ecp5), _ => Target::Generic },
                     axis: false $(|| { let _: u32 = $user; true })?,
                     axis_user: 0 $(+ $user)?,
                     lanes: 1 $(- 1 + $lanes)?,

@@ -76,7 +76,7 @@ impl Default for Options {
             size: 512,
             seconds: 0.3,
             yosys: true,
-            family: Family::Ice40,
+            family: Family::default(),
             lanes: 1,
             quick: false,
             scenes: scenes(),
@@ -293,9 +293,7 @@ pub fn run(opts: &Options, progress: &dyn Fn(&str)) -> Result<Vec<Row>> {
                     ice40_too_big: matches!(fig, Flow::DoesNotFit(_)),
                     family: opts.family,
                     lanes: opts.lanes,
-                    dsps: placed
-                        .filter(|_| opts.family == Family::Ecp5)
-                        .map(|f| f.dsps),
+                    dsps: placed.filter(|_| opts.family.get().dsps).map(|f| f.dsps),
                     pareto_cost: false,
                     pareto_speed: false,
                 });

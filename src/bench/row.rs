@@ -36,7 +36,7 @@ pub struct Row {
     /// None).
     pub ice40_too_big: bool,
     /// The family placed (`bench --family`); left out of bench.json for the iCE40.
-    #[serde(skip_serializing_if = "is_ice40")]
+    #[serde(skip_serializing_if = "is_default_family")]
     pub family: Family,
     /// Lanes of the placed design (`bench --lanes`); the error and model speed are the same
     /// for every lane. Left out of bench.json when 1.
@@ -50,8 +50,9 @@ pub struct Row {
     pub pareto_speed: bool,
 }
 
-fn is_ice40(f: &Family) -> bool {
-    *f == Family::Ice40
+/// Whether `f` is the default family (left out of bench.json then).
+fn is_default_family(f: &Family) -> bool {
+    *f == Family::default()
 }
 
 fn is_one(n: &u32) -> bool {
@@ -71,6 +72,6 @@ impl Row {
     /// Whether the FPGA columns are the default's (iCE40, one lane): the tables then have the
     /// columns they had before `bench --family` and `--lanes`.
     pub fn default_fpga(&self) -> bool {
-        self.family == Family::Ice40 && self.lanes == 1
+        self.family == Family::default() && self.lanes == 1
     }
 }

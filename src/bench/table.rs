@@ -11,7 +11,7 @@ use crate::flow::fpga::Family;
 /// The family and lane count of the rows' FPGA columns (every row of a run has the same),
 /// and whether they are the default's.
 fn fpga(rows: &[Row]) -> (Family, u32, bool) {
-    rows.first().map_or((Family::Ice40, 1, true), |r| {
+    rows.first().map_or((Family::default(), 1, true), |r| {
         (r.family, r.lanes, r.default_fpga())
     })
 }

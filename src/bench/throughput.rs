@@ -45,7 +45,7 @@ pub struct Sweep {
 /// The lane counts of the full sweep.
 pub const LANES: [u32; 4] = [1, 2, 4, 8];
 /// The families of the full sweep.
-pub const FAMILIES: [Family; 2] = [Family::Ice40, Family::Ecp5];
+pub const FAMILIES: [Family; Family::ALL.len()] = Family::ALL;
 /// Seeds of the full sweep: 1..=SEEDS.
 pub const SEEDS: u64 = 5;
 /// The placer's target in the sweep, MHz: above what either part reaches with this design,
@@ -132,7 +132,7 @@ pub fn run(sweep: &Sweep, out: &StagedDir, progress: &dyn Fn(&str)) -> Result<Ve
                     mult,
                     ..Config::default()
                 }
-                .for_target(Target::Ice40);
+                .for_target(Target::Family(family));
                 cfg.validate()?;
                 let name = format!("{}-l{lanes}-{}", family.name(), mult.name());
                 let logs = out.path().join(&name);
@@ -196,7 +196,7 @@ fn configuration(
             .err()
             .and_then(|e| e.downcast_ref::<fpga::DoesNotFit>())
             .is_some_and(|d| d.pins);
-        if pins && family == Family::Ecp5 && !opts.out_of_context {
+        if pins && family.get().out_of_context && !opts.out_of_context {
             progress(&format!(
                 "{name}: more port bits than pins; placing out of context"
             ));

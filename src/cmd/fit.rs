@@ -201,10 +201,8 @@ pub fn run(a: &FitArgs) -> Result<()> {
         d.target.describe(),
         match d.cost {
             CostKind::Bits => "ROM + map bits".to_string(),
-            CostKind::Cells => match d.family {
-                crate::flow::fpga::Family::Ice40 => "Yosys cells".to_string(),
-                f => format!("Yosys cells ({} synthesis)", f.title()),
-            },
+            CostKind::Cells if d.family == Default::default() => "Yosys cells".to_string(),
+            CostKind::Cells => format!("Yosys cells ({} synthesis)", d.family.title()),
         }
     )?;
     match d.cost {

@@ -5,7 +5,7 @@
 //! reported, not an error.
 
 use super::config_args::ConfigArgs;
-use crate::flow::fpga::{self, Family, Options};
+use crate::flow::fpga::{self, Options};
 use crate::output::StagedDir;
 use anyhow::{Context, Result};
 use clap::Args;
@@ -58,8 +58,10 @@ pub fn run(a: &FpgaArgs) -> Result<()> {
     );
     // Refused before the log directory is made: bad input writes nothing.
     anyhow::ensure!(
-        !a.ooc || a.part.family() == Family::Ecp5,
-        "--ooc (out-of-context place and route) is for --family ecp5 only; nextpnr-ice40 has no such mode"
+        !a.ooc || a.part.family().get().out_of_context,
+        "--ooc (out-of-context place and route) is for --family {} only; the {} nextpnr has no such mode",
+        crate::family::Family::names_with(|d| d.out_of_context),
+        a.part.family().title()
     );
     let opts = options(a)?;
     // The design (its directory's manifest, or the flags' configuration) and the part are
@@ -73,7 +75,10 @@ pub fn run(a: &FpgaArgs) -> Result<()> {
             None
         }
         None => {
-            let cfg = a.cfg.resolve()?.for_target(crate::config::Target::Ice40);
+            let cfg = a
+                .cfg
+                .resolve()?
+                .for_target(crate::config::Target::Family(opts.family));
             cfg.validate()?;
             Some(cfg)
         }

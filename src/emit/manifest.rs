@@ -75,6 +75,22 @@ pub fn memories(cfg: &Config) -> Vec<Memory> {
     stages::top(cfg).memories(cfg)
 }
 
+/// The block RAMs of `family` that memory `m` takes, as Yosys maps it (a copy per read port
+/// where a block has fewer; the FPGA checks compare with Yosys, memory by memory).
+pub fn block_rams_of(m: &Memory, family: crate::family::Family) -> u32 {
+    family.get().block_ram.blocks(m.entries, m.width, m.reads)
+}
+
+/// The block RAMs of `family` that `cfg`'s memories take, written for it (`--target
+/// <family>`: what `rmapgen fpga --family <family>` places).
+pub fn block_rams(cfg: &Config, family: crate::family::Family) -> u32 {
+    let cfg = cfg.for_target(crate::config::Target::Family(family));
+    memories(&cfg)
+        .iter()
+        .map(|m| block_rams_of(m, family))
+        .sum()
+}
+
 impl Manifest {
     /// The manifest of configuration `cfg` whose maps are `scene`'s, listing `files`, with
     /// `vectors` when the directory holds test vectors.
@@ -137,7 +153,7 @@ mod tests {
         assert_eq!(m.memory_bits, cfg.rom_total_bits() + cfg.bank_total_bits());
         assert_eq!(m.latency, 24);
         // iCE40: the atan ROM twice, one copy per read port.
-        let ice40 = cfg.for_target(crate::config::Target::Ice40);
+        let ice40 = cfg.for_target(crate::config::Target::Family(crate::family::Family::Ice40));
         let m = Manifest::new(&ice40, &Scene::standard(), None, vec![]);
         assert_eq!(m.memory_bits, 1280 + 2 * 1536 + 4 * 8192);
         assert_eq!(
@@ -164,9 +180,10 @@ mod tests {
                 one - 1280
             );
             // On the iCE40 every lane has its own.
-            let ice40 = cfg.for_target(crate::config::Target::Ice40);
+            let ice40 = cfg.for_target(crate::config::Target::Family(crate::family::Family::Ice40));
             let one = Manifest::new(
-                &Config::default().for_target(crate::config::Target::Ice40),
+                &Config::default()
+                    .for_target(crate::config::Target::Family(crate::family::Family::Ice40)),
                 &Scene::standard(),
                 None,
                 vec![],

@@ -52,6 +52,43 @@ struct Core {
     tb_params: Vec<TbFile>,
 }
 
+/// A row of the README's "Fits on" table: a part and what this design takes of it.
+struct FitsRow {
+    family: &'static str,
+    part: &'static str,
+    device: &'static str,
+    package: &'static str,
+    boards: &'static str,
+    /// The larger part whose die it is, when nextpnr offers all of it.
+    die: &'static str,
+    logic_cells: u32,
+    block_rams: u32,
+    needs: u32,
+}
+
+/// Every known part of every family ([`crate::family`]), with the block RAMs `cfg` takes there
+/// written for the family's block RAM ([`manifest::block_rams`]).
+fn fits_rows(cfg: &Config) -> Vec<FitsRow> {
+    crate::family::Family::ALL
+        .into_iter()
+        .flat_map(|f| {
+            let needs = manifest::block_rams(cfg, f);
+            let d = f.get();
+            d.parts.iter().map(move |p| FitsRow {
+                family: d.title,
+                part: p.title,
+                device: p.device,
+                package: p.package,
+                boards: if p.boards.is_empty() { "—" } else { p.boards },
+                die: p.die.unwrap_or_default(),
+                logic_cells: p.logic_cells,
+                block_rams: p.block_rams,
+                needs,
+            })
+        })
+        .collect()
+}
+
 #[derive(Template)]
 #[template(path = "pkg/README.md")]
 struct Readme {
@@ -73,6 +110,14 @@ struct Readme {
     memories: Vec<(String, String, String, String)>,
     /// [`crate::config::Target::name`].
     target: &'static str,
+    /// The family the design is written for: its title, its `--target` help and its default
+    /// part's title (None: generic).
+    family: Option<(&'static str, &'static str, &'static str)>,
+    /// Every family's name, as `--target` and `--family` spell them.
+    family_names: String,
+    fits: Vec<FitsRow>,
+    /// The parts of [`Self::fits`] that are a larger part's die: `iCE40-HX4K: iCE40-HX8K; ...`.
+    dies: String,
     /// The edge after which `valid_o` is high for a sample accepted at edge 0.
     valid_edge: u32,
     compensation: bool,
@@ -346,6 +391,22 @@ pub fn readme(design: &Design) -> Result<String> {
         latency_list,
         memories,
         target: cfg.target.name(),
+        family: cfg.target.family().map(|f| {
+            let d = f.get();
+            (d.title, d.target_help, d.default_part().title)
+        }),
+        family_names: crate::family::Family::ALL
+            .iter()
+            .map(|f| format!("`{}`", f.name()))
+            .collect::<Vec<_>>()
+            .join(" or "),
+        fits: fits_rows(cfg),
+        dies: fits_rows(cfg)
+            .iter()
+            .filter(|p| !p.die.is_empty())
+            .map(|p| format!("{}: {}", p.part, p.die))
+            .collect::<Vec<_>>()
+            .join("; "),
         valid_edge: top_latency(cfg) - 1,
         compensation: cfg.compensation,
         table_ram: !cfg.comp_table.is_rom(),

@@ -23,7 +23,7 @@ pub struct OnPart {
 /// the tools) and, with `check`, checks the part and packs the design into it ([`fpga::pack`])
 /// to see whether it fits; without, only Yosys runs.
 pub fn on_part(cfg: &Config, scene: &Scene, part: &fpga::Options, check: bool) -> Result<OnPart> {
-    let cfg = &cfg.for_target(crate::config::Target::Ice40);
+    let cfg = &cfg.for_target(crate::config::Target::Family(part.family));
     let tmp = crate::output::Scratch::new()?;
     let out = crate::output::StagedDir::new(&tmp.path().join("design"), &Default::default())?;
     crate::emit::write_design(&crate::design::Design::for_scene(cfg, scene)?, &out, None)?;

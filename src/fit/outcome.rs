@@ -45,7 +45,7 @@ pub struct Decision {
     pub cost: CostKind,
     /// The family whose synthesis counted the cells; left out of fit.json for the iCE40 (the
     /// default), so a default fit writes what it wrote before the flag.
-    #[serde(skip_serializing_if = "is_ice40")]
+    #[serde(skip_serializing_if = "is_default_family")]
     pub family: crate::flow::fpga::Family,
     /// With `--family`/`--device`: the part every chosen or listed candidate fits.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -71,8 +71,9 @@ pub struct Decision {
     pub seconds: f64,
 }
 
-fn is_ice40(f: &crate::flow::fpga::Family) -> bool {
-    *f == crate::flow::fpga::Family::Ice40
+/// Whether `f` is the default family (left out of the JSON then).
+fn is_default_family(f: &crate::flow::fpga::Family) -> bool {
+    *f == Default::default()
 }
 
 /// The lowest error reachable, when nothing meets the target.

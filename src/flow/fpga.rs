@@ -6,9 +6,11 @@
 //! DSP blocks used, the LUTs, carries and flip-flops Yosys mapped, the critical path, and where
 //! every memory of the manifest went.
 //!
-//! Both families take the design generated with `--target ice40`: its `ram_style = "block"`
-//! attributes keep the two small ROMs in block RAM, where `synth_ecp5` would build the generic
-//! design's from LUTs (docs/ARCHITECTURE.md, "Targets").
+//! Each family takes the design written for its block RAM (`--target <family>`: its
+//! `ram_style = "block"` attributes keep the two small ROMs in block RAM, where the synthesis
+//! would build the generic design's from LUTs, and its read ports; docs/ARCHITECTURE.md,
+//! "Targets and FPGA families"). What differs between the families is their descriptor's
+//! ([`crate::family`]).
 //!
 //! Every memory (reciprocal ROM, both compensation-ROM copies, every map bank with both
 //! buffers) must be in block RAM (`SB_RAM40_4K`, `DP16KD`); a memory that Yosys turned into
@@ -52,7 +54,7 @@ pub struct Options {
 
 impl Default for Options {
     fn default() -> Self {
-        Options::for_family(Family::Ice40)
+        Options::for_family(Family::default())
     }
 }
 
@@ -61,8 +63,8 @@ impl Options {
     pub fn for_family(family: Family) -> Options {
         Options {
             family,
-            device: family.default_device().into(),
-            package: family.default_package().into(),
+            device: family.get().default_device.into(),
+            package: family.get().default_part().package.into(),
             freq_mhz: 125.0,
             seed: 1,
             logs: None,
@@ -136,15 +138,14 @@ impl FpgaReport {
 
     /// The report as lines for people.
     pub fn summary(&self) -> String {
-        let f = self.family;
-        let dsps = match f {
-            Family::Ice40 => String::new(),
-            Family::Ecp5 => format!(
+        let f = self.family.get();
+        let dsps = if f.dsps {
+            format!(
                 ", {} DSP blocks ({}) of {}",
-                self.dsps,
-                f.dsp_key(),
-                self.dsps_available
-            ),
+                self.dsps, f.names.dsp, self.dsps_available
+            )
+        } else {
+            String::new()
         };
         let mut s = format!(
             "Fmax {:.2} MHz on {} ({} at {:.0} MHz), {} logic cells of {}, {} block RAMs ({}) of {}{dsps} ({} {} {}{}, seed {})\n",
@@ -155,9 +156,9 @@ impl FpgaReport {
             self.logic_cells,
             self.logic_cells_available,
             self.block_rams,
-            f.block_ram_cell(),
+            f.block_ram.cell,
             self.block_rams_available,
-            f.title(),
+            f.title,
             self.device,
             self.package,
             if self.out_of_context {
@@ -194,19 +195,12 @@ impl FpgaReport {
 /// Whether the family's Yosys and nextpnr both run (the programs YOSYS and NEXTPNR, or
 /// YOSYS_ECP5 and NEXTPNR_ECP5, name, see [`crate::toolchain`]).
 pub fn tools_available(opts: &Options) -> bool {
-    let yosys = match opts.family {
-        Family::Ice40 => yosys::available(),
-        Family::Ecp5 => {
-            toolchain::capture(std::process::Command::new(yosys::yosys_ecp5()).arg("-V"))
-                .is_ok_and(|r| r.success())
-        }
-    };
-    yosys && nextpnr::available(opts.family)
+    yosys::available_for(opts.family.get()) && nextpnr::available(opts.family)
 }
 
-/// Generates `cfg`'s design with `--target ice40` (block-RAM attributes, whatever
-/// `cfg.target` says; the standard scene's maps) into a temporary directory and runs the flow
-/// of `opts.family` on it.
+/// Generates `cfg`'s design for `opts.family`'s block RAM (`--target <family>`: block-RAM
+/// attributes and the family's read ports, whatever `cfg.target` says; the standard scene's
+/// maps) into a temporary directory and runs the flow of `opts.family` on it.
 pub fn report(cfg: &Config, opts: &Options) -> Result<FpgaReport> {
     report_with(cfg, opts, &|_| {})
 }
@@ -214,7 +208,7 @@ pub fn report(cfg: &Config, opts: &Options) -> Result<FpgaReport> {
 /// [`report`], telling `step` what it starts: generating, synthesising, placing and routing.
 pub fn report_with(cfg: &Config, opts: &Options, step: &dyn Fn(&str)) -> Result<FpgaReport> {
     cfg.validate()?;
-    let cfg = &cfg.for_target(Target::Ice40);
+    let cfg = &cfg.for_target(Target::Family(opts.family));
     step(&format!("generating {}", cfg.summary()));
     let tmp = crate::output::Scratch::new()?;
     let out = StagedDir::new(&tmp.path().join("rtl"), &Default::default())?;
@@ -342,12 +336,16 @@ impl Utilisation {
     /// not counted: a core's ports are nets inside the larger design it goes into.
     pub fn shortage(&self) -> Option<String> {
         let f = self.family;
-        [f.logic_key(), f.block_ram_key(), f.dsp_key()]
-            .into_iter()
-            .find_map(|k| {
-                let (used, available) = self.of(k);
-                (used > available).then(|| ran_out(k, used, available))
-            })
+        [
+            f.get().names.logic,
+            f.get().names.block_ram,
+            f.get().names.dsp,
+        ]
+        .into_iter()
+        .find_map(|k| {
+            let (used, available) = self.of(k);
+            (used > available).then(|| ran_out(k, used, available))
+        })
     }
 }
 
@@ -391,7 +389,7 @@ pub fn run_dir(dir: &Path, opts: &Options) -> Result<FpgaReport> {
 pub fn run_dir_with(dir: &Path, opts: &Options, step: &dyn Fn(&str)) -> Result<FpgaReport> {
     step(&format!(
         "synthesising with Yosys {}",
-        opts.family.synth_pass()
+        opts.family.get().synth_pass
     ));
     let syn = synthesise(dir, opts)?;
     step(&format!(
@@ -411,7 +409,7 @@ pub struct Synthesis {
     logs: PathBuf,
     /// The temporary log directory when `Options::logs` named none (removed on drop).
     _scratch: Option<crate::output::Scratch>,
-    stat: yosys::Ice40Stat,
+    stat: yosys::SynthStat,
     memories: Vec<MemoryPlacement>,
 }
 
@@ -422,8 +420,13 @@ impl Synthesis {
     }
 
     /// What Yosys mapped the design to.
-    pub fn stat(&self) -> &yosys::Ice40Stat {
+    pub fn stat(&self) -> &yosys::SynthStat {
         &self.stat
+    }
+
+    /// Every memory of the manifest and the block RAMs Yosys mapped it to.
+    pub fn memories(&self) -> &[MemoryPlacement] {
+        &self.memories
     }
 }
 
@@ -468,8 +471,10 @@ fn check_options(opts: &Options) -> Result<()> {
     );
     // nextpnr-ice40 has no out-of-context mode: its pins are few and its designs small.
     anyhow::ensure!(
-        !opts.out_of_context || opts.family == Family::Ecp5,
-        "out-of-context place and route (--ooc) is for --family ecp5 only; nextpnr-ice40 has no such mode"
+        !opts.out_of_context || opts.family.get().out_of_context,
+        "out-of-context place and route (--ooc) is for --family {} only; the {} nextpnr has no such mode",
+        crate::family::Family::names_with(|d| d.out_of_context),
+        opts.family.title()
     );
     Ok(())
 }
@@ -552,10 +557,7 @@ pub fn synthesise_for(dir: &Path, opts: &Options, part: bool) -> Result<Synthesi
         }
     };
     let json = logs.join(format!("{top}.json"));
-    let stat = match family {
-        Family::Ice40 => yosys::synth_ice40(dir, &top, &files, &logs)?,
-        Family::Ecp5 => yosys::synth_ecp5(dir, &top, &files, &logs)?,
-    };
+    let stat = yosys::synthesise(family.get(), dir, &top, &files, &logs)?;
 
     // Which block RAMs hold which memory: Yosys names them <memory>.<row>.<column>.
     let netlist: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json)?)
@@ -565,7 +567,7 @@ pub fn synthesise_for(dir: &Path, opts: &Options, part: bool) -> Result<Synthesi
         .context("no top module in the netlist")?;
     let rams: Vec<&String> = cells
         .iter()
-        .filter(|(_, c)| c["type"] == family.block_ram_cell())
+        .filter(|(_, c)| c["type"] == family.get().block_ram.cell)
         .map(|(n, _)| n)
         .collect();
     let memories: Vec<MemoryPlacement> = mems
@@ -585,17 +587,18 @@ pub fn synthesise_for(dir: &Path, opts: &Options, part: bool) -> Result<Synthesi
         .map(|x| x.instance.as_str())
         .collect();
     if !lost.is_empty() {
-        let hint = if target_of_design == Target::Ice40 {
+        let hint = if target_of_design == Target::Family(family) {
             String::new()
         } else {
             format!(
-                "; the design was generated for --target {}: generate it with --target ice40 for block-RAM attributes and one ROM copy per read port",
-                target_of_design.name()
+                "; the design was generated for --target {}: generate it with --target {} for block-RAM attributes and its block RAM's read ports",
+                target_of_design.name(),
+                family.name()
             )
         };
         bail!(
             "memories fell back to logic instead of {} block RAM: {} (log: {}){hint}",
-            family.block_ram_cell(),
+            family.get().block_ram.cell,
             lost.join(", "),
             logs.join("yosys.log").display()
         );
@@ -715,6 +718,7 @@ pub fn place(syn: &Synthesis, opts: &Options) -> Result<FpgaReport> {
             }
         });
     let stat = &syn.stat;
+    let names = &family.get().names;
     Ok(FpgaReport {
         family,
         device: opts.device.clone(),
@@ -725,12 +729,12 @@ pub fn place(syn: &Synthesis, opts: &Options) -> Result<FpgaReport> {
         clock,
         fmax_mhz,
         timing_met: fmax_mhz >= opts.freq_mhz,
-        logic_cells: util(family.logic_key(), "used"),
-        logic_cells_available: util(family.logic_key(), "available"),
-        block_rams: util(family.block_ram_key(), "used"),
-        block_rams_available: util(family.block_ram_key(), "available"),
-        dsps: util(family.dsp_key(), "used"),
-        dsps_available: util(family.dsp_key(), "available"),
+        logic_cells: util(names.logic, "used"),
+        logic_cells_available: util(names.logic, "available"),
+        block_rams: util(names.block_ram, "used"),
+        block_rams_available: util(names.block_ram, "available"),
+        dsps: util(names.dsp, "used"),
+        dsps_available: util(names.dsp, "available"),
         luts: stat.luts,
         carries: stat.carries,
         flip_flops: stat.flip_flops,

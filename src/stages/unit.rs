@@ -83,6 +83,9 @@ pub struct Memory {
     pub width: u32,
     pub bits: u64,
     pub writable: bool,
+    /// Synchronous reads of the array in one clock (its read ports): a block RAM with fewer
+    /// read ports holds a copy per port ([`crate::family::BlockRam::blocks`]).
+    pub reads: u32,
 }
 
 impl Memory {
@@ -104,7 +107,14 @@ impl Memory {
             width,
             bits: entries as u64 * width as u64,
             writable,
+            reads: 1,
         }
+    }
+
+    /// The same array read through `reads` ports in one clock (1 unless said).
+    pub fn with_reads(mut self, reads: u32) -> Memory {
+        self.reads = reads;
+        self
     }
 
     /// The same array as seen from the module that instantiates its owner as `instance`.

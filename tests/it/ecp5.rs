@@ -10,12 +10,12 @@
 
 use crate::hdl;
 use crate::helpers;
-use rmapgen::toolchain::{self, nextpnr, yosys};
+use rmapgen::toolchain::{self, nextpnr};
 use rmapgen::{emit, flow::fpga};
 
 pub(crate) fn ecp5_tools() -> bool {
     let found = toolchain::installed(&nextpnr::nextpnr(fpga::Family::Ecp5))
-        && toolchain::installed(&yosys::yosys_ecp5());
+        && toolchain::installed(&toolchain::tool(&fpga::Family::Ecp5.get().yosys));
     if !found {
         if std::env::var("CI").is_ok_and(|v| v == "true") {
             panic!("the ECP5 tools are not installed and CI=true: run `make venv`");
@@ -88,7 +88,7 @@ fn ecp5_fails_on_a_memory_in_logic() {
     ]);
     helpers::assert_error(&o, "fell back to logic instead of DP16KD block RAM");
     helpers::assert_error(&o, "u_normalise.u_recip_rom.rom");
-    helpers::assert_error(&o, "generate it with --target ice40");
+    helpers::assert_error(&o, "generate it with --target ecp5");
     assert!(!String::from_utf8_lossy(&o.stderr).contains("u_map_lookup"));
     assert_eq!(
         helpers::entries(&dir),
@@ -115,8 +115,8 @@ fn ecp5_report_gives_a_missed_target_as_a_figure_with_every_memory_in_dp16kd() {
         "{r:?}"
     );
     assert_eq!(r.family, fpga::Family::Ecp5);
-    let ice40 = cfg.for_target(rmapgen::config::Target::Ice40);
-    assert_eq!(r.memories.len(), emit::manifest::memories(&ice40).len());
+    let ecp5 = cfg.for_target(rmapgen::config::Target::Family(fpga::Family::Ecp5));
+    assert_eq!(r.memories.len(), emit::manifest::memories(&ecp5).len());
     assert!(r.in_logic().is_empty(), "{r:?}");
     assert_eq!(
         r.block_rams,
@@ -193,7 +193,7 @@ fn out_of_context_is_refused_for_the_ice40_in_one_line_and_writes_nothing() {
     let o = helpers::run(&["fpga", "--ooc", "--logs", l.to_str().unwrap()]);
     helpers::assert_error(
         &o,
-        "--ooc (out-of-context place and route) is for --family ecp5 only",
+        "--ooc (out-of-context place and route) is for --family ecp5 only; the iCE40 nextpnr has no such mode",
     );
     assert!(!l.exists(), "the log directory was made");
     // The sweep's own flags: a lane count out of range, a flag of the sweep without it.
@@ -274,7 +274,10 @@ fn ecp5_out_of_context_times_clk_i_with_every_memory_in_dp16kd() {
         "IO buffers placed"
     );
     assert!(!logs
-        .join(fpga::Family::Ecp5.bitstream_file("rmap_top"))
+        .join(rmapgen::toolchain::nextpnr::bitstream_file(
+            fpga::Family::Ecp5,
+            "rmap_top"
+        ))
         .exists());
     assert!(r.summary().contains("on clk_i") && r.summary().contains("out of context"));
 }

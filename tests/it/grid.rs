@@ -13,6 +13,7 @@
 use crate::hdl::{self, require};
 use crate::helpers;
 use rmapgen::config::{CompTable, Mult, Target, PIPELINE_DEPTHS, RANGES};
+use rmapgen::family::Family;
 use rmapgen::grid::{self, GridRow};
 use std::path::Path;
 
@@ -182,7 +183,7 @@ fn grid_covers_every_range_end_and_switch() {
     }
     // Both memory targets, each with and without the compensation ROM (whose read ports are
     // what differs most between them).
-    for target in [Target::Generic, Target::Ice40] {
+    for target in [Target::Generic, Target::Family(Family::Ice40)] {
         for comp in [false, true] {
             assert!(
                 rows.iter()
@@ -205,16 +206,18 @@ fn grid_covers_every_range_end_and_switch() {
     }
     assert!(rows
         .iter()
-        .any(|r| r.config.lanes > 1 && r.config.target == Target::Ice40));
-    assert!(rows
-        .iter()
-        .any(|r| r.config.lanes > 1 && r.config.target == Target::Ecp5 && r.icarus));
+        .any(|r| r.config.lanes > 1 && r.config.target == Target::Family(Family::Ice40)));
+    assert!(rows.iter().any(|r| r.config.lanes > 1
+        && r.config.target == Target::Family(Family::Ecp5)
+        && r.icarus));
     // Icarus runs a subset that still has every optional stage and both interfaces.
     let ic: Vec<&GridRow> = rows.iter().filter(|r| r.icarus).collect();
     assert!(ic.len() >= 5);
     assert!(ic.iter().any(|r| r.config.color) && ic.iter().any(|r| !r.config.compensation));
     assert!(ic.iter().any(|r| r.config.handshake) && ic.iter().any(|r| !r.config.interpolation));
-    assert!(ic.iter().any(|r| r.config.target == Target::Ice40));
+    assert!(ic
+        .iter()
+        .any(|r| r.config.target == Target::Family(Family::Ice40)));
     assert!(ic.iter().any(|r| r.config.axis && r.config.axis_user > 0));
     // Inferred multipliers (--mult infer): the paper's design, colour, the widest widths, the
     // handshake, every depth (each places the products' registers differently), in Icarus too.
@@ -246,7 +249,11 @@ fn grid_covers_every_range_end_and_switch() {
         .collect();
     assert!(ram.iter().any(|r| r.config.handshake) && ram.iter().any(|r| !r.config.handshake));
     assert!(ram.iter().any(|r| r.config.lanes > 1) && ram.iter().any(|r| r.icarus));
-    for target in [Target::Generic, Target::Ice40, Target::Ecp5] {
+    for target in [
+        Target::Generic,
+        Target::Family(Family::Ice40),
+        Target::Family(Family::Ecp5),
+    ] {
         assert!(
             ram.iter().any(|r| r.config.target == target),
             "no row with the loaded table and target {target:?}"

@@ -333,14 +333,25 @@ fn cycles_through_doc_links_aliases_and_relative_paths_are_found() {
 /// the design writer above the stages, and the flows and proofs that read a written design.
 const LAYERS: [&str; 6] = ["hdl", "stages", "emit", "flow", "prove", "cmd"];
 
-/// The imports that point upward: a layer of [`LAYERS`] using a later one, `config` using anything but `toml_input`, or a stage's
-/// bit-accurate model (`stages::<stage>::model`, the definition the generator, the vectors and
-/// the renders build on) reaching back into any of them or into a stage's generator unit.
+/// What `config` may import: the TOML reader and the family descriptors (data).
+const BELOW_CONFIG: [&str; 2] = ["toml_input", "family"];
+
+/// The imports that point upward: a layer of [`LAYERS`] using a later one, `config` using
+/// anything but [`BELOW_CONFIG`], `family` (the FPGA families' descriptors, the bottom layer)
+/// using anything of rmapgen, or a stage's bit-accurate model (`stages::<stage>::model`, the
+/// definition the generator, the vectors and the renders build on) reaching back into any of
+/// them or into a stage's generator unit.
 fn upward_imports(g: &BTreeMap<String, BTreeSet<String>>) -> Vec<String> {
     let mut out = Vec::new();
+    let top_of = |m: &str| m.split("::").next().unwrap_or("").to_string();
     for d in g.get("config").into_iter().flatten() {
-        if d != "toml_input" {
+        if !BELOW_CONFIG.contains(&top_of(d).as_str()) {
             out.push(format!("config -> {d}"));
+        }
+    }
+    for (m, deps) in g.iter().filter(|(m, _)| top_of(m) == "family") {
+        for d in deps.iter().filter(|d| top_of(d) != "family") {
+            out.push(format!("{m} -> {d}"));
         }
     }
     let above = [
@@ -390,9 +401,14 @@ fn planted_upward_imports_are_found() {
     let mods: BTreeMap<String, String> = [
         (
             "config",
-            "use crate::toml_input;\nuse crate::rtl::ports::Port;\n",
+            "use crate::toml_input;\nuse crate::family::Family;\nuse crate::rtl::ports::Port;\n",
         ),
         ("toml_input", ""),
+        ("family", "mod ice40;\n"),
+        (
+            "family::ice40",
+            "use super::Descriptor;\nuse crate::config::Target;\n",
+        ),
         ("rtl", ""),
         ("rtl::ports", ""),
         ("hdl", ""),
@@ -416,6 +432,7 @@ fn planted_upward_imports_are_found() {
         upward_imports(&graph(&mods)),
         [
             "config -> rtl::ports",
+            "family::ice40 -> config",
             "emit::tb -> prove",
             "hdl::ports -> stages",
             "stages::sort_shift::model -> stages::normalise"

@@ -294,7 +294,9 @@ fn ice40_report_gives_a_missed_target_as_a_figure() {
         "{r:?}"
     );
     // The report is of the design built for the iCE40, whatever the configuration's target.
-    let ice40 = cfg.for_target(rmapgen::config::Target::Ice40);
+    let ice40 = cfg.for_target(rmapgen::config::Target::Family(
+        rmapgen::family::Family::Ice40,
+    ));
     assert_eq!(r.memories.len(), emit::manifest::memories(&ice40).len());
     assert!(r.in_logic().is_empty());
     assert_eq!(

@@ -70,8 +70,8 @@ module {= h.module =}{= h.params =} (
 // Distortion compensation (atan) ROM: turns a normalised fraction u = tan(angle) into a map
 // position, so that equal position steps are equal steps in angle: entry u holds
 // round(atan(u / 2^F) / (pi/4) * POS_MAX), the all-ones code standing for tan = 1
-// (contents: rmapgen's model, atan_rom::contents).{% if ice40 %} u and v each read their own copy of the
-// table (--target ice40), so each is a single-port synchronous ROM that maps to its own block
+// (contents: rmapgen's model, atan_rom::contents).{% if copies %} u and v each read their own copy of the
+// table (--target {= target =}), so each is a single-port synchronous ROM that maps to its own block
 // RAM.{% else %} u and v read one table through two synchronous read ports
 // (a true dual-port block RAM where the device has one).{% endif %}{% if out_reg %} A fabric
 // register follows the block RAM's output register (pipeline_depth >= 1).{% endif %} Latency {= latency =}.
@@ -83,7 +83,7 @@ module {= h.module =}{= h.params =} (
   localparam ENTRIES = {= entries =};  // 2^F, one per fraction code
   localparam LATENCY = {= latency =};
 
-{%- if ice40 %}
+{%- if copies %}
   // ram_style: block RAM even where Yosys would build a small table from LUTs.
   (* ram_style = "block" *)
   reg [POS-1:0] rom_u [0:ENTRIES-1];

@@ -18,13 +18,13 @@ use askama::Template;
 
 pub struct AtanRom;
 
-/// The table's arrays: one copy per read port (u, v) for the iCE40, whose block RAM has one
+/// The table's arrays: one copy per read port (u, v) for a target whose block RAM has one
 /// read port, and for the RAM (two reads and a write are more ports than a block RAM has);
 /// one ROM array read through two ports otherwise.
 fn arrays(cfg: &Config) -> Vec<&'static str> {
     if ram(cfg) {
         vec!["ram_u", "ram_v"]
-    } else if cfg.target.ice40() {
+    } else if cfg.target.read_ports() == 1 {
         vec!["rom_u", "rom_v"]
     } else {
         vec!["rom"]
@@ -58,7 +58,8 @@ struct Verilog {
     latency: u32,
     out_reg: bool,
     param: String,
-    ice40: bool,
+    /// One ROM copy per read port (a block RAM with one read port).
+    copies: bool,
     /// Block-RAM attributes on the one array (true dual-port targets but generic).
     attrs: bool,
     target: &'static str,
@@ -116,6 +117,8 @@ impl Unit for AtanRom {
                     cfg.pos_bits(),
                     ram(cfg),
                 )
+                // u and v: one array read twice, or a copy each.
+                .with_reads(2 / arrays(cfg).len() as u32)
             })
             .collect()
     }
@@ -126,7 +129,7 @@ impl Unit for AtanRom {
             latency: self.latency(cfg).expect("fixed"),
             out_reg: out_reg(cfg),
             param: file_param(self.name()),
-            ice40: cfg.target.ice40(),
+            copies: cfg.target.read_ports() == 1,
             attrs: cfg.target.block_attrs(),
             target: cfg.target.name(),
             rom_u: arrays(cfg)[0],

@@ -45,10 +45,10 @@ pub fn reader_ports(cfg: &Config) -> Vec<Port> {
 
 /// Whether this configuration's ROM has the two read ports of [`PORTS`] (it lives in
 /// rmap_lanes, shared by two lanes) rather than one inside normalise: with lanes, on a target
-/// whose block RAM is true dual-port (every target but `ice40`). Defined here, below
+/// whose block RAM is true dual-port (read ports 2: generic and the ECP5). Defined here, below
 /// normalise, rmap_top and rmap_lanes, which all ask it.
 pub fn dual(cfg: &Config) -> bool {
-    cfg.lanes > 1 && !cfg.target.ice40()
+    cfg.lanes > 1 && cfg.target.read_ports() == 2
 }
 
 /// Its `$readmemh` file, `<module>.hex`.
@@ -114,7 +114,8 @@ impl Unit for RecipRom {
             cfg.recip_entries(),
             cfg.recip_bits,
             false,
-        )]
+        )
+        .with_reads(if dual(cfg) { 2 } else { 1 })]
     }
 
     fn render(&self, cfg: &Config, h: Head) -> askama::Result<String> {

@@ -500,13 +500,14 @@ mod tests {
     #[test]
     fn two_lanes_share_a_reciprocal_rom_where_the_block_ram_is_dual_port() {
         use crate::config::Target;
+        use crate::family::Family;
         // Lane 2j on port a, lane 2j+1 on port b of ROM j.
         assert_eq!(
             (0..5).map(recip_read).collect::<Vec<_>>(),
             [(0, 0), (0, 1), (1, 0), (1, 1), (2, 0)]
         );
         for (l, roms) in [(2, 1), (3, 2), (8, 4)] {
-            for t in [Target::Generic, Target::Ecp5] {
+            for t in [Target::Generic, Target::Family(Family::Ecp5)] {
                 let cfg = lanes(l, false, false).for_target(t);
                 assert!(recip_rom::dual(&cfg));
                 assert_eq!(recip_roms(&cfg), roms);
@@ -527,7 +528,7 @@ mod tests {
                 );
             }
             // The iCE40's SB_RAM40_4K has one read port: each lane keeps its own ROM.
-            let cfg = lanes(l, false, false).for_target(Target::Ice40);
+            let cfg = lanes(l, false, false).for_target(Target::Family(Family::Ice40));
             assert!(!recip_rom::dual(&cfg));
             assert_eq!(recip_roms(&cfg), 0);
             assert!(RmapTop

