@@ -27,9 +27,9 @@ module rmap_top #(
   input  wire [11:0] gx_i,       // G-bit two's complement
   input  wire [11:0] gy_i,
   input  wire [11:0] gz_i,
-  input  wire [7:0]  r_i,        // sample colour
-  input  wire [7:0]  g_i,
-  input  wire [7:0]  b_i,
+  input  wire [7:0]  r_i,        // sample colour channel
+  input  wire [7:0]  g_i,        // sample colour channel
+  input  wire [7:0]  b_i,        // sample colour channel
   input  wire        swap_i,     // exchange front and back map buffers
   input  wire        wr_en_i,    // host write into the back buffer
   input  wire [1:0]  wr_axis_i,
@@ -38,9 +38,9 @@ module rmap_top #(
   output wire        valid_o,    // a result is on the outputs (high one clock per sample)
   output wire        zero_o,     // the sample's gradient was zero
   output wire [7:0]  i_o,        // intensity (0 when zero_o)
-  output wire [7:0]  r_o,        // colour times intensity
-  output wire [7:0]  g_o,
-  output wire [7:0]  b_o
+  output wire [7:0]  r_o,        // colour channel times the intensity
+  output wire [7:0]  g_o,        // colour channel times the intensity
+  output wire [7:0]  b_o         // colour channel times the intensity
 );
 
   localparam R   = 8;  // reduced magnitude width

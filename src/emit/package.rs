@@ -497,11 +497,9 @@ fn describe(name: &str, note: &str) -> String {
         "gx_i" => "gradient x component, G-bit two's complement",
         "gy_i" => "gradient y component, G-bit two's complement",
         "gz_i" => "gradient z component, G-bit two's complement",
-        "r_i" | "g_i" | "b_i" => "sample colour channel",
         "wr_axis_i" => "host write: axis map (0 x, 1 y, 2 z)",
         "wr_data_i" => "host write: entry",
         "wr_addr_i" => "host write: logical map address",
-        "r_o" | "g_o" | "b_o" => "colour channel times the intensity",
         _ => "",
     };
     match (base.is_empty(), note.is_empty()) {
@@ -510,5 +508,34 @@ fn describe(name: &str, note: &str) -> String {
         (false, true) => base.to_string(),
         (false, false) if base.contains(note) => base.to_string(),
         (false, false) => format!("{base}: {note}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A port's description never says its name's description and a note that repeats it
+    /// ("colour channel times the intensity: colour times intensity"): every port of the top of
+    /// every grid row, the colour ones included.
+    #[test]
+    fn no_port_description_says_a_thing_twice() {
+        for row in crate::grid::rows() {
+            let cfg = &row.config;
+            for p in TOP.ports(cfg) {
+                let d = describe(p.name, p.note);
+                if let Some((base, note)) = d.split_once(": ") {
+                    let words = |s: &str| {
+                        s.split(|c: char| !c.is_alphanumeric())
+                            .filter(|w| w.len() > 2)
+                            .map(str::to_lowercase)
+                            .collect::<Vec<_>>()
+                    };
+                    let base = words(base);
+                    let said = words(note).iter().filter(|w| base.contains(w)).count();
+                    assert!(said * 2 < words(note).len().max(1), "{}: {d}", p.name);
+                }
+            }
+        }
     }
 }

@@ -147,9 +147,9 @@ impl Unit for RmapTop {
             i("gz_i", g, ""),
         ];
         if cfg.color {
-            v.push(i("r_i", COLOR_BITS, "sample colour"));
-            v.push(i("g_i", COLOR_BITS, ""));
-            v.push(i("b_i", COLOR_BITS, ""));
+            v.push(i("r_i", COLOR_BITS, "sample colour channel"));
+            v.push(i("g_i", COLOR_BITS, "sample colour channel"));
+            v.push(i("b_i", COLOR_BITS, "sample colour channel"));
         }
         v.push(i("swap_i", 1, "exchange front and back map buffers"));
         v.push(i("wr_en_i", 1, "host write into the back buffer"));
@@ -195,9 +195,9 @@ impl Unit for RmapTop {
         v.push(o("zero_o", 1, "the sample's gradient was zero"));
         v.push(o("i_o", mb, "intensity (0 when zero_o)"));
         if cfg.color {
-            v.push(o("r_o", COLOR_BITS, "colour times intensity"));
-            v.push(o("g_o", COLOR_BITS, ""));
-            v.push(o("b_o", COLOR_BITS, ""));
+            v.push(o("r_o", COLOR_BITS, "colour channel times the intensity"));
+            v.push(o("g_o", COLOR_BITS, "colour channel times the intensity"));
+            v.push(o("b_o", COLOR_BITS, "colour channel times the intensity"));
         }
         if cfg.side_bits() > 0 {
             v.push(o("side_o", cfg.side_bits(), "side_i of the sample"));
