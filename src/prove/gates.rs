@@ -390,4 +390,265 @@ mod tests {
         std::fs::write(&f, "assign b = 1'bz;\n").unwrap();
         assert!(no_undefined_literal(&f).is_err());
     }
+
+    /// An and-inverter graph built by hand: literals as AIGER writes them (2 x variable, +1
+    /// complemented), gates structurally hashed.
+    struct Builder {
+        ands: Vec<(u32, u32, u32)>,
+        next: u32,
+        seen: std::collections::HashMap<(u32, u32), u32>,
+    }
+
+    impl Builder {
+        fn new(inputs: u32) -> Builder {
+            Builder {
+                ands: Vec::new(),
+                next: inputs + 1,
+                seen: Default::default(),
+            }
+        }
+
+        fn and(&mut self, a: u32, b: u32) -> u32 {
+            let (a, b) = (a.max(b), a.min(b));
+            if b == 0 || a == b ^ 1 {
+                return 0;
+            }
+            if b == 1 || a == b {
+                return a;
+            }
+            if let Some(&l) = self.seen.get(&(a, b)) {
+                return l;
+            }
+            let l = 2 * self.next;
+            self.next += 1;
+            self.ands.push((l, a, b));
+            self.seen.insert((a, b), l);
+            l
+        }
+
+        fn or(&mut self, a: u32, b: u32) -> u32 {
+            self.and(a ^ 1, b ^ 1) ^ 1
+        }
+
+        /// The function of `vars` (least significant first) whose value at input `k` is
+        /// `table[k]`: a tree of multiplexers.
+        fn table(&mut self, vars: &[u32], table: &[bool]) -> u32 {
+            match vars.split_last() {
+                None => table[0] as u32,
+                Some((&top, rest)) => {
+                    let half = table.len() / 2;
+                    let lo = self.table(rest, &table[..half]);
+                    let hi = self.table(rest, &table[half..]);
+                    let t = self.and(2 * top, hi);
+                    let e = self.and(2 * top + 1, lo);
+                    self.or(t, e)
+                }
+            }
+        }
+    }
+
+    /// The front of `cfg` (G = 8) as a graph that is the model on the gradient rows `rows`
+    /// (gy and gz fixed, every gx) and 0 elsewhere, with the bits `flip` ((gradient index,
+    /// module, bit)) inverted; placed as [`build`] places Yosys's graph.
+    fn model_front(cfg: &Config, rows: &[u64], flip: &[(u64, usize, u32)]) -> GateFront {
+        let g = cfg.grad_bits;
+        let [zw, sw] = FRONT.map(|u| widths(u, cfg));
+        let width = |w: &[(&str, u32)]| w.iter().map(|(_, b)| b).sum::<u32>();
+        let (zb, sb) = (width(&zw), width(&sw));
+        // Inputs: gx, gy, gz bits (variables 1..=3G), then rst_ni, valid_i, clk_i.
+        let mut map = String::new();
+        let names = ["gx0_i", "gy0_i", "gz0_i"];
+        for (c, n) in names.iter().enumerate() {
+            for b in 0..g {
+                map += &format!("input {} {b} {n}\n", c as u32 * g + b);
+            }
+        }
+        for (k, n) in ["rst_ni", "valid_i", "clk_i"].iter().enumerate() {
+            map += &format!("input {} 0 {n}\n", 3 * g + k as u32);
+        }
+        let inputs = 3 * g + 3;
+        let mut b = Builder::new(inputs);
+        let gx: Vec<u32> = (1..=g).collect();
+        // Per output bit: the OR over the rows of (row selected) AND (the row's table).
+        let mut outs = vec![0u32; (zb + sb) as usize];
+        for &row in rows {
+            let mut sel = 1;
+            for k in 0..2 * g {
+                let v = g + 1 + k;
+                let lit = if (row >> k) & 1 == 1 {
+                    2 * v
+                } else {
+                    2 * v + 1
+                };
+                sel = b.and(sel, lit);
+            }
+            let words: Vec<(u64, u64)> = (0..1u64 << g)
+                .map(|x| {
+                    let idx = (row << g) | x;
+                    let gr = gradient(cfg, idx).map(|v| dec_grad(cfg, v));
+                    let z = zero_detect::eval(gr) as u64;
+                    let s = pack(
+                        &stages::sort_shift::outputs(&sort_shift::eval(cfg, gr)),
+                        &sw,
+                    );
+                    let mut w = (z, s);
+                    for &(at, m, bit) in flip {
+                        if at == idx {
+                            if m == 0 {
+                                w.0 ^= 1 << bit;
+                            } else {
+                                w.1 ^= 1 << bit;
+                            }
+                        }
+                    }
+                    w
+                })
+                .collect();
+            for (o, out) in outs.iter_mut().enumerate() {
+                let o = o as u32;
+                let table: Vec<bool> = words
+                    .iter()
+                    .map(|&(z, s)| {
+                        if o < zb {
+                            (z >> o) & 1 == 1
+                        } else {
+                            (s >> (o - zb)) & 1 == 1
+                        }
+                    })
+                    .collect();
+                let f = b.table(&gx, &table);
+                let t = b.and(sel, f);
+                *out = b.or(*out, t);
+            }
+        }
+        let mut aag = format!(
+            "aag {} {inputs} 0 {} {}\n",
+            b.next - 1,
+            outs.len() + 2,
+            b.ands.len()
+        );
+        for v in 1..=inputs {
+            aag += &format!("{}\n", 2 * v);
+        }
+        for (k, o) in outs.iter().enumerate() {
+            aag += &format!("{o}\n");
+            let (name, bit) = if (k as u32) < zb {
+                ("zero_detect0_o", k as u32)
+            } else {
+                ("sort_shift0_o", k as u32 - zb)
+            };
+            map += &format!("output {k} {bit} {name}\n");
+        }
+        // The valid bits: the held valid_i.
+        for (k, name) in ["zero_detect_valid_o", "sort_shift_valid_o"]
+            .iter()
+            .enumerate()
+        {
+            aag += &format!("{}\n", 2 * (3 * g + 2));
+            map += &format!("output {} 0 {name}\n", outs.len() + k);
+        }
+        for (l, x, y) in &b.ands {
+            aag += &format!("{l} {x} {y}\n");
+        }
+        place(Aig::parse(&aag, &map).unwrap(), cfg).unwrap()
+    }
+
+    /// The gates engine on a front that is the model, built here gate by gate on a few rows:
+    /// every gradient of a row checked, each once (also of part of a row and across rows), no
+    /// failure; every flipped output bit found at its gradient and module, whichever word and
+    /// lane it is in; a gradient whose state is not in the set reported; a row the graph
+    /// gets wrong (all 0) failed. Kills what the integration tests (Yosys's graph of a real
+    /// front) would, without Yosys.
+    #[test]
+    fn a_front_that_is_the_model_passes_and_every_flipped_bit_is_found_where_it_is() {
+        let cfg = &crate::grid::narrowest();
+        let g = cfg.grad_bits;
+        assert_eq!(g, 8);
+        let states = crate::prove::states::enumerate(cfg, |_, _| Ok(())).unwrap();
+        // Row 0 holds the zero gradient; 0x80 has gy = -128; 0xFF01 and 0xFF02 are neighbours.
+        let rows = [0u64, 0x80, 0xFF01, 0xFF02];
+        let gf = model_front(cfg, &rows, &[]);
+        let mut scratch = Vec::new();
+        for &r in &rows {
+            let f = check_row(&gf, cfg, &states, r, (r << g)..((r + 1) << g), &mut scratch);
+            assert_eq!(
+                (f.checked, f.count),
+                (1 << g, 0),
+                "row {r:#x}: {:?}",
+                f.kept
+            );
+        }
+        let first = 0x80 << g;
+        let f = check_row(
+            &gf,
+            cfg,
+            &states,
+            0x80,
+            first + 10..first + 200,
+            &mut scratch,
+        );
+        assert_eq!((f.checked, f.count), (190, 0));
+        // Across two rows, in part.
+        let mut all = Failures::default();
+        let (a, z) = ((0xFF01 << g) + 100, (0xFF03 << g) - 7);
+        check(&gf, cfg, &states, a..z, &mut all, &|_| ()).unwrap();
+        assert_eq!((all.checked, all.count), (z - a, 0), "{:?}", all.kept);
+        // A row the graph does not compute: its gradients fail.
+        let mut wrong = Failures::default();
+        check(
+            &gf,
+            cfg,
+            &states,
+            (3 << g)..(3 << g) + 5,
+            &mut wrong,
+            &|_| (),
+        )
+        .unwrap();
+        assert_eq!((wrong.checked, wrong.count), (5, 5), "{:?}", wrong.kept);
+        assert!(check(&gf, cfg, &states, 7..7, &mut wrong, &|_| ()).is_ok());
+        assert_eq!(wrong.checked, 5);
+
+        // Flipped bits in several words and lanes, of both modules.
+        let sb: u32 = widths(FRONT[1], cfg).iter().map(|(_, w)| w).sum();
+        let flips = [
+            (0u64, 0usize, 0u32),
+            (0x80 << g | 63, 1, 0),
+            (0x80 << g | 64, 1, sb - 1),
+            (0x80 << g | 200, 1, 3),
+            (0x80 << g | 255, 0, 0),
+        ];
+        let bad = model_front(cfg, &rows, &flips);
+        for &(idx, m, _) in &flips {
+            let r = idx >> g;
+            let f = check_row(&bad, cfg, &states, r, idx..idx + 1, &mut scratch);
+            let gr = gradient(cfg, idx).map(|v| dec_grad(cfg, v));
+            assert_eq!((f.checked, f.count), (1, 1), "{idx:#x}");
+            let want = format!("front: {} on gradient {gr:?}: ", FRONT[m].name());
+            assert!(f.kept[0].starts_with(&want), "{} / {want}", f.kept[0]);
+        }
+        let f = check_row(&bad, cfg, &states, 0x80, first..first + 256, &mut scratch);
+        assert_eq!((f.checked, f.count), (256, 4), "{:?}", f.kept);
+
+        // No state in the set: every non-zero gradient is reported, the zero one is not.
+        let none = crate::prove::states::StateSet::new(cfg).unwrap();
+        let f = check_row(&gf, cfg, &none, 0, 0..256, &mut scratch);
+        assert_eq!((f.checked, f.count), (256, 255));
+        assert!(
+            f.kept[0].contains("is not among the states"),
+            "{}",
+            f.kept[0]
+        );
+    }
+
+    #[test]
+    fn the_wrapper_inputs_have_their_roles_and_nothing_else_is_taken() {
+        assert_eq!(role("gx0_i", 3), Some(Role::Grad(0, 3)));
+        assert_eq!(role("gy0_i", 0), Some(Role::Grad(1, 0)));
+        assert_eq!(role("gz0_i", 7), Some(Role::Grad(2, 7)));
+        assert_eq!(role("rst_ni", 0), Some(Role::Held(true)));
+        assert_eq!(role("valid_i", 0), Some(Role::Held(true)));
+        assert_eq!(role("clk_i", 0), Some(Role::Held(false)));
+        assert_eq!(role("gx1_i", 0), None);
+        assert_eq!(role("en_i", 0), None);
+    }
 }

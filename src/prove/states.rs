@@ -26,7 +26,7 @@ pub struct StateSet {
 }
 
 impl StateSet {
-    fn new(cfg: &Config) -> Result<StateSet> {
+    pub(super) fn new(cfg: &Config) -> Result<StateSet> {
         ensure!(
             cfg.red_bits <= MAX_RED_BITS,
             "rmapgen prove keeps one bit per sort & shift state (24 x 2^(3 red_bits - 1)); red_bits = {} is above {MAX_RED_BITS}",
