@@ -672,4 +672,116 @@ mod tests {
         let v = never_loaded(&m);
         assert_eq!(v, vec![("u.hold_q".into(), "s.v:7".into(), "[0]".into())]);
     }
+
+    /// A cell of `kind` with the input pins `pins` (one bit each) and a CLK_ENABLE of `sync`.
+    fn cell(kind: &str, pins: &[&str], sync: Option<&str>) -> Cell {
+        Cell {
+            name: "c".into(),
+            kind: kind.into(),
+            inputs: pins
+                .iter()
+                .map(|p| (p.to_string(), vec![Some(1)]))
+                .collect(),
+            outputs: vec![("Y".into(), vec![Some(2)])],
+            params: sync
+                .map(|v| HashMap::from([("CLK_ENABLE".to_string(), v.to_string())]))
+                .unwrap_or_default(),
+            undefined: Vec::new(),
+            src: String::new(),
+        }
+    }
+
+    /// The netlist reader keeps what Yosys's JSON says: ports with direction and bits
+    /// (constants as None), nets, and each cell's kind, inputs and outputs by the port
+    /// directions, its parameters, its source and the input pins with an `x` or `z` bit.
+    #[test]
+    fn the_netlist_reader_keeps_ports_nets_and_cells_with_their_undefined_pins() {
+        let json = serde_json::json!({"modules": {"top": {
+            "ports": {"a_i": {"direction": "input", "bits": [2, 3]},
+                      "y_o": {"direction": "output", "bits": ["0", 4]}},
+            "netnames": {"w": {"bits": [4]}},
+            "cells": {"$m": {
+                "type": "$mux",
+                "port_directions": {"A": "input", "B": "input", "S": "input", "Y": "output"},
+                "connections": {"A": ["x"], "B": [2], "S": ["z"], "Y": [4]},
+                "parameters": {"WIDTH": "00000000000000000000000000000001"},
+                "attributes": {"src": "top.v:3.1-3.9"}}}}}});
+        let m = module(&json, "top").unwrap();
+        assert_eq!(
+            m.ports["a_i"],
+            ("input".to_string(), vec![Some(2), Some(3)])
+        );
+        assert_eq!(m.ports["y_o"], ("output".to_string(), vec![None, Some(4)]));
+        assert_eq!(m.netnames["w"], vec![Some(4)]);
+        let c = &m.cells[0];
+        assert_eq!((c.name.as_str(), c.kind.as_str()), ("$m", "$mux"));
+        let names = |l: &[(String, Vec<Bit>)]| l.iter().map(|p| p.0.clone()).collect::<Vec<_>>();
+        assert_eq!(names(&c.inputs), ["A", "B", "S"]);
+        assert_eq!(names(&c.outputs), ["Y"]);
+        assert_eq!(c.undefined, ["A", "S"]);
+        assert_eq!(c.params["WIDTH"].len(), 32);
+        assert_eq!(c.src, "top.v:3.1-3.9");
+        assert!(module(&json, "other").is_err());
+        assert_eq!(
+            bits(&serde_json::json!([1, "1", 7])),
+            vec![Some(1), None, Some(7)]
+        );
+        assert!(bits(&serde_json::json!("x")).is_empty());
+    }
+
+    /// Which cells are registers, bitwise or memories, and how each pin passes a sample: a
+    /// register's D through one register, a synchronous read's address through one and an
+    /// asynchronous one's through none, everything else of a register or memory as control,
+    /// any other cell's pins combinationally.
+    #[test]
+    fn cells_and_pins_are_classed_as_the_depth_count_needs() {
+        for k in ["$dff", "$adffe", "$sdff", "$dlatch", "$sr"] {
+            assert!(is_register(k) && bitwise(k), "{k}");
+        }
+        for k in [
+            "$mux", "$pmux", "$and", "$or", "$xor", "$xnor", "$not", "$pos", "$bwmux",
+        ] {
+            assert!(bitwise(k) && !is_register(k), "{k}");
+        }
+        for k in ["$add", "$eq", "$shl", "$memrd_v2", "$reduce_or"] {
+            assert!(!bitwise(k), "{k}");
+        }
+        assert!(is_memory("$mem_v2") && is_memory("$memrd") && !is_memory("$mux"));
+        let dff = cell("$dffe", &["D", "EN", "CLK"], None);
+        assert!(pin_class(&dff, "D") == Pin::Data(1));
+        assert!(pin_class(&dff, "EN") == Pin::Control && pin_class(&dff, "CLK") == Pin::Control);
+        let sync = cell("$memrd_v2", &["ADDR", "EN", "CLK"], Some("1"));
+        assert!(pin_class(&sync, "ADDR") == Pin::Data(1));
+        assert!(pin_class(&sync, "EN") == Pin::Control);
+        let asy = cell("$memrd_v2", &["ADDR"], Some("0"));
+        assert!(pin_class(&asy, "ADDR") == Pin::Data(0));
+        let wr = cell("$memwr_v2", &["ADDR", "DATA"], Some("1"));
+        assert!(pin_class(&wr, "ADDR") == Pin::Control && pin_class(&wr, "DATA") == Pin::Control);
+        let add = cell("$add", &["A", "B"], None);
+        assert!(pin_class(&add, "A") == Pin::Data(0));
+    }
+
+    /// An undefined bit is allowed only on a multiplexer's data inputs and on the clock and
+    /// enable of an asynchronous memory read.
+    #[test]
+    fn undefined_bits_are_allowed_only_where_no_path_reads_them() {
+        for k in ["$mux", "$pmux", "$bwmux"] {
+            let c = cell(k, &["A", "B", "S"], None);
+            assert!(
+                may_be_undefined(&c, "A") && may_be_undefined(&c, "B"),
+                "{k}"
+            );
+            assert!(!may_be_undefined(&c, "S"), "{k}");
+        }
+        let asy = cell("$memrd_v2", &["ADDR", "EN", "CLK"], Some("0"));
+        assert!(may_be_undefined(&asy, "CLK") && may_be_undefined(&asy, "EN"));
+        assert!(!may_be_undefined(&asy, "ADDR"));
+        let sync = cell("$memrd_v2", &["ADDR", "EN", "CLK"], Some("1"));
+        assert!(!may_be_undefined(&sync, "CLK") && !may_be_undefined(&sync, "EN"));
+        let no_param = cell("$memrd", &["CLK"], None);
+        assert!(may_be_undefined(&no_param, "CLK"));
+        for k in ["$and", "$dff", "$memwr_v2"] {
+            assert!(!may_be_undefined(&cell(k, &["A"], None), "A"), "{k}");
+        }
+    }
 }
