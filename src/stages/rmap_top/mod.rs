@@ -269,3 +269,55 @@ impl Unit for RmapTop {
         Some(self)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::stages::unit::Head;
+
+    /// The top's Verilog follows the one pipeline list: for every row of the parameter grid,
+    /// each child of [`RmapTop::children`] (the zero detect and [`pipeline`]) is instantiated
+    /// exactly once, as `u_<stage>`, the pipeline's stages in the list's order, and no stage the
+    /// list leaves out (interpolation or colour off, the other position stage) is there. The
+    /// model's trace is the same chain by its data flow: each stage reads the one before, and
+    /// the top's vectors and `prove` compare the two sample by sample.
+    #[test]
+    fn the_top_instantiates_the_pipeline_list_in_its_order_and_nothing_else() {
+        let every = [
+            "zero_detect",
+            "sort_shift",
+            "normalise",
+            "atan_rom",
+            "linear_index",
+            "map_lookup",
+            "interpolate",
+            "color_mul",
+        ];
+        for row in crate::grid::rows() {
+            let cfg = &row.config;
+            let text = RmapTop.render(cfg, Head::new(cfg, &RmapTop)).unwrap();
+            let at = |name: &str| {
+                let inst = format!(" u_{name} (");
+                let found: Vec<usize> = text.match_indices(&inst).map(|(i, _)| i).collect();
+                found
+            };
+            let list: Vec<&str> = pipeline(cfg).iter().map(|u| u.name()).collect();
+            let mut last = 0;
+            for name in &list {
+                let found = at(name);
+                assert_eq!(found.len(), 1, "{}: u_{name} {found:?}", row.name);
+                assert!(
+                    found[0] > last,
+                    "{}: u_{name} before its predecessor",
+                    row.name
+                );
+                last = found[0];
+            }
+            let children: Vec<&str> = RmapTop.children(cfg).iter().map(|u| u.name()).collect();
+            for name in every {
+                let want = usize::from(children.contains(&name));
+                assert_eq!(at(name).len(), want, "{}: u_{name}", row.name);
+            }
+        }
+    }
+}
