@@ -4,6 +4,7 @@
 
 use super::force::ForceArg;
 use crate::design_dir::DesignDir;
+use crate::mutants::campaign::{self, Judged};
 use crate::mutants::journal::{self, Journal};
 use crate::mutants::{self, Change, Method, Mutant, Outcome, Plan};
 use crate::output::{absolute, StagedDir, StagedFile};
@@ -11,8 +12,6 @@ use anyhow::{bail, Result};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 #[derive(Args, Debug)]
@@ -250,63 +249,18 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
     )?;
     crate::outln!("{}", journal.said)?;
     let t0 = Instant::now();
-    let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<Result<Outcome>>> = Mutex::new(Vec::new());
-    // Judged once per binary, design and draw: a run that was stopped goes on where it
-    // stopped (the journal's outcomes are printed first, marked).
-    let judge = |m: &Mutant| -> Result<Outcome> {
-        if let Some(o) = journal.earlier.get(&m.id) {
-            print_outcome(o, n, " (journal)")?;
-            return Ok(o.clone());
+    let said = |o: &Outcome, from: &str| print_outcome(o, n, from);
+    let outcomes = match campaign::run(&design, &list, &plan, &work, &journal, a.jobs, &said)? {
+        Judged::All(o) => o,
+        Judged::BrokenFlow(broken) => {
+            let work = staged.commit()?;
+            bail!(
+                "the null mutant (the design through Yosys, no mutation) does not pass: {}; logs in {}",
+                broken.join(", "),
+                work.join("m0").display()
+            );
         }
-        let o = mutants::judge(&design, m, &plan, &work)?;
-        journal.record(&o)?;
-        print_outcome(&o, n, "")?;
-        Ok(o)
     };
-    // The null mutant first, alone: if the flow changes the design, nothing else means much.
-    let null = judge(&list[0])?;
-    let broken: Vec<String> = null
-        .verdicts
-        .iter()
-        .filter(|(_, v)| v.kills())
-        .map(|(m, v)| format!("{} {v:?}", m.name()))
-        .collect();
-    if !broken.is_empty() {
-        let work = staged.commit()?;
-        bail!(
-            "the null mutant (the design through Yosys, no mutation) does not pass: {}; logs in {}",
-            broken.join(", "),
-            work.join("m0").display()
-        );
-    }
-    for m in list.iter().skip(1) {
-        if journal.earlier.contains_key(&m.id) {
-            judge(m)?;
-        }
-    }
-    next.store(1, Ordering::SeqCst);
-    std::thread::scope(|s| {
-        for _ in 0..a.jobs {
-            s.spawn(|| loop {
-                let k = next.fetch_add(1, Ordering::SeqCst);
-                let Some(m) = list.get(k) else { break };
-                // A line that cannot be printed, or a journal that cannot be written, is the
-                // mutant's error.
-                let r = if journal.earlier.contains_key(&m.id) {
-                    Ok(journal.earlier[&m.id].clone())
-                } else {
-                    judge(m)
-                };
-                results.lock().unwrap_or_else(|e| e.into_inner()).push(r);
-            });
-        }
-    });
-    let mut outcomes = vec![null];
-    for r in results.into_inner().unwrap_or_else(|e| e.into_inner()) {
-        outcomes.push(r?);
-    }
-    outcomes.sort_by_key(|o| o.mutant.id);
     let mut methods = vec![truth];
     if a.quick {
         methods = vec![truth.proof(), truth];

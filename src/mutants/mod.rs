@@ -29,6 +29,7 @@ use crate::stages::TOP;
 use anyhow::{bail, ensure, Context, Result};
 use serde::{Deserialize, Serialize};
 
+pub mod campaign;
 pub mod journal;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
