@@ -451,6 +451,12 @@ mod tests {
     /// (gy and gz fixed, every gx) and 0 elsewhere, with the bits `flip` ((gradient index,
     /// module, bit)) inverted; placed as [`build`] places Yosys's graph.
     fn model_front(cfg: &Config, rows: &[u64], flip: &[(u64, usize, u32)]) -> GateFront {
+        let (aag, map) = model_graph(cfg, rows, flip);
+        place(Aig::parse(&aag, &map).unwrap(), cfg).unwrap()
+    }
+
+    /// [`model_front`]'s graph as AIGER text and its map, before placing.
+    fn model_graph(cfg: &Config, rows: &[u64], flip: &[(u64, usize, u32)]) -> (String, String) {
         let g = cfg.grad_bits;
         let [zw, sw] = FRONT.map(|u| widths(u, cfg));
         let width = |w: &[(&str, u32)]| w.iter().map(|(_, b)| b).sum::<u32>();
@@ -550,7 +556,52 @@ mod tests {
         for (l, x, y) in &b.ands {
             aag += &format!("{l} {x} {y}\n");
         }
-        place(Aig::parse(&aag, &map).unwrap(), cfg).unwrap()
+        (aag, map)
+    }
+
+    /// Placing refuses a graph that is not the wrapper's: an input or output it does not
+    /// have, an output bit past a module's width, an output the map leaves unnamed, a module
+    /// output bit missing.
+    #[test]
+    fn a_graph_that_is_not_the_wrappers_is_refused_naming_what_is_wrong() {
+        let cfg = &crate::grid::narrowest();
+        let (aag, map) = model_graph(cfg, &[0], &[]);
+        let placed = |map: &str| place(Aig::parse(&aag, map).unwrap(), cfg).map(|_| ());
+        assert!(placed(&map).is_ok());
+        let err = |map: String| format!("{:#}", placed(&map).unwrap_err());
+        let e = err(map.replace(" rst_ni\n", " en_i\n"));
+        assert!(e.contains("the front's graph has the input en_i[0]"), "{e}");
+        let e = err(map.replace(" sort_shift_valid_o\n", " other_o\n"));
+        assert!(
+            e.contains("the front's graph has the output other_o[0]"),
+            "{e}"
+        );
+        let e = err(map.replace(" 0 zero_detect0_o\n", " 7 zero_detect0_o\n"));
+        assert!(e.contains("zero_detect0_o[7] is past its width"), "{e}");
+        let unnamed: String = map
+            .lines()
+            .filter(|l| !l.ends_with(" sort_shift_valid_o"))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        let e = err(unnamed);
+        assert!(e.contains("an output its map does not name"), "{e}");
+        // sort_shift0_o bit 0 renamed as a valid output: the module lacks that bit.
+        let lacking: String = map
+            .lines()
+            .map(|l| {
+                if l.ends_with(" 0 sort_shift0_o") {
+                    l.replace(" 0 sort_shift0_o", " 0 zero_detect_valid_o")
+                } else {
+                    l.to_string()
+                }
+            })
+            .map(|l| format!("{l}\n"))
+            .collect();
+        let e = err(lacking);
+        assert!(
+            e.contains("the front's graph lacks sort_shift0_o[0]"),
+            "{e}"
+        );
     }
 
     /// The gates engine on a front that is the model, built here gate by gate on a few rows:
