@@ -1,6 +1,6 @@
 //! One descriptor per FPGA family, in the spirit of FloPoCo's `Target`: everything that
 //! differs between the families rmapgen places on lives in one file per family
-//! ([`ice40`], [`ecp5`]), as data. The rest of rmapgen asks a [`Descriptor`] for what it needs
+//! (`ice40.rs`, `ecp5.rs`), as data. The rest of rmapgen asks a [`Descriptor`] for what it needs
 //! (the block RAM's read ports and shapes, the Yosys pass and the tools, nextpnr's names for
 //! the cells, the parts and their capacity) and never matches on a family's name.
 //!
