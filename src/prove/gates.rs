@@ -389,6 +389,14 @@ mod tests {
         assert!(e.contains("m.v:2") && e.contains("'b1x"), "{e}");
         std::fs::write(&f, "assign b = 1'bz;\n").unwrap();
         assert!(no_undefined_literal(&f).is_err());
+        // Digits grouped by `_`, and `?` (Verilog's z), belong to the literal.
+        for bad in ["assign b = 4'b1_x0;\n", "assign b = 4'b10?1;\n"] {
+            std::fs::write(&f, bad).unwrap();
+            assert!(no_undefined_literal(&f).is_err(), "{bad}");
+        }
+        // A literal ends where its digits do: an x or z in a name after it is not its own.
+        std::fs::write(&f, "assign a = 4'hF + max_z;\nassign b = 2'b1_0 ^ x;\n").unwrap();
+        assert!(no_undefined_literal(&f).is_ok());
     }
 
     /// An and-inverter graph built by hand: literals as AIGER writes them (2 x variable, +1
@@ -644,6 +652,11 @@ mod tests {
         let (a, z) = ((0xFF01 << g) + 100, (0xFF03 << g) - 7);
         check(&gf, cfg, &states, a..z, &mut all, &|_| ()).unwrap();
         assert_eq!((all.checked, all.count), (z - a, 0), "{:?}", all.kept);
+        // A range that ends one short of a row's end.
+        let mut short = Failures::default();
+        let (a, z) = (0xFF01 << g, (0xFF02 << g) - 1);
+        check(&gf, cfg, &states, a..z, &mut short, &|_| ()).unwrap();
+        assert_eq!((short.checked, short.count), (z - a, 0), "{:?}", short.kept);
         // A row the graph does not compute: its gradients fail.
         let mut wrong = Failures::default();
         check(
@@ -689,6 +702,32 @@ mod tests {
             "{}",
             f.kept[0]
         );
+    }
+
+    /// At G = 10 a row is two evaluations of 512 gradients: the second pass's gradients are
+    /// numbered from 512 (a flipped bit there is found at its own gradient).
+    #[test]
+    fn a_row_of_more_than_one_pass_numbers_its_gradients_by_pass() {
+        let cfg = &Config {
+            grad_bits: 10,
+            ..crate::grid::narrowest()
+        };
+        let states = crate::prove::states::enumerate(cfg, |_, _| Ok(())).unwrap();
+        let row = 0x1_23u64;
+        let idx = (row << 10) | 700;
+        let gf = model_front(cfg, &[row], &[(idx, 1, 2)]);
+        let mut scratch = Vec::new();
+        let f = check_row(
+            &gf,
+            cfg,
+            &states,
+            row,
+            (row << 10)..((row + 1) << 10),
+            &mut scratch,
+        );
+        assert_eq!((f.checked, f.count), (1024, 1), "{:?}", f.kept);
+        let gr = gradient(cfg, idx).map(|v| dec_grad(cfg, v));
+        assert!(f.kept[0].contains(&format!("{gr:?}")), "{}", f.kept[0]);
     }
 
     #[test]
