@@ -650,27 +650,28 @@ mod tests {
         // Across two rows, in part.
         let mut all = Failures::default();
         let (a, z) = ((0xFF01 << g) + 100, (0xFF03 << g) - 7);
-        check(&gf, cfg, &states, a..z, &mut all, &|_| ()).unwrap();
+        let told = std::sync::atomic::AtomicU64::new(0);
+        let progress = |n: u64| {
+            told.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
+        };
+        check(&gf, cfg, &states, a..z, &mut all, &progress).unwrap();
         assert_eq!((all.checked, all.count), (z - a, 0), "{:?}", all.kept);
+        // The progress told is the gradients checked.
+        assert_eq!(told.into_inner(), z - a);
         // A range that ends one short of a row's end.
         let mut short = Failures::default();
         let (a, z) = (0xFF01 << g, (0xFF02 << g) - 1);
         check(&gf, cfg, &states, a..z, &mut short, &|_| ()).unwrap();
         assert_eq!((short.checked, short.count), (z - a, 0), "{:?}", short.kept);
-        // A row the graph does not compute: its gradients fail.
+        // A row the graph does not compute: its gradients fail, more than are kept: every one
+        // counted, the first 20 kept.
         let mut wrong = Failures::default();
-        check(
-            &gf,
-            cfg,
-            &states,
-            (3 << g)..(3 << g) + 5,
-            &mut wrong,
-            &|_| (),
-        )
-        .unwrap();
-        assert_eq!((wrong.checked, wrong.count), (5, 5), "{:?}", wrong.kept);
+        let bad = (3 << g)..(3 << g) + 100;
+        check(&gf, cfg, &states, bad, &mut wrong, &|_| ()).unwrap();
+        assert_eq!((wrong.checked, wrong.count), (100, 100));
+        assert_eq!(wrong.kept.len(), 20);
         assert!(check(&gf, cfg, &states, 7..7, &mut wrong, &|_| ()).is_ok());
-        assert_eq!(wrong.checked, 5);
+        assert_eq!(wrong.checked, 100);
 
         // Flipped bits in several words and lanes, of both modules.
         let sb: u32 = widths(FRONT[1], cfg).iter().map(|(_, w)| w).sum();
