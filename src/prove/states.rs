@@ -246,4 +246,36 @@ mod tests {
         }
         assert_eq!(image.len(), set.len(), "a state no gradient produces");
     }
+
+    /// A state outside the key space (an axis above 2, an m without its top bit or wider than
+    /// red_bits, an a or b wider than red_bits) has no index and is never in the set, even a
+    /// full one: no non-zero gradient gives it.
+    #[test]
+    fn a_state_outside_the_key_space_has_no_index_and_is_not_in_the_set() {
+        let cfg = crate::grid::row("narrowest").unwrap().config;
+        let set = enumerate(&cfg, |_, _| Ok(())).unwrap();
+        let r = cfg.red_bits;
+        let top = 1u32 << (r - 1);
+        let ok = SortShift {
+            axis: 1,
+            s_max: 0,
+            s_u: 1,
+            s_v: 0,
+            shift: 0,
+            m: top,
+            a: 0,
+            b: 1,
+        };
+        assert!(set.index(&ok).is_some() && set.contains(&ok));
+        for bad in [
+            SortShift { axis: 3, ..ok },
+            SortShift { m: top - 1, ..ok },
+            SortShift { m: 2 * top, ..ok },
+            SortShift { a: 2 * top, ..ok },
+            SortShift { b: 2 * top, ..ok },
+        ] {
+            assert_eq!(set.index(&bad), None, "{bad:?}");
+            assert!(!set.contains(&bad), "{bad:?}");
+        }
+    }
 }
