@@ -267,6 +267,7 @@ mod tests {
             b: 1,
         };
         assert!(set.index(&ok).is_some() && set.contains(&ok));
+        assert!(!set.is_empty() && StateSet::new(&cfg).unwrap().is_empty());
         for bad in [
             SortShift { axis: 3, ..ok },
             SortShift { m: top - 1, ..ok },
