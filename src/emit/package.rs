@@ -370,6 +370,8 @@ pub fn readme(design: &Design) -> Result<String> {
             )
         })
         .collect();
+    // Every part's row, computed once (the table and its footnote read it).
+    let fits = fits_rows(cfg);
     let text = Readme {
         version: env!("CARGO_PKG_VERSION"),
         summary: cfg.summary(),
@@ -400,13 +402,13 @@ pub fn readme(design: &Design) -> Result<String> {
             .map(|f| format!("`{}`", f.name()))
             .collect::<Vec<_>>()
             .join(" or "),
-        fits: fits_rows(cfg),
-        dies: fits_rows(cfg)
+        dies: fits
             .iter()
             .filter(|p| !p.die.is_empty())
             .map(|p| format!("{}: {}", p.part, p.die))
             .collect::<Vec<_>>()
             .join("; "),
+        fits,
         valid_edge: top_latency(cfg) - 1,
         compensation: cfg.compensation,
         table_ram: !cfg.comp_table.is_rom(),
