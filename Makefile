@@ -93,7 +93,7 @@ report-browser: build venv
 	$(VENV)/bin/python tests/browser/check_report.py $(REPORT_OUT)/report.html --metrics $(REPORT_OUT)/metrics.json --self-test
 
 tools:
-	@WITH_FPGA=1 WITH_DOCS=1 scripts/install-tools.sh
+	@WITH_FPGA=1 WITH_DOCS=1 WITH_SLURM=1 scripts/install-tools.sh
 
 # rmapgen against VolPack (classified shear-warp) on VolPack's MRI head, 256^2 and 512^2, 1 and
 # 2 threads, in one run (scripts/bench-volume.sh; installs libvolpack1-dev when missing). A
@@ -130,7 +130,7 @@ roms: build
 # build as well would compile everything a second time for the same code (98 s of the
 # 1,028 s make test took here before the checks ran side by side).
 TEST_JOBS   ?= 2
-TEST_CHECKS  = mutants-sample docs report-browser man gate-sim formal mutants-formal-sample formal-mult sim-all sim-handshake fpga-check-ecp5 fpga-check axis-test synth lint
+TEST_CHECKS  = mutants-sample slurm-test docs report-browser man gate-sim formal mutants-formal-sample formal-mult sim-all sim-handshake fpga-check-ecp5 fpga-check axis-test synth lint
 TEST_BIN     = RMAPGEN=target/debug/rmapgen BUILD_CMD="$(CARGO) test --no-run"
 
 test: tools venv
@@ -297,6 +297,18 @@ prove: build
 	$(RMAPGEN) prove --merge $$(seq -f "$(PROVE_BUILD)/shard-%g-of-$(PROVE_SHARDS).json" 1 $(PROVE_SHARDS)) || status=1; \
 	echo "make prove: $$(( $$(date +%s) - start )) s wall on $(PROVE_SHARDS) shards"; \
 	exit $$status
+
+# ---- The proof on a Slurm cluster (rmapgen prove --slurm, src/prove/slurm.rs): a one-node
+# cluster started here (scripts/slurm-cluster.sh: Debian's slurm-wlm and munge, every file in
+# $(SLURM_TEST_DIR), stopped on the way out) runs a G = 8 proof as a build job, four shard
+# tasks and a merge job: PROVEN as generated; a planted reciprocal-ROM fault FAILED through
+# Slurm; a cancelled task and an interrupted rmapgen each handled (scripts/slurm-test.sh).
+# About a minute. In make test. Runs its daemons as root.
+SLURM_TEST_DIR ?= build/slurm-test
+.PHONY: slurm-test
+slurm-test: build
+	@WITH_SLURM=1 scripts/install-tools.sh
+	scripts/slurm-test.sh $(RMAPGEN) $(SLURM_TEST_DIR)
 
 # ---- Mutation testing (rmapgen mutants, src/mutants/; docs/VERIFICATION.md "Every verdict
 # can fail"): mutants of a G = 8 design drawn by Yosys's `mutate` pass and single changed

@@ -4,7 +4,8 @@
 # WITH_FPGA=1 also nextpnr-ice40 and fpga-icestorm (place and route, make fpga); WITH_FORMAL=1
 # also z3 (the SMT solver of make formal's SymbiYosys runs); WITH_DOCS=1 also linkchecker (make
 # docs) and chromium (make report-browser, driven by Playwright); WITH_VOLPACK=1 also
-# libvolpack1-dev (VolPack and its example MRI head, for make bench-volume only).
+# libvolpack1-dev (VolPack and its example MRI head, for make bench-volume only); WITH_SLURM=1
+# also slurm-wlm and munge (the one-node cluster of make slurm-test).
 # Fails loudly (exit 1) when it cannot: the tests must never skip a simulator silently.
 set -euo pipefail
 need=()
@@ -26,6 +27,11 @@ fi
 if [ "${WITH_VOLPACK:-0}" = 1 ]; then
   [ -f /usr/include/volpack.h ] || need+=(libvolpack1-dev)
 fi
+if [ "${WITH_SLURM:-0}" = 1 ]; then
+  for t in sbatch squeue scancel sinfo slurmctld slurmd munged; do
+    command -v "$t" >/dev/null 2>&1 || { need+=(slurm-wlm munge); break; }
+  done
+fi
 if [ ${#need[@]} -eq 0 ]; then
   exit 0
 fi
@@ -43,6 +49,7 @@ check=(iverilog vvp verilator yosys ccache)
 [ "${WITH_FPGA:-0}" = 1 ] && check+=(nextpnr-ice40 icepack)
 [ "${WITH_FORMAL:-0}" = 1 ] && check+=(z3)
 [ "${WITH_DOCS:-0}" = 1 ] && check+=(linkchecker chromium)
+[ "${WITH_SLURM:-0}" = 1 ] && check+=(sbatch slurmctld slurmd munged)
 if [ "${WITH_VOLPACK:-0}" = 1 ] && [ ! -f /usr/include/volpack.h ]; then
   echo "install-tools: libvolpack1-dev still missing after install" >&2; exit 1
 fi

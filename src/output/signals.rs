@@ -37,6 +37,9 @@ pub enum Undo {
     /// A child process started in a process group of its own (its id the group's): kill
     /// the group, so no tool it started outlives rmapgen.
     KillGroup(u32),
+    /// Work rmapgen handed to another system (jobs submitted to Slurm): run this command
+    /// (`scancel` and the job ids), its output discarded, and wait for it.
+    Run(Vec<String>),
 }
 
 impl Undo {
@@ -71,6 +74,17 @@ impl Undo {
                 // is touched.
                 unsafe {
                     libc::kill(-(*pgid as i32), libc::SIGKILL);
+                }
+            }
+            Undo::Run(words) => {
+                if let Some((program, args)) = words.split_first() {
+                    std::process::Command::new(program)
+                        .args(args)
+                        .stdin(std::process::Stdio::null())
+                        .stdout(std::process::Stdio::null())
+                        .stderr(std::process::Stdio::null())
+                        .status()
+                        .ok();
                 }
             }
             Undo::Restore { from, to } => {
@@ -242,19 +256,20 @@ fn start_guardian() -> Guardian {
 /// One registration as the guardian reads it: `+ID KIND HEX [HEX]`, paths absolute and in
 /// hex (any byte may be in a path).
 fn encode(id: u64, undo: &Undo) -> String {
+    let bytes = |b: &[u8]| -> String { b.iter().map(|b| format!("{b:02x}")).collect() };
     let hex = |p: &Path| -> String {
         let abs = std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
-        abs.as_os_str()
-            .as_bytes()
-            .iter()
-            .map(|b| format!("{b:02x}"))
-            .collect()
+        bytes(abs.as_os_str().as_bytes())
     };
     match undo {
         Undo::Remove(p) => format!("+{id} R {}\n", hex(p)),
         Undo::RemoveIfEmpty(p) => format!("+{id} E {}\n", hex(p)),
         Undo::Restore { from, to } => format!("+{id} S {} {}\n", hex(from), hex(to)),
         Undo::KillGroup(g) => format!("+{id} K {g}\n"),
+        Undo::Run(words) => {
+            let hexes: Vec<String> = words.iter().map(|w| bytes(w.as_bytes())).collect();
+            format!("+{id} X {}\n", hexes.join(" "))
+        }
     }
 }
 
@@ -282,6 +297,16 @@ fn decode(line: &str) -> Option<(u64, Undo)> {
             Undo::Restore { from, to: path()? }
         }
         "K" => Undo::KillGroup(w.next()?.parse().ok()?),
+        "X" => {
+            let mut words = Vec::new();
+            while let Some(p) = path() {
+                words.push(p.into_os_string().into_string().ok()?);
+            }
+            if words.is_empty() {
+                return None;
+            }
+            Undo::Run(words)
+        }
         _ => return None,
     };
     Some((id, undo))
@@ -394,6 +419,7 @@ mod tests {
                 to: odd.clone(),
             },
             Undo::KillGroup(4242),
+            Undo::Run(vec!["scancel".into(), "12".into(), "a b\nc".into()]),
         ] {
             let line = encode(7, &undo);
             let (id, back) = decode(line.trim_end()).expect("decodes");
@@ -402,5 +428,7 @@ mod tests {
         }
         assert!(decode("+1 R 6").is_none());
         assert!(decode("+1 Q 00").is_none());
+        assert!(decode("+1 X").is_none());
+        assert!(decode("+1 X 7").is_none());
     }
 }

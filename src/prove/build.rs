@@ -150,7 +150,27 @@ fn shared(
     Ok(mdir.join(lib))
 }
 
-/// The front's shared object, built in `build/front`.
+/// Where [`top`] puts the top's shared object in `build`.
+pub fn top_lib(build: &Path) -> PathBuf {
+    build
+        .join("top")
+        .join("obj")
+        .join(format!("lib{TOP_PREFIX}.so"))
+}
+
+/// Where [`front`] puts the front's shared object in `build`.
+pub fn front_lib(build: &Path) -> PathBuf {
+    build
+        .join("front")
+        .join("obj")
+        .join(format!("lib{FRONT_PREFIX}.so"))
+}
+
+/// The Verilated classes' prefixes (the libraries' names).
+const TOP_PREFIX: &str = "Vrmap_top";
+const FRONT_PREFIX: &str = "Vprove_front";
+
+/// The front's shared object, built in `build/front` (at [`front_lib`]).
 pub fn front(d: &DesignDir, build: &Path) -> Result<PathBuf> {
     let dir = build.join("front");
     crate::disk::create_dir_all(&dir)?;
@@ -166,7 +186,7 @@ pub fn front(d: &DesignDir, build: &Path) -> Result<PathBuf> {
     files.push(wrapper);
     shared(
         FRONT_MODULE,
-        "Vprove_front",
+        FRONT_PREFIX,
         &dir.join("obj"),
         &files,
         &harness,
@@ -176,7 +196,8 @@ pub fn front(d: &DesignDir, build: &Path) -> Result<PathBuf> {
 }
 
 /// The top's shared object (the design's rmap_top, also inside an AXI4-Stream design),
-/// built in `build/top`, its memories read from the design directory by absolute path.
+/// built in `build/top` (at [`top_lib`]), its memories read from the design directory by
+/// absolute path.
 pub fn top(d: &DesignDir, build: &Path) -> Result<PathBuf> {
     let dir = build.join("top");
     crate::disk::create_dir_all(&dir)?;
@@ -184,7 +205,7 @@ pub fn top(d: &DesignDir, build: &Path) -> Result<PathBuf> {
     crate::disk::write(&harness, TOP_HARNESS)?;
     shared(
         &TOP.module(&d.config),
-        "Vrmap_top",
+        TOP_PREFIX,
         &dir.join("obj"),
         &d.files(),
         &harness,

@@ -75,7 +75,7 @@ fn role(name: &str, bit: u32) -> Option<Role> {
 }
 
 /// Builds the graph of `d`'s front in `build/gates` (the wrapper, the techmap file, Yosys's
-/// log and the graph).
+/// log and the graph), then reads it ([`load`]).
 pub fn build(d: &DesignDir, build: &Path) -> Result<GateFront> {
     let dir = build.join("gates");
     crate::disk::create_dir_all(&dir)?;
@@ -91,12 +91,20 @@ pub fn build(d: &DesignDir, build: &Path) -> Result<GateFront> {
         .map(|u| crate::toolchain::quoted(&d.path().join(u.file(&d.config)).to_string_lossy()))
         .collect();
     files.push(crate::toolchain::quoted(&wrapper.to_string_lossy()));
-    let (aag, map) = yosys::aig(
+    yosys::aig(
         build::FRONT_MODULE,
         &files,
         crate::prove::mult::TRANSPARENT_FILE,
         &dir,
     )?;
+    load(d, build)
+}
+
+/// The graph of `d`'s front that [`build`] wrote in `build/gates` (by this run, or by a
+/// `--build-only` run whose build a shard reuses), its inputs and outputs placed.
+pub fn load(d: &DesignDir, build: &Path) -> Result<GateFront> {
+    let dir = build.join("gates");
+    let (aag, map) = (dir.join(yosys::AIG_FILES.0), dir.join(yosys::AIG_FILES.1));
     let read = |p: &Path| std::fs::read_to_string(p).with_context(|| format!("{}", p.display()));
     let graph = Aig::parse(&read(&aag)?, &read(&map)?)
         .with_context(|| format!("the front's graph {}", aag.display()))?;

@@ -23,6 +23,7 @@ pub mod front;
 pub mod gates;
 pub mod mult;
 pub mod report;
+pub mod slurm;
 pub mod states;
 pub mod structure;
 pub mod top;
@@ -32,7 +33,7 @@ use crate::design_dir::DesignDir;
 use crate::model::{MapSet, Model};
 use anyhow::{bail, ensure, Context, Result};
 use report::{Part, Report};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// The widest gradient a factored run takes: 2^36 gradients through the front.
@@ -138,6 +139,9 @@ pub struct Options {
     pub front_engine: FrontEngine,
     /// Only these parts (all when empty); a report without every part does not merge.
     pub parts: Vec<String>,
+    /// Simulate what a `--build-only` run built in this directory (for the same files)
+    /// instead of building it again: every shard of a cluster run shares one build.
+    pub reuse: Option<PathBuf>,
 }
 
 /// Checks that `rmapgen prove` takes this design.
@@ -379,6 +383,112 @@ fn changed<'a>(before: &'a [report::FileHash], after: &[report::FileHash]) -> Op
         .map(|(b, _)| b.name.as_str())
 }
 
+/// The file a `--build-only` run leaves in its build directory: what it built, from which
+/// files ([`Built`]).
+pub const BUILT_FILE: &str = "built.json";
+
+/// What a `--build-only` run built and from what: the configuration, every file the proof
+/// reads (by SHA-256), whether the top is built and which front engine's model.
+#[derive(Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Built {
+    pub config: Config,
+    pub files: Vec<report::FileHash>,
+    pub top: bool,
+    pub front_engine: Option<String>,
+}
+
+/// Builds in `build` what a run of `opts` (any shard) simulates, without running it: the
+/// Verilated top when a part drives it, and the front's gates or Verilated front for the
+/// `front` part. Writes [`BUILT_FILE`] last, so a directory that has it holds a whole build.
+/// Shards given `reuse` = `build` then load these instead of building their own.
+pub fn build_only(d: &DesignDir, build: &Path, opts: &Options) -> Result<Built> {
+    check_design(d, opts.direct)?;
+    check_options(opts)?;
+    let names = report::read_files(d);
+    let files = report::hash_files(d, &names)?;
+    let top = opts.needs_top();
+    if top {
+        build::top(d, build)?;
+    }
+    let front = !opts.direct && opts.wants("front");
+    if front {
+        match opts.front_engine {
+            FrontEngine::Gates => drop(gates::build(d, build)?),
+            FrontEngine::Verilator => drop(build::front(d, build)?),
+        }
+    }
+    if let Some(name) = changed(&files, &report::hash_files(d, &names)?) {
+        bail!(
+            "{} changed while it was being built; build again",
+            d.path().join(name).display()
+        );
+    }
+    let built = Built {
+        config: d.config.clone(),
+        files,
+        top,
+        front_engine: front.then(|| opts.front_engine.name().to_string()),
+    };
+    crate::disk::write(
+        &build.join(BUILT_FILE),
+        serde_json::to_string_pretty(&built)? + "\n",
+    )?;
+    Ok(built)
+}
+
+/// Checks that `dir` holds a `--build-only` build of design `d` as it is now (`files`, hashed
+/// at the start of this run) with everything a run of `opts` loads from it.
+fn reusable(d: &DesignDir, dir: &Path, files: &[report::FileHash], opts: &Options) -> Result<()> {
+    let at = dir.join(BUILT_FILE);
+    let text = std::fs::read_to_string(&at).map_err(|e| {
+        anyhow::anyhow!(
+            "--reuse {}: no finished `rmapgen prove --build-only` build there ({}: {e})",
+            dir.display(),
+            at.display()
+        )
+    })?;
+    let built: Built = serde_json::from_str(&text).with_context(|| {
+        format!(
+            "--reuse {}: {} is not rmapgen's",
+            dir.display(),
+            at.display()
+        )
+    })?;
+    ensure!(
+        built.config == d.config,
+        "--reuse {}: built for another configuration ({}, not {})",
+        dir.display(),
+        built.config.summary(),
+        d.config.summary()
+    );
+    let key = |f: &report::FileHash| (f.name.clone(), f.sha256.clone());
+    if let Some(f) = files
+        .iter()
+        .find(|f| !built.files.iter().any(|b| key(b) == key(f)))
+    {
+        bail!(
+            "--reuse {}: built from other files than {} has now ({} differs): build again with --build-only",
+            dir.display(),
+            d.path().display(),
+            f.name
+        );
+    }
+    ensure!(
+        !opts.needs_top() || built.top,
+        "--reuse {}: the build has no Verilated top (built with --part that needs none)",
+        dir.display()
+    );
+    let front = !opts.direct && opts.wants("front");
+    ensure!(
+        !front || built.front_engine.as_deref() == Some(opts.front_engine.name()),
+        "--reuse {}: built for front engine {}, not {}",
+        dir.display(),
+        built.front_engine.as_deref().unwrap_or("none"),
+        opts.front_engine.name()
+    );
+    Ok(())
+}
+
 /// Runs one shard on design `d`, building in `build` (a directory rmapgen owns).
 pub fn run(d: &DesignDir, build: &Path, opts: &Options, progress: &Progress) -> Result<Report> {
     check_design(d, opts.direct)?;
@@ -406,9 +516,16 @@ pub fn run(d: &DesignDir, build: &Path, opts: &Options, progress: &Progress) -> 
         }
     }
 
+    if let Some(dir) = &opts.reuse {
+        reusable(d, dir, &files, opts)?;
+    }
     let t = report::now();
     let top_lib = if opts.needs_top() {
-        Some(ffi::Library::open(&build::top(d, build)?)?)
+        let lib = match &opts.reuse {
+            Some(dir) => build::top_lib(dir),
+            None => build::top(d, build)?,
+        };
+        Some(ffi::Library::open(&lib)?)
     } else {
         None
     };
@@ -476,11 +593,18 @@ pub fn run(d: &DesignDir, build: &Path, opts: &Options, progress: &Progress) -> 
             let mut fails = Failures::default();
             match opts.front_engine {
                 FrontEngine::Gates => {
-                    let gf = gates::build(d, build)?;
+                    let gf = match &opts.reuse {
+                        Some(dir) => gates::load(d, dir)?,
+                        None => gates::build(d, build)?,
+                    };
                     gates::check(&gf, cfg, &set, range.clone(), &mut fails, progress)?;
                 }
                 FrontEngine::Verilator => {
-                    let front_lib = ffi::Library::open(&build::front(d, build)?)?;
+                    let lib = match &opts.reuse {
+                        Some(dir) => build::front_lib(dir),
+                        None => build::front(d, build)?,
+                    };
+                    let front_lib = ffi::Library::open(&lib)?;
                     let mut fr = ffi::Front::new(&front_lib)?;
                     front::check(&mut fr, cfg, &set, range.clone(), &mut fails, progress)?;
                 }
@@ -580,6 +704,7 @@ mod tests {
             direct,
             front_engine: FrontEngine::Gates,
             parts: parts.iter().map(|p| p.to_string()).collect(),
+            reuse: None,
         }
     }
 

@@ -13,6 +13,7 @@
 pub mod child;
 pub mod icarus;
 pub mod nextpnr;
+pub mod slurm;
 pub mod verilator;
 pub mod yosys;
 
@@ -285,19 +286,21 @@ pub fn complaint(text: &str) -> String {
 pub fn shell_line(cmd: &Command) -> String {
     let words: Vec<String> = std::iter::once(cmd.get_program())
         .chain(cmd.get_args())
-        .map(|w| quote(&w.to_string_lossy()))
+        .map(|w| shell_word(&w.to_string_lossy()))
         .collect();
     match cmd.get_current_dir() {
         Some(d) => format!(
             "(cd {} && {})",
-            quote(&d.to_string_lossy()),
+            shell_word(&d.to_string_lossy()),
             words.join(" ")
         ),
         None => words.join(" "),
     }
 }
 
-fn quote(word: &str) -> String {
+/// `word` as a POSIX shell reads it back: as it is when it holds nothing a shell would
+/// interpret, else in single quotes.
+pub fn shell_word(word: &str) -> String {
     let plain = |c: char| c.is_ascii_alphanumeric() || "_-./=+:,@%".contains(c);
     if !word.is_empty() && word.chars().all(plain) {
         word.to_string()

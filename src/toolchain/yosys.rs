@@ -388,6 +388,10 @@ pub struct Structure {
     pub flat: PathBuf,
 }
 
+/// The files [`aig`] writes into its directory: the graph and the map of its inputs and
+/// outputs.
+pub const AIG_FILES: (&str, &str) = ("front.aag", "front.map");
+
 /// The and-inverter graph `rmapgen prove`'s gate-level front evaluates: `top` (a wrapper
 /// around design modules, from `files`, absolute paths) with every flip-flop made a wire from
 /// D to Q by the techmap file `transparent` (a file name in `logs`: what the value would be at
@@ -406,7 +410,7 @@ pub fn aig(
     logs: &Path,
 ) -> Result<(PathBuf, PathBuf)> {
     crate::disk::create_dir_all(logs)?;
-    let (aag, map) = ("front.aag", "front.map");
+    let (aag, map) = AIG_FILES;
     let script = format!(
         "read_verilog {}; hierarchy -check -top {top}; proc; opt_expr -mux_undef; flatten; \
          opt_clean; opt_dff; techmap -map {transparent}; opt_expr -mux_undef; opt_clean; \

@@ -434,6 +434,9 @@ fn bad_input_is_one_line_and_exit_2() {
         (vec!["--shard", "3/2"], "K must be in 1..=2"),
         (vec!["--shard", "1"], "a shard is K/N"),
         (vec!["--shard", "1/0"], "N must be in"),
+        (vec!["--shards", "4"], "--slurm"),
+        (vec!["--slurm", "--shard", "1/2"], "cannot be used with"),
+        (vec!["--build-only", "--reuse", "x"], "cannot be used with"),
     ] {
         let mut a = vec!["prove", "nowhere"];
         a.extend(args);
@@ -603,6 +606,82 @@ fn a_flipped_rom_bit_fails_the_factored_proof_and_the_edited_file_is_named() {
     assert_eq!(rom["as_generated"], false);
     assert_eq!(rom["sha256"].as_str().unwrap().len(), 64);
     assert!(files.iter().any(|f| f["name"] == "rmap_top.v"));
+}
+
+/// `--build-only` builds once what the shards simulate, and shards given `--reuse` load it
+/// instead of compiling their own: the shards merge into the verdict of a run that built
+/// itself. A build is reused only for the files it was built from: a design edited since is
+/// refused (exit 2, naming the file), and a build of the edited design fails its proof.
+#[test]
+fn shards_reuse_one_build_of_the_same_files_and_nothing_else() {
+    if !tools() {
+        return;
+    }
+    let tmp = helpers::tempdir();
+    let dir = tmp.path().join("d");
+    hdl::generate(&dir, &["--grad-bits", "8", "--red-bits", "6"], 0);
+    let build = tmp.path().join("build");
+    let o = prove(&dir, &build, &["--build-only"]);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{t}");
+    assert!(
+        t.starts_with("built the Verilated top and the front (gates) for "),
+        "{t}"
+    );
+    let built = build.join("d-build");
+    assert!(built.join("built.json").is_file(), "{t}");
+    let shards = tmp.path().join("shards");
+    let mut reports = Vec::new();
+    for k in 1..=2 {
+        let r = tmp.path().join(format!("r{k}.json"));
+        let o = prove(
+            &dir,
+            &shards,
+            &[
+                "--shard",
+                &format!("{k}/2"),
+                "--reuse",
+                s(&built),
+                "--report",
+                s(&r),
+            ],
+        );
+        assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+        // Nothing Verilated in the shard's own build directory: it loaded the shared one.
+        assert!(!shards.join(format!("d-{k}of2")).join("top").exists());
+        reports.push(r);
+    }
+    let mut a = vec!["prove", "--merge"];
+    a.extend(reports.iter().map(|r| s(r)));
+    let o = helpers::run(&a);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    assert!(text(&o).contains("PROVEN: G8 R6"), "{}", text(&o));
+    // Another front engine than the build's, and a directory that is no build.
+    helpers::assert_error(
+        &prove(
+            &dir,
+            &shards,
+            &["--reuse", s(&built), "--front-engine", "verilator"],
+        ),
+        "built for front engine gates, not verilator",
+    );
+    helpers::assert_error(
+        &prove(&dir, &shards, &["--reuse", s(&shards)]),
+        "no finished `rmapgen prove --build-only` build there",
+    );
+    // Edited after the build: refused; its own build proves it wrong.
+    corrupt_entry(&dir, "recip_rom.hex", 4);
+    helpers::assert_error(
+        &prove(&dir, &shards, &["--reuse", s(&built)]),
+        "(recip_rom.hex differs): build again with --build-only",
+    );
+    let o = prove(&dir, &build, &["--build-only"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    assert_fails(
+        &prove(&dir, &shards, &["--reuse", s(&built)]),
+        "states",
+        &["states (buffer 0 as loaded): sample "],
+    );
 }
 
 /// One entry changed in each class of memory file the top reads (the reciprocal ROM, the

@@ -1,0 +1,621 @@
+//! `rmapgen prove --slurm`: the proof as jobs of a Slurm cluster. Three submissions, each a
+//! script written into the run's job directory (`BUILD/<design>-slurm`, replaced whole):
+//!
+//! 1. **build** (one job): `rmapgen prove DIR --build-only` builds the Verilated top and the
+//!    front's gates once, into the job directory ([`super::build_only`]);
+//! 2. **shards** (an array job of N tasks, after the build succeeded:
+//!    `--dependency=afterok`): task K runs `rmapgen prove DIR --shard K/N --reuse BUILD
+//!    --report reports/shard-K-of-N.json`, loading the build instead of compiling its own;
+//! 3. **merge** (one job, after every task ended, however: `afterany`): `rmapgen prove
+//!    --merge` of the N reports ([`super::report::merge`]).
+//!
+//! Each script writes its command's exit status into `status/` when the command ends; a task
+//! that Slurm cancelled or killed (time limit, node failure, `scancel`) writes none. rmapgen
+//! waits for the merge job, then gives the verdict: the merge's text, and a line for every
+//! job that did not end well, naming the shard and its log. The run passes only when the
+//! build, every shard and the merge exited 0. An interrupted rmapgen cancels every job it
+//! submitted (`scancel`, also by its guardian when it is killed outright).
+//!
+//! The design directory, the job directory and rmapgen itself must be at the same paths on
+//! every node (a shared file system), as on any cluster that runs one build for many tasks.
+
+use super::{FrontEngine, MAX_SHARDS};
+use crate::design_dir::DesignDir;
+use crate::output::signals::{self, Undo};
+use crate::toolchain::{self, shell_word, slurm};
+use anyhow::{ensure, Context, Result};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// How the run is spread.
+#[derive(Clone, Debug)]
+pub struct Options {
+    pub shards: u64,
+    /// `--partition` of every job (the cluster's default when None).
+    pub partition: Option<String>,
+    /// More sbatch options for every job (`--time=30`, `--cpus-per-task=8`, `--account=x`).
+    pub sbatch_args: Vec<String>,
+    pub direct: bool,
+    pub front_engine: FrontEngine,
+}
+
+/// Slurm's own limit on an array's task index (its default `MaxArraySize` is 1001): more
+/// shards than this are refused before anything is submitted.
+pub const MAX_ARRAY: u64 = 1000;
+
+/// The job directory: the scripts, the logs, the exit statuses, the reports and the builds.
+pub struct Layout {
+    pub root: PathBuf,
+}
+
+impl Layout {
+    pub fn script(&self, job: &str) -> PathBuf {
+        self.root.join(format!("{job}.sh"))
+    }
+    /// The log of `job` (`shard-K` for a task).
+    pub fn log(&self, job: &str) -> PathBuf {
+        self.root.join("logs").join(format!("{job}.log"))
+    }
+    /// The exit status file of `job`.
+    pub fn status(&self, job: &str) -> PathBuf {
+        self.root.join("status").join(format!("{job}.exit"))
+    }
+    pub fn report(&self, k: u64, n: u64) -> PathBuf {
+        self.root
+            .join("reports")
+            .join(format!("shard-{k}-of-{n}.json"))
+    }
+    /// Where the build job builds (`--build-only --build ROOT` makes `ROOT/<design>-build`).
+    pub fn build(&self, d: &DesignDir) -> PathBuf {
+        self.root.join(format!("{}-build", d.name()))
+    }
+    /// The shards' own build directories (each `<design>-KofN`: the structure part's logs).
+    pub fn shard_builds(&self) -> PathBuf {
+        self.root.join("shards")
+    }
+}
+
+/// A shell script that runs `command` (its words, already shell words), writes its exit
+/// status to `status` and exits with it.
+fn script(what: &str, design: &Path, command: &str, status: &str) -> String {
+    format!(
+        "#!/bin/sh\n\
+         # Written by `rmapgen prove --slurm` for {}: {what}.\n\
+         # Submitted by it with the dependencies between the jobs (docs/VERIFICATION.md,\n\
+         # \"On a cluster\"). The exit status goes to a file: a job Slurm cancels writes none.\n\
+         {command}\n\
+         status=$?\n\
+         echo \"$status\" > {status}\n\
+         exit \"$status\"\n",
+        design.display()
+    )
+}
+
+/// `rmapgen prove` with `args`, as shell words.
+fn rmapgen(exe: &Path, args: &[String]) -> String {
+    std::iter::once(shell_word(&exe.to_string_lossy()))
+        .chain(std::iter::once("prove".to_string()))
+        .chain(args.iter().map(|a| shell_word(a)))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// A path with the array task's index spliced in where `{K}` is: `'/a/shard-'"$K"'.json'`.
+fn with_task(path: &Path) -> String {
+    let text = path.to_string_lossy();
+    let (before, after) = text.split_once("{K}").expect("the path has {K}");
+    format!(
+        "{}\"$SLURM_ARRAY_TASK_ID\"{}",
+        shell_word(before),
+        shell_word(after)
+    )
+}
+
+/// The three scripts of a run of design `d`, written into `layout`.
+pub fn write_scripts(d: &DesignDir, layout: &Layout, exe: &Path, o: &Options) -> Result<()> {
+    for sub in ["logs", "status", "reports"] {
+        crate::disk::create_dir_all(&layout.root.join(sub))?;
+    }
+    let design = d.path().to_string_lossy().into_owned();
+    let mut mode = Vec::new();
+    if o.direct {
+        mode.push("--direct".to_string());
+    } else {
+        mode.extend([
+            "--front-engine".to_string(),
+            o.front_engine.name().to_string(),
+        ]);
+    }
+    let path = |p: PathBuf| p.to_string_lossy().into_owned();
+    // build
+    let mut args = vec![design.clone(), "--build-only".into()];
+    args.extend(mode.iter().cloned());
+    args.extend(["--build".into(), path(layout.root.clone())]);
+    let status = shell_word(&path(layout.status("build")));
+    let text = script(
+        "the build every shard loads",
+        d.path(),
+        &rmapgen(exe, &args),
+        &status,
+    );
+    crate::disk::write(&layout.script("build"), text)?;
+    // shards: the task index spliced into --shard and the report's and status's names.
+    let n = o.shards;
+    let mut args = vec![design.clone()];
+    args.extend(mode.iter().cloned());
+    args.extend([
+        "--build".into(),
+        path(layout.shard_builds()),
+        "--reuse".into(),
+        path(layout.build(d)),
+    ]);
+    let report = layout
+        .root
+        .join("reports")
+        .join(format!("shard-{{K}}-of-{n}.json"));
+    let command = format!(
+        "{} --shard \"$SLURM_ARRAY_TASK_ID\"/{n} --report {}",
+        rmapgen(exe, &args),
+        with_task(&report)
+    );
+    let status = with_task(&layout.root.join("status").join("shard-{K}.exit"));
+    let text = script(
+        &format!("shard K of {n}, K the array task's index"),
+        d.path(),
+        &command,
+        &status,
+    );
+    crate::disk::write(&layout.script("shards"), text)?;
+    // merge
+    let mut args = vec!["--merge".to_string()];
+    args.extend((1..=n).map(|k| path(layout.report(k, n))));
+    let status = shell_word(&path(layout.status("merge")));
+    let text = script(
+        &format!("the merge of the {n} shards' reports"),
+        d.path(),
+        &rmapgen(exe, &args),
+        &status,
+    );
+    crate::disk::write(&layout.script("merge"), text)?;
+    Ok(())
+}
+
+/// The jobs of a run, as Slurm numbered them.
+#[derive(Clone, Debug)]
+pub struct Jobs {
+    pub build: String,
+    pub shards: String,
+    pub merge: String,
+}
+
+impl Jobs {
+    fn all(&self) -> Vec<String> {
+        vec![self.build.clone(), self.shards.clone(), self.merge.clone()]
+    }
+}
+
+/// The verdict of a run.
+pub struct Outcome {
+    pub passed: bool,
+    pub text: String,
+}
+
+/// Checks the options before anything is written or submitted.
+pub fn check(o: &Options) -> Result<()> {
+    ensure!(
+        (1..=MAX_ARRAY.min(MAX_SHARDS)).contains(&o.shards),
+        "--shards {}: a Slurm run has 1 to {MAX_ARRAY} shards (Slurm's default MaxArraySize)",
+        o.shards
+    );
+    Ok(())
+}
+
+/// Submits the three jobs of the scripts in `layout` (each with the partition and the user's
+/// sbatch options), registering their cancellation for an interrupt as each is submitted.
+pub fn submit(layout: &Layout, o: &Options) -> Result<(Jobs, signals::Token)> {
+    let common = |job: &str| -> Vec<String> {
+        let mut a = vec![
+            format!("--job-name=rmapgen-prove-{job}"),
+            format!("--output={}", layout.log(job).display()),
+        ];
+        if let Some(p) = &o.partition {
+            a.push(format!("--partition={p}"));
+        }
+        a.extend(o.sbatch_args.iter().cloned());
+        a
+    };
+    let build = slurm::submit(&common("build"), &layout.script("build"))?;
+    let token = signals::register(Undo::Run(slurm::cancel_words(std::slice::from_ref(&build))));
+    let cancel_all = |ids: &[String]| {
+        signals::hold().replace(&token, Undo::Run(slurm::cancel_words(ids)));
+    };
+    let mut args = common("shards");
+    // %a: the task index in the log's name.
+    args[1] = format!("--output={}", layout.log("shard-%a").display());
+    args.extend([
+        format!("--array=1-{}", o.shards),
+        format!("--dependency=afterok:{build}"),
+        "--kill-on-invalid-dep=yes".into(),
+    ]);
+    let shards = match slurm::submit(&args, &layout.script("shards")) {
+        Ok(id) => id,
+        Err(e) => {
+            cancel(std::slice::from_ref(&build));
+            return Err(e);
+        }
+    };
+    cancel_all(&[build.clone(), shards.clone()]);
+    let mut args = common("merge");
+    args.extend([
+        format!("--dependency=afterany:{shards}"),
+        "--kill-on-invalid-dep=yes".into(),
+    ]);
+    let merge = match slurm::submit(&args, &layout.script("merge")) {
+        Ok(id) => id,
+        Err(e) => {
+            cancel(&[build, shards]);
+            return Err(e);
+        }
+    };
+    let jobs = Jobs {
+        build,
+        shards,
+        merge,
+    };
+    cancel_all(&jobs.all());
+    Ok((jobs, token))
+}
+
+/// Cancels the jobs `ids` now (a submission that failed half-way).
+fn cancel(ids: &[String]) {
+    Undo::Run(slurm::cancel_words(ids)).run_now();
+}
+
+/// What a job's status file says: its command's exit code, or None when the job wrote none
+/// (not yet ended, or cancelled or killed by Slurm).
+fn exit_of(path: &Path) -> Option<i32> {
+    std::fs::read_to_string(path).ok()?.trim().parse().ok()
+}
+
+/// The shards whose tasks have ended and how many of them failed, from the status files.
+fn shards_ended(layout: &Layout) -> (u64, u64) {
+    let Ok(dir) = std::fs::read_dir(layout.root.join("status")) else {
+        return (0, 0);
+    };
+    let mut ended = 0;
+    let mut failed = 0;
+    for e in dir.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        if name.starts_with("shard-") && name.ends_with(".exit") {
+            ended += 1;
+            if exit_of(&e.path()) != Some(0) {
+                failed += 1;
+            }
+        }
+    }
+    (ended, failed)
+}
+
+/// How often the status files are looked at, and how often Slurm is asked whether the jobs
+/// are still there (a merge job cancelled before it ran writes no status).
+const LOOK: Duration = Duration::from_millis(500);
+const ASK: Duration = Duration::from_secs(5);
+
+/// Waits until the merge job has ended (its status file) or none of the jobs is left in
+/// Slurm's queue; `progress` gets a line whenever the count of ended shards changes.
+pub fn wait(layout: &Layout, jobs: &Jobs, n: u64, progress: &dyn Fn(&str)) -> Result<()> {
+    let mut last = None;
+    let mut asked = Instant::now();
+    loop {
+        if layout.status("merge").exists() {
+            return Ok(());
+        }
+        let now = shards_ended(layout);
+        let build = exit_of(&layout.status("build"));
+        if last != Some((build, now)) {
+            last = Some((build, now));
+            let b = match build {
+                None => "build running or queued".to_string(),
+                Some(0) => "built".to_string(),
+                Some(c) => format!("build failed (exit {c})"),
+            };
+            progress(&format!(
+                "slurm: {b}; {} of {n} shards ended ({} failed)",
+                now.0, now.1
+            ));
+        }
+        if asked.elapsed() >= ASK {
+            asked = Instant::now();
+            if slurm::live(&jobs.all())? == 0 {
+                // The merge may have written its status just before it left the queue.
+                return Ok(());
+            }
+        }
+        std::thread::sleep(LOOK);
+    }
+}
+
+/// The last non-empty line of a job's log, for a message.
+fn last_line(log: &Path) -> String {
+    std::fs::read_to_string(log)
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .rev()
+                .find(|l| !l.trim().is_empty())
+                .map(String::from)
+        })
+        .unwrap_or_else(|| "no output".into())
+}
+
+/// The most shards named one by one in a verdict (all are counted).
+const NAMED: usize = 20;
+
+/// The verdict once the jobs have ended: the merge's text, and a line for each job that did
+/// not end with exit 0 (a shard that failed the proof, failed to run, or was cancelled).
+pub fn verdict(layout: &Layout, jobs: &Jobs, n: u64) -> Outcome {
+    let mut problems = Vec::new();
+    match exit_of(&layout.status("build")) {
+        Some(0) => {}
+        Some(c) => problems.push(format!(
+            "the build job {} failed (exit {c}): {} ({})",
+            jobs.build,
+            last_line(&layout.log("build")),
+            layout.log("build").display()
+        )),
+        None => problems.push(format!(
+            "the build job {} was cancelled or killed before it ended (no exit status; {})",
+            jobs.build,
+            layout.log("build").display()
+        )),
+    }
+    let mut bad = 0usize;
+    for k in 1..=n {
+        let log = layout.log(&format!("shard-{k}"));
+        let line = match exit_of(&layout.status(&format!("shard-{k}"))) {
+            Some(0) => continue,
+            Some(1) => format!(
+                "shard {k}/{n} (task {}_{k}) found inputs where the design differs from its model ({})",
+                jobs.shards,
+                layout.report(k, n).display()
+            ),
+            Some(c) => format!(
+                "shard {k}/{n} (task {}_{k}) failed (exit {c}): {} ({})",
+                jobs.shards,
+                last_line(&log),
+                log.display()
+            ),
+            None => format!(
+                "shard {k}/{n} (task {}_{k}) was cancelled or killed before it ended (no exit status; {})",
+                jobs.shards,
+                log.display()
+            ),
+        };
+        bad += 1;
+        if bad <= NAMED {
+            problems.push(line);
+        }
+    }
+    if bad > NAMED {
+        problems.push(format!("... and {} more shards", bad - NAMED));
+    }
+    let merge_log = layout.log("merge");
+    let merged = std::fs::read_to_string(&merge_log).unwrap_or_default();
+    let merge = exit_of(&layout.status("merge"));
+    match merge {
+        Some(0) | Some(1) => {}
+        Some(c) => problems.push(format!(
+            "the merge job {} failed (exit {c}): {} ({})",
+            jobs.merge,
+            last_line(&merge_log),
+            merge_log.display()
+        )),
+        None => problems.push(format!(
+            "the merge job {} was cancelled or killed before it ended (no exit status; {})",
+            jobs.merge,
+            merge_log.display()
+        )),
+    }
+    let passed = problems.is_empty() && merge == Some(0);
+    let mut text = String::new();
+    if matches!(merge, Some(0) | Some(1)) {
+        text.push_str(merged.trim_end());
+        text.push('\n');
+    }
+    if passed {
+        text.push_str(&format!(
+            "slurm: PASSED: build, {n} shards and merge (jobs {}, {}, {}) all exited 0",
+            jobs.build, jobs.shards, jobs.merge
+        ));
+    } else {
+        text.push_str("slurm: FAILED:");
+        for p in &problems {
+            text.push_str("\n  ");
+            text.push_str(p);
+        }
+        if problems.is_empty() {
+            text.push_str(" the merge found a failure");
+        }
+    }
+    Outcome { passed, text }
+}
+
+/// The whole run: scripts into `layout` (a directory rmapgen owns), the jobs submitted, waited
+/// for, and the verdict. `exe` is the rmapgen every job runs.
+pub fn run(
+    d: &DesignDir,
+    layout: &Layout,
+    exe: &Path,
+    o: &Options,
+    announce: &dyn Fn(&str) -> Result<()>,
+    progress: &dyn Fn(&str),
+) -> Result<Outcome> {
+    check(o)?;
+    write_scripts(d, layout, exe, o)?;
+    // An interrupt cancels the jobs (registered later, so undone first), then removes the
+    // job directory: nothing half-written is left.
+    let remove = signals::register(Undo::Remove(layout.root.clone()));
+    let (jobs, token) = match submit(layout, o) {
+        Ok(s) => s,
+        Err(e) => {
+            remove.release();
+            crate::output::stamp::write(&layout.root)?;
+            return Err(e);
+        }
+    };
+    announce(&format!(
+        "slurm: submitted build job {}, shards job {} (array 1-{}), merge job {}; scripts and logs in {}",
+        jobs.build,
+        jobs.shards,
+        o.shards,
+        jobs.merge,
+        layout.root.display()
+    ))?;
+    let waited = wait(layout, &jobs, o.shards, progress);
+    if waited.is_err() {
+        // Waiting failed (squeue broke): the jobs are not left behind.
+        cancel(&jobs.all());
+    }
+    token.release();
+    remove.release();
+    // Everything in the directory is rmapgen's (the jobs are rmapgen): recorded, so that the
+    // next run replaces it.
+    crate::output::stamp::write(&layout.root)?;
+    waited.context("waiting for the Slurm jobs")?;
+    Ok(verdict(layout, &jobs, o.shards))
+}
+
+/// The programs a run needs, checked before anything is written.
+pub fn check_tools() -> Result<()> {
+    for p in [slurm::sbatch(), slurm::squeue(), slurm::scancel()] {
+        ensure!(
+            toolchain::installed(&p),
+            "{p} not found: --slurm submits to a Slurm cluster (sbatch, squeue and scancel on PATH, or SBATCH, SQUEUE, SCANCEL); make slurm-test starts a one-node cluster"
+        );
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_task_splices_its_index_into_a_quoted_path() {
+        let p = Path::new("/a b/shard-{K}-of-4.json");
+        assert_eq!(
+            with_task(p),
+            "'/a b/shard-'\"$SLURM_ARRAY_TASK_ID\"-of-4.json"
+        );
+    }
+
+    /// A job directory whose status files and logs say `exits` (None: no status file).
+    fn ended(
+        build: Option<i32>,
+        shards: &[Option<i32>],
+        merge: Option<i32>,
+    ) -> (tempfile::TempDir, Outcome) {
+        let tmp = tempfile::tempdir().unwrap();
+        let layout = Layout {
+            root: tmp.path().to_path_buf(),
+        };
+        for sub in ["logs", "status", "reports"] {
+            std::fs::create_dir_all(tmp.path().join(sub)).unwrap();
+        }
+        let put = |job: &str, exit: Option<i32>| {
+            std::fs::write(layout.log(job), format!("{job} says\n\nits last line\n")).unwrap();
+            if let Some(c) = exit {
+                std::fs::write(layout.status(job), format!("{c}\n")).unwrap();
+            }
+        };
+        put("build", build);
+        for (k, e) in shards.iter().enumerate() {
+            put(&format!("shard-{}", k + 1), *e);
+        }
+        put("merge", merge);
+        std::fs::write(layout.log("merge"), "prove d:\nPROVEN: G8\n").unwrap();
+        let jobs = Jobs {
+            build: "7".into(),
+            shards: "8".into(),
+            merge: "9".into(),
+        };
+        let n = shards.len() as u64;
+        (tmp, verdict(&layout, &jobs, n))
+    }
+
+    #[test]
+    fn the_verdict_passes_only_when_every_job_exited_0_and_names_each_that_did_not() {
+        let (_t, v) = ended(Some(0), &[Some(0), Some(0)], Some(0));
+        assert!(v.passed, "{}", v.text);
+        assert!(
+            v.text.starts_with(
+                "prove d:\nPROVEN: G8\nslurm: PASSED: build, 2 shards and merge (jobs 7, 8, 9)"
+            ),
+            "{}",
+            v.text
+        );
+        // A shard that found a difference, one that failed to run, one cancelled.
+        let (_t, v) = ended(Some(0), &[Some(1), Some(2), None, Some(0)], Some(1));
+        assert!(!v.passed);
+        for want in [
+            "\n  shard 1/4 (task 8_1) found inputs where the design differs from its model (",
+            "\n  shard 2/4 (task 8_2) failed (exit 2): its last line (",
+            "\n  shard 3/4 (task 8_3) was cancelled or killed before it ended (no exit status; ",
+        ] {
+            assert!(v.text.contains(want), "{want:?} in {}", v.text);
+        }
+        assert!(!v.text.contains("shard 4/4"), "{}", v.text);
+        // Every shard passed but the merge was cancelled, or the build failed.
+        let (_t, v) = ended(Some(0), &[Some(0)], None);
+        assert!(!v.passed);
+        assert!(
+            v.text.contains("the merge job 9 was cancelled or killed"),
+            "{}",
+            v.text
+        );
+        assert!(
+            !v.text.contains("PROVEN"),
+            "a merge that did not end says nothing: {}",
+            v.text
+        );
+        let (_t, v) = ended(Some(2), &[None], Some(2));
+        assert!(!v.passed);
+        assert!(
+            v.text
+                .contains("the build job 7 failed (exit 2): its last line"),
+            "{}",
+            v.text
+        );
+        assert!(
+            v.text.contains("the merge job 9 failed (exit 2)"),
+            "{}",
+            v.text
+        );
+        // A merge that passed does not pass a run whose shard did not end well.
+        let (_t, v) = ended(Some(0), &[Some(0), Some(3)], Some(0));
+        assert!(!v.passed, "{}", v.text);
+        // Many failed shards: the first 20 named, the rest counted.
+        let (_t, v) = ended(Some(0), &[None; 25], Some(2));
+        assert!(v.text.contains("shard 20/25") && !v.text.contains("shard 21/25"));
+        assert!(v.text.contains("... and 5 more shards"), "{}", v.text);
+    }
+
+    #[test]
+    fn the_shard_count_is_bounded_by_slurms_array_size() {
+        let o = |shards| Options {
+            shards,
+            partition: None,
+            sbatch_args: vec![],
+            direct: false,
+            front_engine: FrontEngine::Gates,
+        };
+        assert!(check(&o(1)).is_ok());
+        assert!(check(&o(MAX_ARRAY)).is_ok());
+        let e = check(&o(0)).unwrap_err().to_string();
+        assert!(
+            e.starts_with("--shards 0: a Slurm run has 1 to 1000 shards"),
+            "{e}"
+        );
+        assert!(check(&o(MAX_ARRAY + 1)).is_err());
+    }
+}
