@@ -298,6 +298,17 @@ prove: build
 	echo "make prove: $$(( $$(date +%s) - start )) s wall on $(PROVE_SHARDS) shards"; \
 	exit $$status
 
+# How the proof scales with shards (scripts/prove-scaling.py, a benchmark, not in make test):
+# one --build-only build, then the N shards of $(PROVE_DIR) one after another with --reuse,
+# for each N of $(SCALING_SHARDS), merged; the largest shard is what N nodes would take. A
+# table and a 64-node projection in $(SCALING_BUILD)/scaling.md. Each N is a whole proof: on
+# the default design about 16 minutes on 2 cores per N.
+SCALING_SHARDS ?= 1 2 4 8
+SCALING_BUILD  ?= build/prove-scaling
+.PHONY: prove-scaling
+prove-scaling: build
+	python3 scripts/prove-scaling.py $(RMAPGEN) $(PROVE_DIR) $(SCALING_BUILD) $(SCALING_SHARDS)
+
 # ---- The proof on a Slurm cluster (rmapgen prove --slurm, src/prove/slurm.rs): a one-node
 # cluster started here (scripts/slurm-cluster.sh: Debian's slurm-wlm and munge, every file in
 # $(SLURM_TEST_DIR), stopped on the way out) runs a G = 8 proof as a build job, four shard
