@@ -57,20 +57,25 @@ impl Family {
     /// The names of the families whose descriptor has `what`, as a flag's values for a
     /// message: `ecp5`, `ecp5 or gowin`, `ice40, ecp5 or gowin`.
     pub fn names_with(what: fn(&Descriptor) -> bool) -> String {
-        let names: Vec<&str> = Family::ALL
+        let names: Vec<String> = Family::ALL
             .into_iter()
             .filter(|f| what(f.get()))
-            .map(Family::name)
+            .map(|f| f.name().to_string())
             .collect();
-        match names.split_last() {
-            Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
-            _ => names.concat(),
-        }
+        either(&names)
     }
 
     /// The family `--family` or `--target` spells `name`.
     pub fn from_name(name: &str) -> Option<Family> {
         Family::ALL.into_iter().find(|f| f.name() == name)
+    }
+}
+
+/// `a`, `a or b`, `a, b or c`: alternatives as a sentence says them.
+pub fn either(items: &[String]) -> String {
+    match items.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
+        _ => items.concat(),
     }
 }
 
