@@ -203,19 +203,27 @@ fn configuration(
         // placed out of context from here on, every seed alike. The in-context attempt's log
         // is kept beside the others. Like the seeds' files below, it is renamed only inside
         // `logs`, in the sweep's own staging directory, where `fpga::place` has just written it.
-        let pins = placed
+        let short = placed
             .as_ref()
             .err()
             .and_then(|e| e.downcast_ref::<fpga::DoesNotFit>())
-            .is_some_and(|d| d.pins);
-        if pins && family.get().out_of_context && !opts.out_of_context {
+            .filter(|d| d.pins)
+            .map(|d| d.message.clone());
+        if let Some(said) = short.filter(|_| family.get().out_of_context && !opts.out_of_context)
+        {
             progress(&format!(
                 "{name}: more port bits than pins; placing out of context"
             ));
             let (stem, ext) = split(crate::toolchain::nextpnr::LOG);
             let to = logs.join(format!("{stem}_in_context.{ext}"));
-            std::fs::rename(logs.join(crate::toolchain::nextpnr::LOG), &to)
-                .with_context(|| format!("cannot write {}", to.display()))?;
+            let log = logs.join(crate::toolchain::nextpnr::LOG);
+            // A Gowin pin file finds too few pins before nextpnr runs: no log but its words.
+            if log.exists() {
+                std::fs::rename(&log, &to)
+            } else {
+                std::fs::write(&to, format!("{said}\n"))
+            }
+            .with_context(|| format!("cannot write {}", to.display()))?;
             opts.out_of_context = true;
             row.out_of_context = true;
             placed = fpga::place(&syn, &opts);
