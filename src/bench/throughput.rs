@@ -209,8 +209,7 @@ fn configuration(
             .and_then(|e| e.downcast_ref::<fpga::DoesNotFit>())
             .filter(|d| d.pins)
             .map(|d| d.message.clone());
-        if let Some(said) = short.filter(|_| family.get().out_of_context && !opts.out_of_context)
-        {
+        if let Some(said) = short.filter(|_| family.get().out_of_context && !opts.out_of_context) {
             progress(&format!(
                 "{name}: more port bits than pins; placing out of context"
             ));
