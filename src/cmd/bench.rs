@@ -56,9 +56,9 @@ pub struct BenchArgs {
     /// lanes x Fmax) [1..=8, default 1].
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true, value_parser = super::parse::field("lanes"))]
     pub lanes: Vec<u32>,
-    /// Families of the throughput sweep [default: ice40,ecp5]; without --throughput, the one
-    /// family each configuration is placed on (its default part: iCE40 HX8K, ECP5-85F)
-    /// [default: ice40].
+    /// Families of the throughput sweep [default: ice40,ecp5,gowin]; without --throughput, the
+    /// one family each configuration is placed on (its default part: iCE40 HX8K, ECP5-85F,
+    /// Gowin GW2A-18) [default: ice40].
     #[arg(long, value_enum, value_delimiter = ',')]
     pub family: Vec<crate::flow::fpga::Family>,
     /// Multiplier styles of the throughput sweep [default: tree,infer].

