@@ -565,10 +565,11 @@ fpga-check-gowin: build venv
 # bits than CABGA381 has pins (eight lanes) out of context (fpga --ooc), and the row says so;
 # iCE40 rows on the HX8K ("does not fit" is a row). Writes throughput.md/.csv/.json (rewritten
 # after every row) and every seed's logs to $(TP_DIR). The full sweep at 3 seeds took
-# 67 minutes on 2 shared cores (eight ECP5 lanes: ~1 min synthesis, ~4.5 min a seed);
+# 67 minutes on 2 shared cores for the iCE40 and ECP5 (eight ECP5 lanes: ~1 min synthesis,
+# ~4.5 min a seed), before Gowin joined the default families;
 # sections with e.g. make fpga-throughput TP_LANES=8 TP_FAMILIES=ecp5 TP_MULTS=tree.
 TP_LANES    ?= 1,2,4,8
-TP_FAMILIES ?= ice40,ecp5
+TP_FAMILIES ?= ice40,ecp5,gowin
 TP_MULTS    ?= tree,infer
 TP_SEEDS    ?= 5
 TP_DIR      ?= out/throughput
