@@ -600,6 +600,85 @@ mod tests {
         assert!(v.text.contains("... and 5 more shards"), "{}", v.text);
     }
 
+    /// The scripts run as Slurm runs them (`sh`, the task index in the environment) against a
+    /// stand-in rmapgen that records its arguments and exits 3: each job calls rmapgen with
+    /// the paths the others read (spelled out here, not taken from `Layout`), and writes the
+    /// exit status where `verdict` looks for it.
+    #[test]
+    fn the_scripts_chain_the_build_the_shards_and_the_merge_through_their_paths() {
+        let tmp = tempfile::tempdir().unwrap();
+        let design = tmp.path().join("my design");
+        std::fs::create_dir_all(&design).unwrap();
+        let manifest = serde_json::json!({
+            "top": "rmap_top",
+            "config": crate::config::Config::default(),
+            "modules": [],
+        });
+        std::fs::write(design.join("manifest.json"), manifest.to_string()).unwrap();
+        let d = DesignDir::open(&design).unwrap();
+        let root = tmp.path().join("job dir");
+        let exe = tmp.path().join("fake rmapgen");
+        let calls = tmp.path().join("calls");
+        std::fs::write(
+            &exe,
+            format!(
+                "#!/bin/sh\nfor a in \"$@\"; do printf '%s|' \"$a\"; done >> {}\necho >> {0}\nexit 3\n",
+                shell_word(&calls.to_string_lossy())
+            ),
+        )
+        .unwrap();
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&exe, std::fs::Permissions::from_mode(0o755)).unwrap();
+        let layout = Layout { root: root.clone() };
+        let o = Options {
+            shards: 4,
+            partition: None,
+            sbatch_args: vec![],
+            direct: false,
+            front_engine: FrontEngine::Gates,
+        };
+        write_scripts(&d, &layout, &exe, &o).unwrap();
+        for (script, task) in [("build.sh", ""), ("shards.sh", "2"), ("merge.sh", "")] {
+            let s = std::process::Command::new("sh")
+                .arg(root.join(script))
+                .env("SLURM_ARRAY_TASK_ID", task)
+                .status()
+                .unwrap();
+            assert_eq!(s.code(), Some(3), "{script} exits with rmapgen's status");
+        }
+        let r = |p: &str| root.join(p).to_string_lossy().into_owned();
+        let dp = d.path().to_string_lossy().into_owned();
+        let want = [
+            format!(
+                "prove|{dp}|--build-only|--front-engine|gates|--build|{}|",
+                root.display()
+            ),
+            format!(
+                "prove|{dp}|--front-engine|gates|--build|{}|--reuse|{}|--shard|2/4|--report|{}|",
+                r("shards"),
+                r("my design-build"),
+                r("reports/shard-2-of-4.json")
+            ),
+            format!(
+                "prove|--merge|{}|{}|{}|{}|",
+                r("reports/shard-1-of-4.json"),
+                r("reports/shard-2-of-4.json"),
+                r("reports/shard-3-of-4.json"),
+                r("reports/shard-4-of-4.json")
+            ),
+        ];
+        let got = std::fs::read_to_string(&calls).unwrap();
+        assert_eq!(got.lines().collect::<Vec<_>>(), want, "{got}");
+        for status in ["build.exit", "shard-2.exit", "merge.exit"] {
+            let text = std::fs::read_to_string(root.join("status").join(status)).unwrap();
+            assert_eq!(text, "3\n", "{status}");
+        }
+        // The build job writes where the shards reuse it from: `--build-only --build ROOT`
+        // makes ROOT/<design>-build.
+        assert_eq!(layout.build(&d), root.join("my design-build"));
+        assert_eq!(layout.script("merge"), root.join("merge.sh"));
+    }
+
     #[test]
     fn the_shard_count_is_bounded_by_slurms_array_size() {
         let o = |shards| Options {
