@@ -98,11 +98,6 @@ pub struct FitArgs {
 pub fn run(a: &FitArgs) -> Result<()> {
     crate::vectors::check_stage_vectors(a.vectors, "--vectors")?;
     let scene = a.map.scene_or(|| anyhow::bail!("fit needs --scene FILE"))?;
-    // The search is over ROM designs (the loaded table is not among its options yet).
-    anyhow::ensure!(
-        scene.map_fit != crate::model::map_fit::MapFit::Table,
-        "fit searches designs whose compensation table is a ROM, and map_fit table needs --comp-table ram; give another --map-fit"
-    );
     let scene_file = a.map.input().unwrap_or(std::path::Path::new("")).display();
     let base = Config {
         grad_bits: a.grad_bits,
@@ -112,6 +107,12 @@ pub fn run(a: &FitArgs) -> Result<()> {
         lanes: a.lanes.unwrap_or(Config::default().lanes),
         color: scene.color.is_some(),
         prefix: a.prefix.clone().unwrap_or_default(),
+        // A fitted table is loaded with the maps: every candidate holds it in RAM.
+        comp_table: if scene.map_fit == crate::model::map_fit::MapFit::Table {
+            crate::config::CompTable::Ram
+        } else {
+            crate::config::CompTable::Rom
+        },
         ..Config::default()
     };
     base.validate()?;

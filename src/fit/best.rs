@@ -2,7 +2,7 @@
 //! a branch and bound over the candidates in order of cost. Separate from the search, which
 //! only calls it once the search has found nothing.
 
-use super::context::{Ctx, Killers, MapCache, Progress, BATCH};
+use super::context::{Bounds, Ctx, Killers, MapCache, Progress, BATCH};
 use super::measure::{self, Errors, Limits};
 use super::outcome::{Candidate, Unreachable};
 use super::target::Target;
@@ -38,6 +38,7 @@ pub(super) fn unreachable(
                 sampled: Mutex::new(ctx.maps.sampled.lock().expect("map cache").clone()),
             },
             killers: Killers(Mutex::new(Vec::new())),
+            bounds: Bounds::default(),
         };
         best(&sorted, cands, Objective::Rmse, target, progress)
     });

@@ -71,14 +71,41 @@ impl Killers {
 /// Progress of a search: candidates measured, of how many, and a note.
 pub type Progress<'a> = &'a (dyn Fn(usize, usize, &str) + Sync);
 
+/// The information bound of each front end (red, frac and recip widths: what
+/// [`Model::state`](crate::model::Model::state) depends on, the interface fields being the
+/// search's own).
+#[derive(Default)]
+pub(super) struct Bounds(Mutex<HashMap<(u32, u32, u32), Errors>>);
+
+impl Bounds {
+    fn get(&self, cfg: &Config, img: &TestImage) -> Errors {
+        let key = (cfg.red_bits, cfg.frac_bits, cfg.recip_bits);
+        if let Some(b) = self.0.lock().expect("bounds").get(&key) {
+            return *b;
+        }
+        let b = measure::information_bound(cfg, img);
+        self.0.lock().expect("bounds").insert(key, b);
+        b
+    }
+}
+
 pub(super) struct Ctx<'a> {
     pub(super) img: &'a TestImage,
     pub(super) maps: MapCache,
     pub(super) killers: Killers,
+    pub(super) bounds: Bounds,
 }
 
 impl Ctx<'_> {
     pub(super) fn measure(&self, cfg: &Config, limits: Limits) -> Errors {
+        // A front end that cannot meet the limits whatever the contents is rejected before
+        // its maps are fitted.
+        if limits != Limits::default() {
+            let b = self.bounds.get(cfg, self.img);
+            if measure::bound_exceeds(&b, &limits, self.img.pixels()) {
+                return b;
+            }
+        }
         let maps = self.maps.get(cfg);
         let (e, worst) = measure::measure(cfg, &maps, self.img, limits, &self.killers.snapshot());
         if !e.complete {

@@ -223,6 +223,77 @@ pub fn measure(
     (acc.errors(img, true), acc.worst)
 }
 
+/// The information bound: a lower bound on the errors of `cfg` on the image whatever its
+/// maps and compensation table hold. The output of a sample is a function of its state
+/// ([`Model::state`]: face, quadrant and the two fraction codes), so the pixels of one state
+/// share one output y, and the best y for them errs by at least half the spread of their
+/// references (rounded up: outputs and references are integers), and in squares by at least
+/// their squared distances to the integer nearest their mean. It depends only on the front
+/// end (red, frac and recip widths), so `fit` computes it once per front end and skips the
+/// map fit of every candidate it already rules out (the table fit is seconds a candidate).
+pub fn information_bound(cfg: &Config, img: &TestImage) -> Errors {
+    #[derive(Clone, Copy)]
+    struct Group {
+        lo: u32,
+        hi: u32,
+        sum: f64,
+        sq: f64,
+        n: f64,
+        ch: [(u32, u32); 3],
+    }
+    let model = Model::new(cfg);
+    let mut groups: std::collections::HashMap<u64, Group> = std::collections::HashMap::new();
+    for (k, &g) in img.gradients.iter().enumerate() {
+        let r = img.reference[k];
+        let ch = img
+            .color
+            .as_ref()
+            .map_or([(0, 0); 3], |(_, refs)| refs[k].map(|c| (c, c)));
+        let e = groups.entry(model.state(g)).or_insert(Group {
+            lo: r,
+            hi: r,
+            sum: 0.0,
+            sq: 0.0,
+            n: 0.0,
+            ch,
+        });
+        e.lo = e.lo.min(r);
+        e.hi = e.hi.max(r);
+        e.sum += r as f64;
+        e.sq += (r as f64) * (r as f64);
+        e.n += 1.0;
+        for c in 0..3 {
+            e.ch[c] = (e.ch[c].0.min(ch[c].0), e.ch[c].1.max(ch[c].1));
+        }
+    }
+    let (mut max, mut color_max, mut sse) = (0u32, 0u32, 0.0f64);
+    for g in groups.values() {
+        max = max.max((g.hi - g.lo).div_ceil(2));
+        for &(lo, hi) in &g.ch {
+            color_max = color_max.max((hi - lo).div_ceil(2));
+        }
+        // sum (y - r)^2 = sq - 2 y sum + n y^2, smallest at the integer nearest the mean.
+        let y = (g.sum / g.n).round();
+        sse += (g.sq - 2.0 * y * g.sum + g.n * y * y).max(0.0);
+    }
+    Errors {
+        max_abs_error: max,
+        rmse: (sse / img.pixels().max(1) as f64).sqrt(),
+        color_max_abs_error: img.color.as_ref().map(|_| color_max),
+        complete: false,
+        pixels_seen: 0,
+    }
+}
+
+/// Whether errors at least `bound` are proved to exceed `limits` (see [`Acc::exceeds`]).
+pub fn bound_exceeds(bound: &Errors, limits: &Limits, pixels: usize) -> bool {
+    limits.max.is_some_and(|m| {
+        bound.max_abs_error > m || bound.color_max_abs_error.is_some_and(|c| c > m)
+    }) || limits
+        .sse
+        .is_some_and(|s| bound.rmse * bound.rmse * pixels as f64 > s)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -311,5 +382,63 @@ mod tests {
         // The channel scales the intensity by at most 255/255, plus rounding.
         assert!(ch <= e.max_abs_error + 1, "{e:?}");
         assert!(ch > 0);
+    }
+
+    /// The bound is a lower bound for any contents: for the model's own maps, fitted maps
+    /// and random maps and tables alike, and it rules out a coarse front end.
+    #[test]
+    fn the_information_bound_is_below_every_contents_errors() {
+        let scene = Scene::standard();
+        for cfg in [
+            Config::default(),
+            Config {
+                red_bits: 6,
+                frac_bits: 5,
+                recip_bits: 7,
+                index_bits: 3,
+                ..Config::default()
+            },
+            Config {
+                comp_table: crate::config::CompTable::Ram,
+                frac_bits: 6,
+                ..Config::default()
+            },
+        ] {
+            let img = TestImage::new(&cfg, &scene, 96);
+            let b = information_bound(&cfg, &img);
+            let mut rng = crate::rng::SplitMix64::new(7);
+            let n = 3 * cfg.map_entries() as usize;
+            let random = Maps::from_data(&cfg, (0..n).map(|_| rng.below(256) as u32).collect());
+            let mut all = vec![scene.maps(&cfg), random];
+            if !cfg.comp_table.is_rom() {
+                let m = crate::model::map_fit::contents(
+                    &cfg,
+                    crate::model::map_fit::MapFit::Table,
+                    |d| scene.prepared().shade(d),
+                );
+                all.push(m);
+            }
+            for maps in &all {
+                let (e, _) = measure(&cfg, maps, &img, Limits::default(), &[]);
+                assert!(b.max_abs_error <= e.max_abs_error, "{b:?} {e:?}");
+                assert!(b.rmse <= e.rmse + 1e-12, "{b:?} {e:?}");
+            }
+        }
+        // Five fraction bits and a 6-bit reduced gradient cannot draw the highlight.
+        let coarse = Config {
+            red_bits: 6,
+            frac_bits: 4,
+            recip_bits: 5,
+            ..Config::default()
+        };
+        let img = TestImage::new(&coarse, &scene, 128);
+        let b = information_bound(&coarse, &img);
+        assert!(b.max_abs_error > 4, "{b:?}");
+        let lim = Limits {
+            max: Some(4),
+            sse: None,
+        };
+        assert!(bound_exceeds(&b, &lim, img.pixels()));
+        assert!(!bound_exceeds(&b, &Limits::default(), img.pixels()));
     }
 }

@@ -88,6 +88,7 @@ pub fn search(scene: &Scene, opts: &Options, progress: Progress) -> Result<Outco
         img: &img,
         maps: MapCache::new(scene, opts.map_fit),
         killers: Killers(Mutex::new(Vec::new())),
+        bounds: Default::default(),
     };
     let cands = space::by_bits(&base);
     let target = opts.target;

@@ -116,8 +116,11 @@ pub fn no_larger(a: &Config, b: &Config) -> bool {
 }
 
 /// The paper's design with `base`'s interface fields: what `fit` compares its choice with.
+/// Its compensation table is held as the candidates hold theirs (a RAM under `--map-fit
+/// table`, whose table is then fitted like theirs), so it is one of them.
 pub fn paper(base: &Config) -> Config {
     Config {
+        comp_table: base.comp_table,
         grad_bits: base.grad_bits,
         map_bits: base.map_bits,
         color: base.color,

@@ -98,6 +98,22 @@ impl Model {
         }
     }
 
+    /// What decides a sample's output: the zero flag, the face and quadrant (axis and the
+    /// three signs) and the two fraction codes. Every stage after normalise is a function of
+    /// it, whatever the tables and maps hold, so samples with one state have one output (the
+    /// information bound of `fit` rests on this).
+    #[inline]
+    pub fn state(&self, g: [i32; 3]) -> u64 {
+        let sort = sort_shift::eval(&self.cfg, g);
+        let norm = normalise::eval(&self.cfg, &self.recip, sort.m, sort.a, sort.b);
+        let head = (zero_detect::eval(g) as u64) << 5
+            | (sort.axis as u64) << 3
+            | (sort.s_max as u64) << 2
+            | (sort.s_u as u64) << 1
+            | sort.s_v as u64;
+        head << 48 | (norm.u as u64) << 24 | norm.v as u64
+    }
+
     /// Runs one sample through every stage. `rgb` is ignored when colour multiply is off.
     pub fn trace(&self, maps: &Maps, g: [i32; 3], rgb: [u32; 3]) -> Trace {
         let cfg = &self.cfg;

@@ -8,8 +8,9 @@
 
 use crate::hdl::require;
 use crate::helpers;
-use rmapgen::config::Config;
+use rmapgen::config::{CompTable, Config};
 use rmapgen::fit::space;
+use rmapgen::model::map_fit::MapFit;
 use rmapgen::render::{self, Options};
 use rmapgen::scene::Scene;
 use serde_json::Value;
@@ -381,6 +382,79 @@ fn bad_input_is_one_line_exit_2_and_leaves_the_output_alone() {
 }
 
 /// `fit --prefix` writes the chosen design with the prefix, as `generate --prefix` does.
+/// `--map-fit table` searches designs whose compensation table the host loads and fits with
+/// the maps (`comp_table = ram`): every candidate gets its own fitted table, and every
+/// cheaper one is rejected, by its measured errors or by the information bound (its front
+/// end cannot meet the target whatever the table and maps hold).
+#[test]
+fn a_fitted_table_search_chooses_a_ram_table_design_and_rejects_every_cheaper_one() {
+    let tmp = helpers::tempdir();
+    let out = tmp.path().join("t");
+    let (d, stdout) = fit(
+        "standard.toml",
+        &out,
+        &[
+            "--map-fit",
+            "table",
+            "--grad-bits",
+            "8",
+            "--max-error",
+            "16",
+            "--size",
+            "128",
+            "--runners-up",
+            "1",
+        ],
+    );
+    let chosen = config(&d["chosen"]);
+    assert_eq!(chosen.comp_table, CompTable::Ram, "{stdout}");
+    assert!(chosen.compensation);
+    let mut sc = scene("standard.toml");
+    sc.map_fit = MapFit::Table;
+    let size = |cfg: &Config| {
+        render::render(
+            cfg,
+            &sc,
+            Options {
+                size: 128,
+                shrink: 0,
+            },
+            None,
+        )
+        .expect("render")
+        .metrics
+    };
+    let m = size(&chosen);
+    assert!(
+        m.max_abs_error <= 16,
+        "{}: {}",
+        chosen.summary(),
+        m.max_abs_error
+    );
+    assert_eq!(d["chosen"]["errors"]["max_abs_error"], m.max_abs_error);
+    // Every cheaper RAM-table design was measured and rejected; the nearest ones miss when
+    // rendered with their own fitted tables.
+    let order = space::by_bits(&chosen);
+    assert!(order.iter().all(|c| c.comp_table == CompTable::Ram));
+    let at = order.iter().position(|c| *c == chosen).unwrap();
+    assert_eq!(d["cheaper_rejected"], at, "{stdout}");
+    assert!(at >= 4, "{stdout}");
+    for c in &order[at - 4..at] {
+        assert!(
+            size(c).max_abs_error > 16,
+            "{} passes but costs less",
+            c.summary()
+        );
+    }
+    // The paper's widths are measured as a candidate: with a fitted table.
+    assert_eq!(config(&d["paper"]).comp_table, CompTable::Ram);
+    // The design written loads its table: the manifest says so.
+    let manifest: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(config(&manifest), chosen);
+    assert!(stdout.contains("table=ram"), "{stdout}");
+}
+
 #[test]
 fn fit_writes_its_design_with_a_prefix() {
     let tmp = helpers::tempdir();
