@@ -285,13 +285,15 @@ pub fn information_bound(cfg: &Config, img: &TestImage) -> Errors {
     }
 }
 
-/// Whether errors at least `bound` are proved to exceed `limits` (see [`Acc::exceeds`]).
+/// Whether errors at least `bound` are proved to exceed `limits` (see [`Acc::exceeds`]). The
+/// squared errors are rebuilt from the RMSE, so they must exceed the limit by more than
+/// rounding could add.
 pub fn bound_exceeds(bound: &Errors, limits: &Limits, pixels: usize) -> bool {
     limits.max.is_some_and(|m| {
         bound.max_abs_error > m || bound.color_max_abs_error.is_some_and(|c| c > m)
     }) || limits
         .sse
-        .is_some_and(|s| bound.rmse * bound.rmse * pixels as f64 > s)
+        .is_some_and(|s| bound.rmse * bound.rmse * pixels as f64 > s * (1.0 + 1e-9) + 1e-9)
 }
 
 #[cfg(test)]
@@ -440,5 +442,13 @@ mod tests {
         };
         assert!(bound_exceeds(&b, &lim, img.pixels()));
         assert!(!bound_exceeds(&b, &Limits::default(), img.pixels()));
+        // In squares: a limit below the bound's is exceeded, one at it is not.
+        let sse = b.rmse * b.rmse * img.pixels() as f64;
+        let at = |s: f64| Limits {
+            max: None,
+            sse: Some(s),
+        };
+        assert!(sse > 0.0 && bound_exceeds(&b, &at(0.99 * sse), img.pixels()));
+        assert!(!bound_exceeds(&b, &at(sse), img.pixels()));
     }
 }

@@ -146,16 +146,19 @@ fn a_bad_map_fit_or_scene_is_one_line_on_every_command() {
             out.to_str().unwrap(),
         ]);
         helpers::assert_error(&helpers::run(&v), "invalid value 'cubic' for '--map-fit");
-        // A fit of the compensation table, for a design whose table is a ROM.
-        let mut v = args.clone();
-        v.extend([
-            "--map-fit",
-            "table",
-            out_flag(args[0]),
-            out.to_str().unwrap(),
-        ]);
-        helpers::assert_error(&helpers::run(&v), "map_fit table");
-        assert!(!out.exists(), "{}", args[0]);
+        // A fit of the compensation table, for a design whose table is a ROM (`fit` instead
+        // searches the designs that load their table: tests/it/fit.rs).
+        if args[0] != "fit" {
+            let mut v = args.clone();
+            v.extend([
+                "--map-fit",
+                "table",
+                out_flag(args[0]),
+                out.to_str().unwrap(),
+            ]);
+            helpers::assert_error(&helpers::run(&v), "map_fit table");
+            assert!(!out.exists(), "{}", args[0]);
+        }
         // A missing scene file, named.
         let mut v = Vec::new();
         let mut it = args.iter();
