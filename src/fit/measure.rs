@@ -426,7 +426,7 @@ mod tests {
                 assert!(b.rmse <= e.rmse + 1e-12, "{b:?} {e:?}");
             }
         }
-        // Five fraction bits and a 6-bit reduced gradient cannot draw the highlight.
+        // Four fraction bits and a 6-bit reduced gradient cannot draw the highlight.
         let coarse = Config {
             red_bits: 6,
             frac_bits: 4,
