@@ -24,6 +24,16 @@ pub const MAX_RUNNERS_UP: usize = 100;
 /// Largest `--synth-limit`: each synthesis takes Yosys seconds to a minute.
 pub const MAX_SYNTH_LIMIT: usize = 64;
 
+/// The help heading of the searched fields a user may fix.
+const FIXED: &str = "Fixed instead of searched";
+
+/// The help of a searched field's fixing flag: `what [min..=max; searched when not given]`,
+/// the range from [`crate::config::range_of`].
+fn fixed_help(name: &str, what: &str) -> String {
+    let (min, max) = crate::config::range_of(name).expect("a configuration field with a range");
+    format!("{what} [{min}..={max}; searched when not given]")
+}
+
 #[derive(Args, Debug)]
 #[command(group(clap::ArgGroup::new("target").required(true).multiple(true).args(["max_error", "rmse"])))]
 #[command(mut_arg("scene", |a| a.required(true)
@@ -90,6 +100,24 @@ pub struct FitArgs {
     /// [0..=1000000].
     #[arg(long, value_name = "N", default_value_t = 2000, value_parser = parse::count::<usize>())]
     pub vectors: usize,
+    #[arg(long, value_name = "R", value_parser = parse::field("red_bits"), help_heading = FIXED,
+        help = fixed_help("red_bits", "Fix the reduced width instead of searching it (with the other flags here: search only what is left free, for example the map around a chosen front end)"))]
+    pub red_bits: Option<u32>,
+    #[arg(long, value_name = "F", value_parser = parse::field("frac_bits"), help_heading = FIXED,
+        help = fixed_help("frac_bits", "Fix the fraction width"))]
+    pub frac_bits: Option<u32>,
+    #[arg(long, value_name = "W", value_parser = parse::field("recip_bits"), help_heading = FIXED,
+        help = fixed_help("recip_bits", "Fix the reciprocal width"))]
+    pub recip_bits: Option<u32>,
+    #[arg(long, value_name = "I", value_parser = parse::field("index_bits"), help_heading = FIXED,
+        help = fixed_help("index_bits", "Fix the index bits (map entries per face: (2^I + 1)^2)"))]
+    pub index_bits: Option<u32>,
+    #[arg(long, value_name = "P", value_parser = parse::field("interp_bits"), help_heading = FIXED,
+        help = fixed_help("interp_bits", "Fix the interpolation fraction bits (0: no interpolator)"))]
+    pub interp_bits: Option<u32>,
+    /// Fix the distortion compensation on or off.
+    #[arg(long, value_name = "on|off", value_parser = ["on", "off"], help_heading = FIXED)]
+    pub compensation: Option<String>,
     /// Seed of the random vectors.
     #[arg(long, value_name = "S", default_value_t = 1, value_parser = parse::at_least::<u64>(0))]
     pub seed: u64,
@@ -150,6 +178,14 @@ pub fn run(a: &FitArgs) -> Result<()> {
         runners_up: a.runners_up,
         synth_limit: a.synth_limit,
         map_fit: scene.map_fit,
+        fixed: fit::space::Fixed {
+            red_bits: a.red_bits,
+            frac_bits: a.frac_bits,
+            recip_bits: a.recip_bits,
+            index_bits: a.index_bits,
+            interp_bits: a.interp_bits,
+            compensation: a.compensation.as_deref().map(|c| c == "on"),
+        },
     };
     // A progress bar, shown once the search has run for a second (on a terminal).
     let bar = ProgressBar::with_draw_target(Some(0), ProgressDrawTarget::hidden());
@@ -206,6 +242,12 @@ pub fn run(a: &FitArgs) -> Result<()> {
             CostKind::Cells => format!("Yosys cells ({} synthesis)", d.family.title()),
         }
     )?;
+    if !d.fixed.is_empty() {
+        crate::outln!(
+            "fit: fixed {}; the other fields searched",
+            d.fixed.describe()
+        )?;
+    }
     match d.cost {
         CostKind::Bits => crate::outln!(
             "fit: {} configurations, {} measured in {:.1} s; every one cheaper than the choice ({}) measured and rejected",

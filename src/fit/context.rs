@@ -147,7 +147,10 @@ mod tests {
     fn sampled_maps_depend_only_on_the_cache_key() {
         let scene = Scene::alternate();
         let cache = MapCache::new(&scene, MapFit::Sample);
-        for c in space::candidates(&Config::default()).iter().step_by(977) {
+        for c in space::candidates(&Config::default(), &space::Fixed::default())
+            .iter()
+            .step_by(977)
+        {
             assert_eq!(*cache.get(c), scene.maps(c), "{}", c.summary());
         }
     }

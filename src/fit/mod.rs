@@ -61,6 +61,8 @@ pub struct Options {
     pub synth_limit: usize,
     /// How the maps are filled (the scene's own `map_fit` unless overridden).
     pub map_fit: MapFit,
+    /// Searched fields the caller fixed: only candidates with those values are searched.
+    pub fixed: space::Fixed,
 }
 /// Rejected candidates below the choice shown in full.
 const SHOWN_BELOW: usize = 3;
@@ -90,7 +92,14 @@ pub fn search(scene: &Scene, opts: &Options, progress: Progress) -> Result<Outco
         killers: Killers(Mutex::new(Vec::new())),
         bounds: Default::default(),
     };
-    let cands = space::by_bits(&base);
+    let cands = space::by_bits(&base, &opts.fixed);
+    anyhow::ensure!(
+        !cands.is_empty(),
+        "no valid configuration has {} (with --grad-bits {} and --map-bits {}): fix fewer fields",
+        opts.fixed.describe(),
+        base.grad_bits,
+        base.map_bits
+    );
     let target = opts.target;
     let limits = target.limits(img.pixels());
     let mut results: Vec<Option<Errors>> = vec![None; cands.len()];
@@ -302,6 +311,7 @@ pub fn search(scene: &Scene, opts: &Options, progress: Progress) -> Result<Outco
         rejected_below,
         paper,
         space: cands.len(),
+        fixed: opts.fixed,
         measured,
         cheaper_rejected: first,
         synthesised,

@@ -64,6 +64,9 @@ pub struct Decision {
     pub paper: Candidate,
     /// Candidates in the space, measured, and cheaper (in bits) than the choice.
     pub space: usize,
+    /// The searched fields the caller fixed (none: the whole space).
+    #[serde(skip_serializing_if = "super::space::Fixed::is_empty")]
+    pub fixed: super::space::Fixed,
     pub measured: usize,
     pub cheaper_rejected: usize,
     /// Candidates synthesised (cost in cells; 0 otherwise), besides the paper's.

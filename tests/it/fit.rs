@@ -110,7 +110,7 @@ fn the_choice_meets_the_target_and_every_cheaper_candidate_misses_it() {
     assert_eq!(d["chosen"]["bits"], space::bits(&chosen));
 
     // Every candidate before the choice in cost order was measured and rejected.
-    let order = space::by_bits(&chosen);
+    let order = space::by_bits(&chosen, &space::Fixed::default());
     let at = order
         .iter()
         .position(|c| *c == chosen)
@@ -320,7 +320,7 @@ fn bad_input_is_one_line_exit_2_and_leaves_the_output_alone() {
         "[material]\nambient=0.1\ndiffuse=0.6\nspecular=0.3\nshininess=20\n[[light]]\ndirection=[0,0,0]\n",
     )
     .unwrap();
-    let cases: [(Vec<&str>, &str); 9] = [
+    let cases: [(Vec<&str>, &str); 12] = [
         (
             vec!["--scene", &s, "--max-error", "4", "--grad-bits", "20"],
             "--grad-bits must be in 8..=16, not 20",
@@ -367,6 +367,28 @@ fn bad_input_is_one_line_exit_2_and_leaves_the_output_alone() {
             vec!["--scene", &s, "--max-error", "4", "--lanes", "9"],
             "--lanes must be in 1..=8, not 9",
         ),
+        // A fixed field out of its range, and fixed fields no valid configuration has.
+        (
+            vec!["--scene", &s, "--max-error", "4", "--red-bits", "13"],
+            "--red-bits must be in 6..=12, not 13",
+        ),
+        (
+            vec!["--scene", &s, "--max-error", "4", "--compensation", "maybe"],
+            "invalid value 'maybe' for '--compensation",
+        ),
+        (
+            vec![
+                "--scene",
+                &s,
+                "--max-error",
+                "4",
+                "--frac-bits",
+                "12",
+                "--recip-bits",
+                "12",
+            ],
+            "no valid configuration has W12 F12 (with --grad-bits 12 and --map-bits 8): fix fewer fields",
+        ),
     ];
     for (args, needle) in cases {
         let mut a = vec!["fit", "--out", o_];
@@ -379,6 +401,59 @@ fn bad_input_is_one_line_exit_2_and_leaves_the_output_alone() {
             "{a:?}"
         );
     }
+}
+
+/// Fields given on the command line are fixed, and the rest searched: with the paper's front
+/// end fixed (R8 W10 F8), the search runs over the map and its stages alone, every cheaper
+/// candidate of that space is measured and rejected, and fit.json records what was fixed.
+#[test]
+fn fixed_fields_are_kept_and_the_rest_searched() {
+    let tmp = helpers::tempdir();
+    let out = tmp.path().join("fixed");
+    let front = ["--red-bits", "8", "--frac-bits", "8", "--recip-bits", "10"];
+    let mut args = vec!["--max-error", "16"];
+    args.extend(front);
+    let (d, stdout) = fit("standard.toml", &out, &args);
+    let chosen = config(&d["chosen"]);
+    assert_eq!(
+        (chosen.red_bits, chosen.frac_bits, chosen.recip_bits),
+        (8, 8, 10),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("fit: fixed R8 W10 F8; the other fields searched"),
+        "{stdout}"
+    );
+    assert_eq!(
+        d["fixed"],
+        serde_json::json!({"red_bits": 8, "frac_bits": 8, "recip_bits": 10})
+    );
+    let fixed = space::Fixed {
+        red_bits: Some(8),
+        frac_bits: Some(8),
+        recip_bits: Some(10),
+        ..Default::default()
+    };
+    let order = space::by_bits(&chosen, &fixed);
+    assert_eq!(d["space"], order.len());
+    let at = order
+        .iter()
+        .position(|c| *c == chosen)
+        .expect("a candidate");
+    assert_eq!(d["cheaper_rejected"], at, "{stdout}");
+    let sc = scene("standard.toml");
+    assert!(rendered(&chosen, &sc).0 <= 16);
+    for c in &order[..at] {
+        assert!(rendered(c, &sc).0 > 16, "{} meets the target", c.summary());
+    }
+    // Searching everything finds no dearer design: the fixed space is a part of it.
+    let (all, _) = fit(
+        "standard.toml",
+        &tmp.path().join("all"),
+        &["--max-error", "16"],
+    );
+    assert!(all["chosen"]["bits"].as_u64() <= d["chosen"]["bits"].as_u64());
+    assert!(all.get("fixed").is_none());
 }
 
 /// `fit --prefix` writes the chosen design with the prefix, as `generate --prefix` does.
@@ -434,7 +509,7 @@ fn a_fitted_table_search_chooses_a_ram_table_design_and_rejects_every_cheaper_on
     assert_eq!(d["chosen"]["errors"]["max_abs_error"], m.max_abs_error);
     // Every cheaper RAM-table design was measured and rejected; the nearest ones miss when
     // rendered with their own fitted tables.
-    let order = space::by_bits(&chosen);
+    let order = space::by_bits(&chosen, &space::Fixed::default());
     assert!(order.iter().all(|c| c.comp_table == CompTable::Ram));
     let at = order.iter().position(|c| *c == chosen).unwrap();
     assert_eq!(d["cheaper_rejected"], at, "{stdout}");
