@@ -216,10 +216,20 @@ pub fn enumerate(
 mod tests {
     use super::*;
 
-    /// At 8 bits every gradient is cheap: the set is exactly the model's image.
+    /// At 8 bits every gradient is cheap: the set is exactly the model's image. On the
+    /// narrowest row (R6) the shift truncates, so neighbouring magnitudes share their states;
+    /// with nothing truncated (R = G = 8) every magnitude has states of its own, so a state
+    /// lost at a tie (a component equal to the max) or added at the edge (a positive
+    /// 2^(G-1), which no G-bit component is) shows.
     #[test]
     fn the_set_is_the_image_of_sort_shift() {
-        let cfg = crate::grid::row("narrowest").unwrap().config;
+        for row in ["narrowest", "grad8_red8"] {
+            is_the_image(&crate::grid::row(row).unwrap().config);
+        }
+    }
+
+    fn is_the_image(cfg: &Config) {
+        let cfg = cfg.clone();
         let mut reps = 0;
         let set = enumerate(&cfg, |ord, _| {
             // The ordinals count the states from 0, in order (the release build of
@@ -245,6 +255,44 @@ mod tests {
             }
         }
         assert_eq!(image.len(), set.len(), "a state no gradient produces");
+    }
+
+    /// The runs of a component's reduced values, at the edge c = 2^(G-1) that only a negative
+    /// component reaches: with nothing truncated (R = G) the magnitude 2^(G-1) is a run of its
+    /// own, which offers a negative sign only. Each run offers the smallest magnitude of each
+    /// sign it holds, so the representatives are the first gradients of their states.
+    #[test]
+    fn a_runs_signs_are_its_smallest_magnitudes_and_the_edge_is_negative_only() {
+        let cfg = crate::grid::row("grad8_red8").unwrap().config;
+        let half = 1u32 << (cfg.grad_bits - 1);
+        for (max, lim) in [
+            (half, half),
+            (half, half - 1),
+            (half - 1, half - 1),
+            (37, 37),
+        ] {
+            let runs = runs(&cfg, max, lim);
+            // Every magnitude, grouped by hand into its runs of equal reduced values.
+            let a = |c: u32| sort_shift::eval(&cfg, [-(max as i32), -(c as i32), 0]).a;
+            let mut groups: Vec<Vec<u32>> = Vec::new();
+            for c in 0..=lim {
+                match groups.last_mut() {
+                    Some(g) if a(g[0]) == a(c) => g.push(c),
+                    _ => groups.push(vec![c]),
+                }
+            }
+            assert_eq!(runs.len(), groups.len(), "max {max} lim {lim}: runs");
+            for (r, g) in runs.iter().zip(&groups) {
+                assert_eq!(r.a, a(g[0]), "max {max}: the run's reduced value");
+                let pos = g.iter().copied().find(|&c| c < half);
+                let neg = g.iter().copied().find(|&c| c >= 1);
+                assert_eq!((r.pos, r.neg), (pos, neg), "max {max}: the run of {g:?}");
+            }
+            if lim == half {
+                let last = runs.last().unwrap();
+                assert_eq!((last.pos, last.neg), (None, Some(half)), "the edge");
+            }
+        }
     }
 
     /// A state outside the key space (an axis above 2, an m without its top bit or wider than
