@@ -136,8 +136,18 @@ impl Ctx<'_> {
     }
 }
 
-/// Candidates measured per parallel batch.
+/// Candidates measured per parallel batch of the lowest-error search ([`super::best`]),
+/// which measures the whole space.
 pub(super) const BATCH: usize = 64;
+
+/// Candidates measured per parallel batch of the search for the cheapest passing one: two
+/// per thread, so that the search stops soon after the first pass. Past it, a batch measures
+/// dearer candidates that nothing needs, and with a slow map fit (`minimax` at 6 index bits
+/// takes minutes) a batch of 64 cost the fixed-front-end search 20 minutes where it needed
+/// one.
+pub(super) fn search_batch() -> usize {
+    (2 * rayon::current_num_threads()).clamp(2, BATCH)
+}
 
 #[cfg(test)]
 mod tests {

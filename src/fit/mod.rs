@@ -31,7 +31,7 @@ use crate::model::map_fit::MapFit;
 use crate::scene::Scene;
 use anyhow::Result;
 pub use context::Progress;
-use context::{Ctx, Killers, MapCache, BATCH};
+use context::{Ctx, Killers, MapCache};
 use measure::{Errors, TestImage};
 use outcome::{Candidate, Decision, Outcome};
 use rayon::prelude::*;
@@ -133,7 +133,7 @@ pub fn search(scene: &Scene, opts: &Options, progress: Progress) -> Result<Outco
     };
     let mut pos = 0;
     while pos < cands.len() && !wanted(&passing, &fitting, tried, &minimal, &class_left) {
-        let end = (pos + BATCH).min(cands.len());
+        let end = (pos + context::search_batch()).min(cands.len());
         let batch: Vec<Errors> = cands[pos..end]
             .par_iter()
             .map(|c| ctx.measure(c, limits))
