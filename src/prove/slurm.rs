@@ -598,6 +598,128 @@ mod tests {
         let (_t, v) = ended(Some(0), &[None; 25], Some(2));
         assert!(v.text.contains("shard 20/25") && !v.text.contains("shard 21/25"));
         assert!(v.text.contains("... and 5 more shards"), "{}", v.text);
+        // Exactly 20: all named, none left to count.
+        let (_t, v) = ended(Some(0), &[None; NAMED], Some(2));
+        assert!(v.text.contains("shard 20/20"), "{}", v.text);
+        assert!(!v.text.contains("more shards"), "{}", v.text);
+    }
+
+    /// A job directory with its three subdirectories, as `write_scripts` makes it.
+    fn job_dir() -> (tempfile::TempDir, Layout) {
+        let tmp = tempfile::tempdir().unwrap();
+        for sub in ["logs", "status", "reports"] {
+            std::fs::create_dir_all(tmp.path().join(sub)).unwrap();
+        }
+        let layout = Layout {
+            root: tmp.path().to_path_buf(),
+        };
+        (tmp, layout)
+    }
+
+    /// Only the shards' status files count, each once, and a shard failed unless its file
+    /// says 0 (an unreadable one too).
+    #[test]
+    fn the_ended_shards_are_their_status_files_and_the_failed_those_not_0() {
+        let (_t, layout) = job_dir();
+        assert_eq!(shards_ended(&layout), (0, 0));
+        for (job, text) in [
+            ("build", "0"),
+            ("merge", "1"),
+            ("shard-1", "0"),
+            ("shard-2", "1"),
+            ("shard-3", "2\n"),
+            ("shard-4", "not a number"),
+            ("shard-5", "0\n"),
+        ] {
+            std::fs::write(layout.status(job), text).unwrap();
+        }
+        std::fs::write(layout.root.join("status").join("shard-6.log"), "0").unwrap();
+        assert_eq!(shards_ended(&layout), (5, 3));
+        let none = Layout {
+            root: layout.root.join("no such dir"),
+        };
+        assert_eq!(shards_ended(&none), (0, 0));
+    }
+
+    #[test]
+    fn a_runs_jobs_are_its_three_ids_in_order() {
+        let jobs = Jobs {
+            build: "7".into(),
+            shards: "8".into(),
+            merge: "9".into(),
+        };
+        assert_eq!(jobs.all(), ["7", "8", "9"]);
+    }
+
+    /// `wait` reports each change of the status files, in the words of the build's and the
+    /// shards' state, and returns once the merge has written its status, not before (the
+    /// files change well within the 5 s after which it would ask Slurm's queue).
+    #[test]
+    fn waiting_reports_each_change_and_ends_when_the_merge_has_ended() {
+        let (_t, layout) = job_dir();
+        let jobs = Jobs {
+            build: "7".into(),
+            shards: "8".into(),
+            merge: "9".into(),
+        };
+        let merged = std::sync::atomic::AtomicBool::new(false);
+        let lines = std::sync::Mutex::new(Vec::<String>::new());
+        std::thread::scope(|s| {
+            s.spawn(|| {
+                std::thread::sleep(Duration::from_millis(1000));
+                std::fs::write(layout.status("build"), "0\n").unwrap();
+                std::thread::sleep(Duration::from_millis(700));
+                std::fs::write(layout.status("shard-1"), "0\n").unwrap();
+                std::fs::write(layout.status("shard-2"), "1\n").unwrap();
+                std::thread::sleep(Duration::from_millis(700));
+                merged.store(true, std::sync::atomic::Ordering::SeqCst);
+                std::fs::write(layout.status("merge"), "1\n").unwrap();
+            });
+            wait(&layout, &jobs, 2, &|l: &str| {
+                lines.lock().unwrap().push(l.to_string())
+            })
+            .unwrap();
+            assert!(
+                merged.load(std::sync::atomic::Ordering::SeqCst),
+                "wait returned before the merge ended"
+            );
+        });
+        let lines = lines.into_inner().unwrap();
+        assert_eq!(
+            lines.first().map(String::as_str),
+            Some("slurm: build running or queued; 0 of 2 shards ended (0 failed)")
+        );
+        assert_eq!(
+            lines.last().map(String::as_str),
+            Some("slurm: built; 2 of 2 shards ended (1 failed)"),
+            "{lines:?}"
+        );
+        assert!(lines.windows(2).all(|w| w[0] != w[1]), "{lines:?}");
+        assert!(lines.len() <= 3, "a line for each change only: {lines:?}");
+        // A build that failed says so; a merge that has ended returns at once, silent.
+        let (_t, layout) = job_dir();
+        std::fs::write(layout.status("build"), "2\n").unwrap();
+        let lines = std::sync::Mutex::new(Vec::<String>::new());
+        std::thread::scope(|s| {
+            s.spawn(|| {
+                std::thread::sleep(Duration::from_millis(800));
+                std::fs::write(layout.status("merge"), "2\n").unwrap();
+            });
+            wait(&layout, &jobs, 3, &|l: &str| {
+                lines.lock().unwrap().push(l.to_string())
+            })
+            .unwrap();
+        });
+        assert_eq!(
+            lines.into_inner().unwrap(),
+            ["slurm: build failed (exit 2); 0 of 3 shards ended (0 failed)"]
+        );
+        let lines = std::sync::Mutex::new(Vec::<String>::new());
+        wait(&layout, &jobs, 3, &|l: &str| {
+            lines.lock().unwrap().push(l.to_string())
+        })
+        .unwrap();
+        assert!(lines.into_inner().unwrap().is_empty());
     }
 
     /// The scripts run as Slurm runs them (`sh`, the task index in the environment) against a
