@@ -642,6 +642,69 @@ pub fn check(d: &DesignDir, build: &Path) -> Result<Part> {
 mod tests {
     use super::*;
 
+    /// A design directory holding only the manifest of `cfg`.
+    fn design(cfg: &crate::config::Config) -> (tempfile::TempDir, DesignDir) {
+        let tmp = tempfile::tempdir().unwrap();
+        let manifest = serde_json::json!({ "top": "rmap_top", "config": cfg, "modules": [] });
+        std::fs::write(tmp.path().join("manifest.json"), manifest.to_string()).unwrap();
+        let d = DesignDir::open(tmp.path()).unwrap();
+        (tmp, d)
+    }
+
+    /// The sample ports are the top's gradient inputs and its result outputs (not the clock,
+    /// the handshake or the host port), with the side channel exactly when the design
+    /// carries one (an AXI4-Stream tuser, the lanes' tag under the handshake).
+    #[test]
+    fn the_sample_ports_are_the_gradient_in_and_the_result_out() {
+        let base = crate::config::Config::default();
+        let (_t, d) = design(&base);
+        let (ins, outs) = sample_ports(&d);
+        assert_eq!(ins, ["gx_i", "gy_i", "gz_i"]);
+        assert_eq!(outs, ["zero_o", "i_o"]);
+        for cfg in [
+            crate::config::Config {
+                axis: true,
+                axis_user: 4,
+                handshake: true,
+                ..base.clone()
+            },
+            crate::config::Config {
+                lanes: 2,
+                handshake: true,
+                ..base.clone()
+            },
+            crate::config::Config {
+                lanes: 2,
+                ..base.clone()
+            },
+        ] {
+            let (_t, d) = design(&cfg);
+            let (ins, outs) = sample_ports(&d);
+            let side = cfg.side_bits() > 0;
+            assert_eq!(ins.contains(&"side_i".to_string()), side, "{ins:?}");
+            assert_eq!(outs.contains(&"side_o".to_string()), side, "{outs:?}");
+            assert_eq!(ins[..3], ["gx_i", "gy_i", "gz_i"], "{}", cfg.summary());
+        }
+    }
+
+    /// Yosys's JSON is read as JSON; a file that is missing or not JSON is an error naming it.
+    #[test]
+    fn a_netlist_is_read_as_json_or_refused_naming_the_file() {
+        let tmp = tempfile::tempdir().unwrap();
+        let good = tmp.path().join("n.json");
+        std::fs::write(&good, r#"{"modules": {"top": {"ports": {}}}}"#).unwrap();
+        assert_eq!(
+            read(&good).unwrap(),
+            serde_json::json!({"modules": {"top": {"ports": {}}}})
+        );
+        let bad = tmp.path().join("bad.json");
+        std::fs::write(&bad, "{ not json").unwrap();
+        let e = format!("{:#}", read(&bad).unwrap_err());
+        assert!(e.contains("bad.json is not JSON"), "{e}");
+        let e = format!("{:#}", read(&tmp.path().join("gone.json")).unwrap_err());
+        assert!(e.contains("cannot read") && e.contains("gone.json"), "{e}");
+    }
+
     fn reg(kind: &str, d: u64, q: u64) -> Cell {
         Cell {
             name: format!("r{q}"),
