@@ -136,7 +136,7 @@ impl Ctx<'_> {
     }
 }
 
-/// Candidates measured per parallel batch of the lowest-error search ([`super::best`]),
+/// Candidates measured per parallel batch of the lowest-error search (when nothing passes),
 /// which measures the whole space.
 pub(super) const BATCH: usize = 64;
 
