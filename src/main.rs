@@ -57,8 +57,9 @@ enum Command {
     /// target, and write its design as `generate` does.
     ///
     /// Searched: red-bits, frac-bits, recip-bits, index-bits, interp-bits (0 = no
-    /// interpolation) and compensation on/off, over every valid combination of their ranges;
-    /// fixed: grad-bits and map-bits (the interface; the target is in LSBs of the map-bits
+    /// interpolation) and compensation on/off, over every valid combination of their ranges
+    /// (each of them may be fixed instead: "Fixed instead of searched" below); fixed:
+    /// grad-bits and map-bits (the interface; the target is in LSBs of the map-bits
     /// output), colour multiply (on exactly when the scene has a `color`). Candidates are
     /// measured in order of cost until the first meets the target, so every cheaper one is
     /// measured and rejected. Exit 2 with the lowest error reachable when none does.
