@@ -13,6 +13,7 @@ use crate::model::{MapSet, Model};
 use crate::rng::SplitMix64;
 use crate::stages::testbench::TbData;
 use crate::vectors::field::{Dir, Field};
+pub use crate::vectors::inputs::Traced;
 use anyhow::Result;
 use serde::Serialize;
 
@@ -292,6 +293,11 @@ pub trait Vectors: Unit {
 
     /// The model's outputs for one input vector.
     fn expected(&self, model: &Model, maps: &MapSet, inp: &[u64]) -> Vec<u64>;
+
+    /// Its inputs (the [`Self::fields`] that drive it, in order) when `s` runs through the
+    /// whole pipeline: the values the top's wires bring it. With [`Self::expected`], one
+    /// sample's path through the design, module by module ([`crate::stages::path`]).
+    fn traced(&self, cfg: &Config, s: &Traced) -> Vec<u64>;
 
     /// Every input vector of the file, in order: the corners, then `random` random ones.
     /// Calls `emit` per vector so a long stream never sits in memory.

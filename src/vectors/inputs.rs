@@ -209,12 +209,34 @@ pub fn position_corners(cfg: &Config) -> Vec<u32> {
     p
 }
 
-/// The gradient corners traced through the model with `maps`: the values they bring to each
-/// stage, which the stages' corner cases include.
-pub fn corner_traces<'a>(model: &'a Model, maps: &'a Maps) -> impl Iterator<Item = Trace> + 'a {
+/// One sample of the whole pipeline: what the top is given (the gradient, the colour, the
+/// map buffer it reads) and every value the model computes for it on the way.
+#[derive(Clone, Copy, Debug)]
+pub struct Traced {
+    pub g: [i32; 3],
+    pub rgb: [u32; 3],
+    pub buf: u64,
+    pub trace: Trace,
+}
+
+impl Traced {
+    /// `g` and `rgb` through the model, reading `maps` as buffer `buf`.
+    pub fn new(model: &Model, maps: &Maps, buf: u64, g: [i32; 3], rgb: [u32; 3]) -> Traced {
+        Traced {
+            g,
+            rgb,
+            buf,
+            trace: model.trace(maps, g, rgb),
+        }
+    }
+}
+
+/// The gradient corners traced through the model with `maps` (buffer 0, no colour): the
+/// values they bring to each stage, which the stages' corner cases include.
+pub fn corner_traces<'a>(model: &'a Model, maps: &'a Maps) -> impl Iterator<Item = Traced> + 'a {
     gradient_corners(&model.cfg)
         .into_iter()
-        .map(move |g| model.trace(maps, g, [0; 3]))
+        .map(move |g| Traced::new(model, maps, 0, g, [0; 3]))
 }
 
 /// A channel value that hits 0 and 255 more often than uniform draws would.

@@ -8,7 +8,7 @@ pub mod model;
 
 use super::position;
 use super::testbench::TbData;
-use super::unit::{file_param, Head, Memory, Unit, Vectors};
+use super::unit::{file_param, Head, Memory, Traced, Unit, Vectors};
 use crate::config::Config;
 use crate::hdl::ports::{i, Port};
 use crate::model::{MapSet, Model};
@@ -188,6 +188,15 @@ impl Vectors for AtanRom {
         [inp[0], inp[1]]
             .map(|u| model.position_in(m, u as u32) as u64)
             .to_vec()
+    }
+
+    fn traced(&self, cfg: &Config, s: &Traced) -> Vec<u64> {
+        let n = s.trace.norm;
+        let mut v = vec![n.u as u64, n.v as u64];
+        if ram(cfg) {
+            v.push(s.buf);
+        }
+        v
     }
 
     /// The buffer field drives rd_buf_i.

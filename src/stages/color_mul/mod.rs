@@ -6,7 +6,7 @@ pub mod model;
 mod plan;
 
 use super::testbench::TbData;
-use super::unit::{Head, Unit, Vectors};
+use super::unit::{Head, Traced, Unit, Vectors};
 use crate::config::{Config, COLOR_BITS};
 use crate::hdl::adder_tree::Step;
 use crate::hdl::ports::{i, o, stage_head, Port};
@@ -138,6 +138,13 @@ impl Vectors for ColorMul {
     fn expected(&self, model: &Model, _maps: &MapSet, inp: &[u64]) -> Vec<u64> {
         let u = |k: usize| inp[k] as u32;
         model::eval(&model.cfg, [u(1), u(2), u(3)], u(0))
+            .map(u64::from)
+            .to_vec()
+    }
+
+    fn traced(&self, _cfg: &Config, s: &Traced) -> Vec<u64> {
+        let c = s.rgb;
+        [s.trace.out.intensity, c[0], c[1], c[2]]
             .map(u64::from)
             .to_vec()
     }

@@ -5,7 +5,7 @@ pub mod model;
 mod plan;
 
 use super::testbench::TbData;
-use super::unit::{Head, Unit, Vectors};
+use super::unit::{Head, Traced, Unit, Vectors};
 use crate::config::Config;
 use crate::hdl::adder_tree::Step;
 use crate::hdl::ports::{i, o, stage_head, Port};
@@ -139,15 +139,7 @@ impl Vectors for Interpolate {
             }
         }
         for t in corner_traces(model, &maps.scene) {
-            let l = t.lookup;
-            out.push(vec![
-                l.e[0] as u64,
-                l.e[1] as u64,
-                l.e[2] as u64,
-                l.e[3] as u64,
-                l.w_u as u64,
-                l.w_v as u64,
-            ]);
+            out.push(self.traced(cfg, &t));
         }
         out
     }
@@ -163,6 +155,13 @@ impl Vectors for Interpolate {
     fn expected(&self, model: &Model, _maps: &MapSet, inp: &[u64]) -> Vec<u64> {
         let u = |k: usize| inp[k] as u32;
         vec![model::eval(&model.cfg, [u(0), u(1), u(2), u(3)], u(4), u(5)) as u64]
+    }
+
+    fn traced(&self, _cfg: &Config, s: &Traced) -> Vec<u64> {
+        let l = s.trace.lookup;
+        [l.e[0], l.e[1], l.e[2], l.e[3], l.w_u, l.w_v]
+            .map(u64::from)
+            .to_vec()
     }
 
     fn testbench(&self, t: &TbData) -> askama::Result<String> {

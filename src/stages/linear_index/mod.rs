@@ -6,7 +6,7 @@ mod plan;
 
 use super::position;
 use super::testbench::TbData;
-use super::unit::{Head, Unit, Vectors};
+use super::unit::{Head, Traced, Unit, Vectors};
 use crate::config::Config;
 use crate::hdl::adder_tree::Step;
 use crate::hdl::ports::Port;
@@ -95,6 +95,11 @@ impl Vectors for LinearIndex {
 
     fn expected(&self, model: &Model, _maps: &MapSet, inp: &[u64]) -> Vec<u64> {
         position::expected(model, inp)
+    }
+
+    fn traced(&self, _cfg: &Config, s: &Traced) -> Vec<u64> {
+        let n = s.trace.norm;
+        vec![n.u as u64, n.v as u64]
     }
 
     fn testbench(&self, t: &TbData) -> askama::Result<String> {

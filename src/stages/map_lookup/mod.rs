@@ -6,7 +6,7 @@ pub mod model;
 
 use super::map_bank::{banks, MapBank};
 use super::testbench::TbData;
-use super::unit::{port_of, Head, Memory, Unit, Vectors};
+use super::unit::{port_of, Head, Memory, Traced, Unit, Vectors};
 use crate::config::Config;
 use crate::hdl::adder_tree::clock_q;
 use crate::hdl::ports::{i, o, stage_head, Port};
@@ -231,17 +231,10 @@ impl Vectors for MapLookup {
                 }
             }
         }
+        // The traced corners, alternating buffers.
         for (i, t) in corner_traces(model, &maps.scene).enumerate() {
-            let s = t.sort;
-            out.push(vec![
-                s.axis as u64,
-                s.s_max as u64,
-                s.s_u as u64,
-                s.s_v as u64,
-                t.p_u as u64,
-                t.p_v as u64,
-                (i & 1) as u64,
-            ]);
+            let buf = (i & 1) as u64;
+            out.push(self.traced(cfg, &Traced { buf, ..t }));
         }
         out
     }
@@ -270,6 +263,15 @@ impl Vectors for MapLookup {
         } else {
             vec![l.e[0] as u64]
         }
+    }
+
+    fn traced(&self, _cfg: &Config, s: &Traced) -> Vec<u64> {
+        let (o, t) = (s.trace.sort, &s.trace);
+        let mut v = [o.axis, o.s_max, o.s_u, o.s_v, t.p_u, t.p_v]
+            .map(u64::from)
+            .to_vec();
+        v.push(s.buf);
+        v
     }
 
     /// The buffer field drives rd_buf_i.

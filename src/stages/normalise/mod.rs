@@ -7,7 +7,7 @@ mod plan;
 
 use super::recip_rom::{self, RecipRom};
 use super::testbench::TbData;
-use super::unit::{param_overrides, Head, Memory, Unit, Vectors};
+use super::unit::{param_overrides, Head, Memory, Traced, Unit, Vectors};
 use crate::config::Config;
 use crate::hdl::adder_tree::Step;
 use crate::hdl::ports::{i, o, stage_head, Port};
@@ -167,7 +167,7 @@ impl Vectors for Normalise {
             out.push(vec![m, m - 1, m * 3 / 4]);
         }
         for t in crate::vectors::inputs::corner_traces(model, &maps.scene) {
-            out.push(vec![t.sort.m as u64, t.sort.a as u64, t.sort.b as u64]);
+            out.push(self.traced(cfg, &t));
         }
         out
     }
@@ -194,6 +194,11 @@ impl Vectors for Normalise {
         let u = |k: usize| inp[k] as u32;
         let n = model::eval(&model.cfg, &model.recip, u(0), u(1), u(2));
         vec![n.u as u64, n.v as u64]
+    }
+
+    fn traced(&self, _cfg: &Config, s: &Traced) -> Vec<u64> {
+        let t = s.trace.sort;
+        [t.m, t.a, t.b].map(u64::from).to_vec()
     }
 
     fn testbench(&self, t: &TbData) -> askama::Result<String> {

@@ -8,7 +8,7 @@ use crate::model::{MapSet, Model};
 use crate::rng::SplitMix64;
 use crate::stages::rmap_top::RmapTop;
 use crate::stages::testbench::TbData;
-use crate::stages::unit::Vectors;
+use crate::stages::unit::{Traced, Vectors};
 use crate::vectors::field::Field;
 use anyhow::Result;
 use askama::Template;
@@ -30,6 +30,10 @@ impl Vectors for RmapLanes {
 
     fn expected(&self, model: &Model, maps: &MapSet, inp: &[u64]) -> Vec<u64> {
         RmapTop.expected(model, maps, inp)
+    }
+
+    fn traced(&self, cfg: &Config, s: &Traced) -> Vec<u64> {
+        RmapTop.traced(cfg, s)
     }
 
     /// The top's stream, vector for vector (the same file).

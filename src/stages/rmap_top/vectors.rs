@@ -7,7 +7,7 @@ use crate::config::{Config, COLOR_BITS};
 use crate::model::{MapSet, Model};
 use crate::rng::SplitMix64;
 use crate::stages::testbench::TbData;
-use crate::stages::unit::{port_of, Unit, Vectors, RESET_AT};
+use crate::stages::unit::{port_of, Traced, Unit, Vectors, RESET_AT};
 use crate::vectors::field::Field;
 use crate::vectors::inputs::{
     dec_grad, gradient_corners, grads, random_top_gradient, COLOR_CORNERS,
@@ -105,6 +105,15 @@ impl Vectors for RmapTop {
         let mut v = vec![o.zero as u64, o.intensity as u64];
         if cfg.color {
             v.extend(o.rgb.map(u64::from));
+        }
+        v
+    }
+
+    fn traced(&self, cfg: &Config, s: &Traced) -> Vec<u64> {
+        let mut v = vec![s.buf];
+        v.extend(grads(cfg, s.g));
+        if cfg.color {
+            v.extend(s.rgb.map(u64::from));
         }
         v
     }

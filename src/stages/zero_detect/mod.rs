@@ -4,7 +4,7 @@
 pub mod model;
 
 use super::testbench::TbData;
-use super::unit::{Head, Unit, Vectors};
+use super::unit::{Head, Traced, Unit, Vectors};
 use crate::config::Config;
 use crate::hdl::ports::{i, o, stage_head, Port};
 use crate::model::{MapSet, Model};
@@ -104,6 +104,10 @@ impl Vectors for ZeroDetect {
     fn expected(&self, model: &Model, _maps: &MapSet, inp: &[u64]) -> Vec<u64> {
         let g = |k: usize| dec_grad(&model.cfg, inp[k]);
         vec![model::eval([g(0), g(1), g(2)]) as u64]
+    }
+
+    fn traced(&self, cfg: &Config, s: &Traced) -> Vec<u64> {
+        grads(cfg, s.g)
     }
 
     fn testbench(&self, t: &TbData) -> askama::Result<String> {
