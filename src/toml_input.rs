@@ -66,6 +66,17 @@ fn place(what: &str, text: &str, span: Option<Range<usize>>) -> String {
     }
 }
 
+/// A message of [`place`] without its position (`what: message`): for TOML that rmapgen wrote
+/// itself from another form (the Python package's keyword arguments, the explorer's fields),
+/// whose lines the user never saw; the message still names the key.
+pub fn without_place(msg: &str, what: &str) -> String {
+    let Some(rest) = msg.strip_prefix(what) else {
+        return msg.to_string();
+    };
+    let rest = rest.trim_start_matches(|c: char| c == ':' || c.is_ascii_digit());
+    format!("{what}: {}", rest.trim_start())
+}
+
 /// One path segment: a table key or an array index.
 enum Seg<'a> {
     Key(&'a str),
@@ -213,6 +224,17 @@ pub fn read(path: &Path, kind: &str) -> Result<String> {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_message_loses_its_position_and_keeps_its_key() {
+        let what = "config";
+        assert_eq!(
+            super::without_place("config:3:1: grad_bits = 40 is out of range", what),
+            "config: grad_bits = 40 is out of range"
+        );
+        assert_eq!(super::without_place("config: x", what), "config: x");
+        assert_eq!(super::without_place("scene:2:5: y", what), "scene:2:5: y");
+    }
+
     use super::*;
 
     #[test]

@@ -118,19 +118,10 @@ impl Config {
             .map(|inner| Config { inner })
             .map_err(|e| {
                 let msg = format!("{e:#}");
-                let msg = strip_place(&msg, "Config");
+                let msg = rmapgen::toml_input::without_place(&msg, "Config");
                 PyValueError::new_err(rmapgen::toml_input::one_line(&msg))
             })
     }
-}
-
-/// `what:line:col: message` without the position (`what: message`).
-fn strip_place(msg: &str, what: &str) -> String {
-    let Some(rest) = msg.strip_prefix(what) else {
-        return msg.to_string();
-    };
-    let rest = rest.trim_start_matches(|c: char| c == ':' || c.is_ascii_digit());
-    format!("{what}: {}", rest.trim_start())
 }
 
 #[pymethods]

@@ -3,6 +3,7 @@
 pub mod bench;
 pub mod compare;
 pub mod config_args;
+pub mod explore;
 pub mod fit;
 pub mod force;
 pub mod fpga;

@@ -146,9 +146,23 @@ pub fn render(
     rtl: Option<&dyn IntensitySource>,
 ) -> Result<Render> {
     options.validate(cfg)?;
+    render_with(&Model::new(cfg), &scene.maps(cfg), scene, options, rtl)
+}
+
+/// [`render`] with the model and the scene's maps already built (`rmapgen explore` keeps
+/// them to trace the pixels it is asked about).
+pub fn render_with(
+    model: &Model,
+    maps: &Maps,
+    scene: &Scene,
+    options: Options,
+    rtl: Option<&dyn IntensitySource>,
+) -> Result<Render> {
+    let cfg = &model.cfg;
+    options.validate(cfg)?;
     let pixels = sphere_gradients(cfg, options.size, options.shrink);
     let gradients: Vec<[i32; 3]> = pixels.iter().map(|p| p.2).collect();
-    let model = model_intensities(&Model::new(cfg), &scene.maps(cfg), &gradients);
+    let model = model_intensities(model, maps, &gradients);
     let reference = Reference::new(cfg, scene).intensities(&gradients);
     let rtl = match rtl {
         None => None,

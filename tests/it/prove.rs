@@ -341,6 +341,26 @@ fn a_small_design_is_proven_in_two_shards_and_every_part_catches_a_planted_fault
     let o = prove(&d, &build, &["--part", "structure"]);
     assert_fails(&o, "structure", &["different enables"]);
 
+    // One bit of a partial product a clock late, where it enters an adder whose low sum bits
+    // are rounded away: the late bit reaches the kept bits only through the carries. A
+    // depth count that passed an adder's input bit k to its output bit k alone (cargo-mutants:
+    // `&&` -> `||` in `depths`' bitwise test) saw it only in the dropped bits and passed
+    // the design, which `--direct` fails on 82,068 gradients.
+    let d = tmp.path().join("late");
+    plant(
+        &dir,
+        &d,
+        "normalise.v",
+        "  assign pa_l2_d = {({{5{1'b0}}, pa_l1_0_q[6:2]}",
+        "  reg late_q;\n  always @(posedge clk_i) late_q <= pa_l1_0_q[2];\n  assign pa_l2_d = {({{5{1'b0}}, pa_l1_0_q[6:3], late_q}",
+    );
+    let o = prove(&d, &build, &["--part", "structure"]);
+    assert_fails(
+        &o,
+        "structure",
+        &["out_i is [20, 21] registers from the sample inputs, not exactly 20"],
+    );
+
     // The gradient reaching the output past the front.
     let d = tmp.path().join("leak");
     plant(
@@ -358,6 +378,39 @@ fn a_small_design_is_proven_in_two_shards_and_every_part_catches_a_planted_fault
             "reads the gradient; only zero_detect and sort_shift may",
             "out_i is [0, ",
         ],
+    );
+}
+
+/// Under the handshake a register loaded when the pipeline's enable is low moves exactly when
+/// the others hold. Its enable is the same net as theirs, at the other polarity, so the
+/// structure must tell enables apart by polarity too (cargo-mutants: `==` -> `!=` where the
+/// polarity is added to a non-constant enable's name passed it).
+#[test]
+fn an_enable_of_the_other_polarity_fails_the_structure() {
+    if !tools() {
+        return;
+    }
+    let tmp = helpers::tempdir();
+    let dir = tmp.path().join("d");
+    let mut flags = hdl::narrowest_flags();
+    flags.push("--handshake".into());
+    hdl::generate(&dir, &hdl::strs(&flags), 0);
+    let d = tmp.path().join("inverted");
+    plant(
+        &dir,
+        &d,
+        "zero_detect.v",
+        "  always @(posedge clk_i) begin\n    if (en_i) begin",
+        "  always @(posedge clk_i) begin\n    if (!en_i) begin",
+    );
+    let build = tmp.path().join("build");
+    let o = prove(&dir, &build, &["--part", "structure"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let o = prove(&d, &build, &["--part", "structure"]);
+    assert_fails(
+        &o,
+        "structure",
+        &["2 different enables", "polarity 0 (1 of them)"],
     );
 }
 

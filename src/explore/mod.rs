@@ -1,0 +1,482 @@
+//! `rmapgen explore`: the paper's "test environment ... [with] interactive change of table
+//! parameters, to ... view image differences immediately", as a page served on 127.0.0.1.
+//!
+//! The page ([`PAGE`]) holds the configuration and the scene as fields; every change posts
+//! them to `/api/render`, which validates them as their TOML files are validated, renders the
+//! sphere exactly as `rmapgen render` does ([`crate::render::render_with`]: the same PNG
+//! bytes), and answers with the figures and the images' addresses. Clicking a pixel asks
+//! `/api/trace` for that sample's path through the design ([`crate::stages::path`]: every
+//! port of every stage under its Verilog name). `/api/config.toml` and `/api/scene.toml` are
+//! the files `generate --config` and `--scene` read.
+//!
+//! Bounds: a request body of at most [`MAX_BODY`] bytes, images of at most [`MAX_SIZE`]
+//! pixels a side, at most [`MAX_LIGHTS`] lights, and the last [`KEPT`] renders kept.
+
+use crate::config::{Config, RANGES};
+use crate::model::map_fit::MapFit;
+use crate::model::{MapSet, Model};
+use crate::render::{images, Options, Render};
+use crate::scene::Scene;
+use crate::toml_input::without_place;
+use anyhow::{anyhow, bail, Context, Result};
+use serde::Serialize;
+use serde_json::{json, Value};
+use std::collections::VecDeque;
+use std::io::Read;
+use std::time::Instant;
+
+/// The page: fields, images, the trace table (no external resources).
+pub const PAGE: &str = include_str!("page.html");
+
+/// Largest request body: a configuration and a scene are a few hundred bytes.
+pub const MAX_BODY: u64 = 64 << 10;
+/// Largest image side the page may ask for.
+pub const MAX_SIZE: u32 = 512;
+/// Most lights a scene may have here.
+pub const MAX_LIGHTS: usize = 8;
+/// Renders kept for their images and traces (the page shows the last).
+pub const KEPT: usize = 4;
+
+/// One finished render and what its traces need.
+struct Kept {
+    id: u64,
+    render: Render,
+    model: Model,
+    maps: MapSet,
+    /// File name and PNG bytes, as `rmapgen render` writes them.
+    files: Vec<(&'static str, Vec<u8>)>,
+}
+
+/// The explorer's state: the last renders.
+#[derive(Default)]
+pub struct Explorer {
+    next: u64,
+    kept: VecDeque<Kept>,
+}
+
+/// An answer: status, content type, body and an optional file name to save it as.
+pub struct Reply {
+    pub status: u16,
+    pub kind: &'static str,
+    pub body: Vec<u8>,
+    pub attachment: Option<&'static str>,
+}
+
+impl Reply {
+    fn json(status: u16, v: &Value) -> Reply {
+        Reply {
+            status,
+            kind: "application/json",
+            body: v.to_string().into_bytes(),
+            attachment: None,
+        }
+    }
+
+    fn error(status: u16, msg: &str) -> Reply {
+        Reply::json(status, &json!({ "error": msg }))
+    }
+}
+
+/// The fields of the page that are not the scene's: the configuration as `config.toml` has
+/// it, and the image side.
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Ask {
+    config: serde_json::Map<String, Value>,
+    scene: serde_json::Map<String, Value>,
+    size: u32,
+}
+
+/// A TOML file's text from the page's fields (a JSON object of the file's keys).
+fn toml_text(fields: &serde_json::Map<String, Value>, what: &str) -> Result<String> {
+    let v =
+        toml::Value::try_from(Value::Object(fields.clone())).map_err(|e| anyhow!("{what}: {e}"))?;
+    toml::to_string(&v).map_err(|e| anyhow!("{what}: {e}"))
+}
+
+/// The configuration and the scene of the page's fields, checked as their files are.
+fn parse(ask: &Ask) -> Result<(Config, Scene)> {
+    let c = toml_text(&ask.config, "config")?;
+    let cfg = Config::from_toml_named(&c, "config")
+        .map_err(|e| anyhow!(without_place(&format!("{e:#}"), "config")))?;
+    let s = toml_text(&ask.scene, "scene")?;
+    let scene = Scene::from_toml_named(&s, "scene")
+        .map_err(|e| anyhow!(without_place(&format!("{e:#}"), "scene")))?;
+    if scene.lights.len() > MAX_LIGHTS {
+        bail!(
+            "scene: {} lights; the explorer takes at most {MAX_LIGHTS}",
+            scene.lights.len()
+        );
+    }
+    if !(16..=MAX_SIZE).contains(&ask.size) {
+        bail!("size {} is out of range; allowed 16..={MAX_SIZE}", ask.size);
+    }
+    scene.map_fit.check(&cfg)?;
+    Ok((cfg, scene))
+}
+
+/// What the page builds its fields from: every width with its range and default, the
+/// switches, the map fits, the default scene and the bounds.
+pub fn schema() -> Value {
+    let d = Config::default();
+    let widths: Vec<Value> = RANGES
+        .iter()
+        .map(|&(name, min, max)| json!({"name": name, "min": min, "max": max, "default": d.field(name)}))
+        .collect();
+    let fits: Vec<&str> = <MapFit as clap::ValueEnum>::value_variants()
+        .iter()
+        .map(|f| f.name())
+        .collect();
+    json!({
+        "widths": widths,
+        "switches": [
+            {"name": "compensation", "default": d.compensation},
+            {"name": "interpolation", "default": d.interpolation},
+        ],
+        "comp_table": ["rom", "ram"],
+        "map_fits": fits,
+        "scene": serde_json::to_value(Scene::standard()).expect("a scene serialises"),
+        "max_size": MAX_SIZE,
+        "max_lights": MAX_LIGHTS,
+    })
+}
+
+/// A pixel's path, as the page's trace table shows it.
+#[derive(Serialize)]
+struct PathReply {
+    x: u32,
+    y: u32,
+    gradient: [i32; 3],
+    model: u32,
+    reference: u32,
+    signals: Vec<crate::stages::Signal>,
+}
+
+impl Explorer {
+    /// Answers one request: `method`, the path with its query, and the body.
+    pub fn answer(&mut self, method: &str, url: &str, body: &[u8]) -> Reply {
+        let (path, query) = url.split_once('?').unwrap_or((url, ""));
+        let q = |k: &str| {
+            query
+                .split('&')
+                .filter_map(|kv| kv.split_once('='))
+                .find(|(a, _)| *a == k)
+                .and_then(|(_, v)| v.parse::<u64>().ok())
+        };
+        match (method, path) {
+            ("GET", "/") => Reply {
+                status: 200,
+                kind: "text/html; charset=utf-8",
+                body: PAGE.as_bytes().to_vec(),
+                attachment: None,
+            },
+            ("GET", "/api/schema") => Reply::json(200, &schema()),
+            // Browsers ask for it; there is none.
+            ("GET", "/favicon.ico") => Reply {
+                status: 204,
+                kind: "image/x-icon",
+                body: Vec::new(),
+                attachment: None,
+            },
+            ("POST", "/api/render") => match self.render(body) {
+                Ok(v) => Reply::json(200, &v),
+                Err(e) => Reply::error(400, &crate::toml_input::one_line(&format!("{e:#}"))),
+            },
+            ("GET", "/api/trace") => match (q("id"), q("x"), q("y")) {
+                (Some(id), Some(x), Some(y)) => self.trace(id, x, y),
+                _ => Reply::error(400, "trace needs id, x and y"),
+            },
+            ("GET", "/api/config.toml" | "/api/scene.toml") => {
+                let Some(k) = q("id").and_then(|id| self.find(id)) else {
+                    return Reply::error(404, "no such render");
+                };
+                let (text, name) = if path.ends_with("config.toml") {
+                    (toml::to_string(&k.render.cfg), "config.toml")
+                } else {
+                    (toml::to_string(&k.render.scene), "scene.toml")
+                };
+                Reply {
+                    status: 200,
+                    kind: "application/toml; charset=utf-8",
+                    body: text.expect("config and scene serialise").into_bytes(),
+                    attachment: Some(name),
+                }
+            }
+            ("GET", p) if p.starts_with("/img/") => self.image(p),
+            ("GET" | "POST", _) => Reply::error(404, "no such page"),
+            _ => Reply::error(405, "only GET and POST"),
+        }
+    }
+
+    fn find(&self, id: u64) -> Option<&Kept> {
+        self.kept.iter().find(|k| k.id == id)
+    }
+
+    fn render(&mut self, body: &[u8]) -> Result<Value> {
+        let t = Instant::now();
+        let ask: Ask = serde_json::from_slice(body).context("the request")?;
+        let (cfg, scene) = parse(&ask)?;
+        let model = Model::new(&cfg);
+        let maps = scene.maps(&cfg);
+        let options = Options {
+            size: ask.size,
+            shrink: 0,
+        };
+        let render = crate::render::render_with(&model, &maps, &scene, options, None)?;
+        let mut files = Vec::new();
+        for (name, img) in render.images() {
+            files.push((name, images::png(&img)?));
+        }
+        for (name, img) in render.pictures()?.into_iter().chain(render.color_images()) {
+            files.push((name, images::png_rgb(&img)?));
+        }
+        self.next += 1;
+        let id = self.next;
+        let addr = |name: &str| format!("/img/{id}/{name}");
+        let images: serde_json::Map<String, Value> = files
+            .iter()
+            .map(|(n, _)| (n.to_string(), Value::String(addr(n))))
+            .collect();
+        let reply = json!({
+            "id": id,
+            "ms": t.elapsed().as_millis() as u64,
+            "summary": render.summary(),
+            "metrics": serde_json::to_value(&render.metrics)?,
+            "worst": serde_json::to_value(render.worst())?,
+            "config": toml::to_string(&cfg)?,
+            "images": images,
+            "rom_bits": cfg.rom_total_bits(),
+            "map_bits": cfg.map_total_bits(),
+        });
+        self.kept.push_back(Kept {
+            id,
+            render,
+            model,
+            maps: MapSet {
+                second: maps.clone(),
+                scene: maps,
+            },
+            files,
+        });
+        while self.kept.len() > KEPT {
+            self.kept.pop_front();
+        }
+        Ok(reply)
+    }
+
+    fn image(&self, path: &str) -> Reply {
+        let mut parts = path.trim_start_matches("/img/").splitn(2, '/');
+        let id = parts.next().and_then(|s| s.parse::<u64>().ok());
+        let name = parts.next().unwrap_or("");
+        let file = id
+            .and_then(|id| self.find(id))
+            .and_then(|k| k.files.iter().find(|(n, _)| *n == name));
+        match file {
+            Some((_, png)) => Reply {
+                status: 200,
+                kind: "image/png",
+                body: png.clone(),
+                attachment: None,
+            },
+            None => Reply::error(404, "no such image"),
+        }
+    }
+
+    fn trace(&self, id: u64, x: u64, y: u64) -> Reply {
+        let Some(k) = self.find(id) else {
+            return Reply::error(404, "no such render");
+        };
+        let r = &k.render;
+        let Some(i) = r
+            .pixels
+            .iter()
+            .position(|p| p.0 as u64 == x && p.1 as u64 == y)
+        else {
+            return Reply::error(404, &format!("pixel ({x}, {y}) is outside the sphere"));
+        };
+        let (px, py, g) = r.pixels[i];
+        let rgb = if r.cfg.color {
+            crate::render::color::sample_color(&r.scene, r.options.size, px, py)
+        } else {
+            [0; 3]
+        };
+        let p = PathReply {
+            x: px,
+            y: py,
+            gradient: g,
+            model: r.model[i],
+            reference: r.reference[i],
+            signals: crate::stages::path(&k.model, &k.maps, 0, g, rgb),
+        };
+        Reply::json(200, &serde_json::to_value(p).expect("a path serialises"))
+    }
+}
+
+/// Serves the page on 127.0.0.1:`port` (0: a free port) until the process is stopped; calls
+/// `ready` with the address once it listens.
+pub fn serve(port: u16, ready: impl FnOnce(&str) -> Result<()>) -> Result<()> {
+    let server = tiny_http::Server::http(("127.0.0.1", port))
+        .map_err(|e| anyhow!("cannot listen on 127.0.0.1:{port}: {e}"))?;
+    let addr = server
+        .server_addr()
+        .to_ip()
+        .ok_or_else(|| anyhow!("the server has no IP address"))?;
+    ready(&format!("http://{addr}/"))?;
+    let mut ex = Explorer::default();
+    for mut rq in server.incoming_requests() {
+        let method = rq.method().as_str().to_string();
+        let url = rq.url().to_string();
+        let mut body = Vec::new();
+        let reply = match rq.as_reader().take(MAX_BODY + 1).read_to_end(&mut body) {
+            Ok(_) if body.len() as u64 > MAX_BODY => {
+                Reply::error(413, &format!("a request body of at most {MAX_BODY} bytes"))
+            }
+            Ok(_) => ex.answer(&method, &url, &body),
+            Err(e) => Reply::error(400, &format!("reading the request: {e}")),
+        };
+        let mut resp = tiny_http::Response::from_data(reply.body)
+            .with_status_code(reply.status)
+            .with_header(header("Content-Type", reply.kind))
+            .with_header(header("Cache-Control", "no-store"));
+        if let Some(name) = reply.attachment {
+            resp = resp.with_header(header(
+                "Content-Disposition",
+                &format!("attachment; filename=\"{name}\""),
+            ));
+        }
+        // A page closed mid-answer is not the server's failure.
+        rq.respond(resp).ok();
+    }
+    Ok(())
+}
+
+fn header(k: &str, v: &str) -> tiny_http::Header {
+    tiny_http::Header::from_bytes(k.as_bytes(), v.as_bytes()).expect("a valid header")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ask(config: Value, size: u32) -> Vec<u8> {
+        let scene = serde_json::to_value(Scene::standard()).unwrap();
+        json!({"config": config, "scene": scene, "size": size})
+            .to_string()
+            .into_bytes()
+    }
+
+    fn body(r: &Reply) -> Value {
+        serde_json::from_slice(&r.body).unwrap()
+    }
+
+    #[test]
+    fn a_render_gives_renders_images_and_each_pixels_path() {
+        let mut ex = Explorer::default();
+        let r = ex.answer("POST", "/api/render", &ask(json!({"index_bits": 4}), 64));
+        assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.body));
+        let v = body(&r);
+        let id = v["id"].as_u64().unwrap();
+        // The same bytes as `rmapgen render` writes for this configuration and scene.
+        let cfg = Config {
+            index_bits: 4,
+            ..Config::default()
+        };
+        let want = crate::render::render(
+            &cfg,
+            &Scene::standard(),
+            Options {
+                size: 64,
+                shrink: 0,
+            },
+            None,
+        )
+        .unwrap();
+        let model_png = images::png(&want.images()[1].1).unwrap();
+        let url = v["images"]["model.png"].as_str().unwrap();
+        let img = ex.answer("GET", url, b"");
+        assert_eq!((img.status, img.kind), (200, "image/png"));
+        assert_eq!(img.body, model_png);
+        assert_eq!(
+            v["metrics"]["max_abs_error"],
+            json!(want.metrics.max_abs_error)
+        );
+        // A pixel's path ends in the model image's value there.
+        let (x, y, g) = want.pixels[want.pixels.len() / 3];
+        let t = ex.answer("GET", &format!("/api/trace?id={id}&x={x}&y={y}"), b"");
+        assert_eq!(t.status, 200);
+        let t = body(&t);
+        assert_eq!(t["gradient"], json!(g));
+        let sig = t["signals"].as_array().unwrap();
+        let i_o = sig.iter().find(|s| s["name"] == "i_o").unwrap();
+        assert_eq!(i_o["value"], json!(want.model[want.pixels.len() / 3]));
+        assert!(sig.iter().any(|s| s["name"] == "u_atan_rom.pu_o"));
+        // Outside the sphere, and a render long gone.
+        assert_eq!(
+            ex.answer("GET", &format!("/api/trace?id={id}&x=0&y=0"), b"")
+                .status,
+            404
+        );
+        let toml = ex.answer("GET", &format!("/api/config.toml?id={id}"), b"");
+        assert_eq!(toml.attachment, Some("config.toml"));
+        assert_eq!(
+            Config::from_toml_named(std::str::from_utf8(&toml.body).unwrap(), "t").unwrap(),
+            cfg
+        );
+        for _ in 0..KEPT {
+            ex.answer("POST", "/api/render", &ask(json!({}), 16));
+        }
+        assert_eq!(
+            ex.answer("GET", url, b"").status,
+            404,
+            "only the last {KEPT} are kept"
+        );
+    }
+
+    #[test]
+    fn bad_fields_are_one_line_naming_the_field() {
+        let mut ex = Explorer::default();
+        let say = |ex: &mut Explorer, b: Vec<u8>| {
+            let r = ex.answer("POST", "/api/render", &b);
+            assert_eq!(r.status, 400);
+            body(&r)["error"].as_str().unwrap().to_string()
+        };
+        assert_eq!(
+            say(&mut ex, ask(json!({"grad_bits": 40}), 64)),
+            "config: grad_bits = 40 is out of range; allowed 8..=16"
+        );
+        assert!(
+            say(&mut ex, ask(json!({"grad_bitz": 8}), 64)).contains("unknown field `grad_bitz`")
+        );
+        assert!(say(&mut ex, ask(json!({}), 5000)).starts_with("size 5000 is out of range"));
+        assert!(say(&mut ex, b"{".to_vec()).starts_with("the request"));
+        let mut scene = serde_json::to_value(Scene::standard()).unwrap();
+        scene["map_fit"] = json!("table");
+        let b = json!({"config": {}, "scene": scene, "size": 64})
+            .to_string()
+            .into_bytes();
+        assert!(say(&mut ex, b).contains("comp-table ram"));
+        assert_eq!(ex.answer("DELETE", "/", b"").status, 405);
+        assert_eq!(ex.answer("GET", "/nothing", b"").status, 404);
+    }
+
+    #[test]
+    fn the_schema_is_the_configurations_ranges() {
+        let s = schema();
+        let w = s["widths"].as_array().unwrap();
+        assert_eq!(w.len(), RANGES.len());
+        for (v, &(name, min, max)) in w.iter().zip(RANGES) {
+            assert_eq!(
+                (
+                    v["name"].as_str().unwrap(),
+                    v["min"].as_u64().unwrap(),
+                    v["max"].as_u64().unwrap()
+                ),
+                (name, min as u64, max as u64)
+            );
+        }
+        assert!(s["map_fits"]
+            .as_array()
+            .unwrap()
+            .contains(&json!("minimax")));
+    }
+}
