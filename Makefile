@@ -138,12 +138,11 @@ roms: build
 # build as well would compile everything a second time for the same code (98 s of the
 # 1,028 s make test took here before the checks ran side by side).
 TEST_JOBS   ?= 2
-TEST_CHECKS  = mutants-sample slurm-test docs python-test report-browser explore-browser man gate-sim formal mutants-formal-sample formal-mult sim-all sim-handshake fpga-check-ecp5 fpga-check-gowin fpga-check axis-test synth lint
+TEST_CHECKS  = mutants-sample slurm-test python-test docs report-browser explore-browser man gate-sim formal mutants-formal-sample formal-mult sim-all sim-handshake fpga-check-ecp5 fpga-check-gowin fpga-check axis-test synth lint
 TEST_BIN     = RMAPGEN=target/debug/rmapgen BUILD_CMD="$(CARGO) test --no-run"
 
 test: tools venv
 	$(MAKE) cargo-test
-	$(MAKE) python
 	$(MAKE) -j$(TEST_JOBS) --output-sync=target $(TEST_BIN) $(TEST_CHECKS)
 	@echo "make test: all checks passed"
 
@@ -243,14 +242,15 @@ explore-browser: build venv
 # ---- The Python package (python/, docs/PYTHON.md): rmapgen._rmapgen, built by maturin from
 # the same crate as the command line and installed into $(VENV) (editable: the extension sits
 # beside python/rmapgen/__init__.py). PY_BUILD=--release for speed (make python-bench); make
-# test builds it in the dev profile, sharing target/debug with the cargo tests. python-test:
+# test builds it in the dev profile with rmapgen itself at opt-level 1 (python/.cargo/
+# config.toml), beside the slurm test, whose jobs mostly wait. python-test:
 # pytest (python/tests: bit for bit against the vectors the CLI writes, and the package's
 # checks of its input), then the cube-against-octahedral example on a small sphere.
 PY_BUILD ?=
 PY_ENV    = VIRTUAL_ENV=$(abspath $(VENV)) PATH="$(abspath $(VENV))/bin:$$PATH"
 .PHONY: python python-test python-bench
 python: venv
-	$(PY_ENV) maturin develop --quiet --manifest-path python/Cargo.toml $(PY_BUILD)
+	cd python && $(PY_ENV) maturin develop --quiet $(PY_BUILD)
 
 python-test: build python
 	RMAPGEN=$(abspath $(RMAPGEN)) $(VENV)/bin/python -m pytest -q -p no:cacheprovider python/tests

@@ -39,6 +39,7 @@ mod rtl_generate;
 mod rtl_in_loop;
 mod rtl_ip;
 mod sim;
+mod slurm_client;
 mod stability;
 mod stdout;
 mod stress;
