@@ -240,7 +240,9 @@ pub fn submit(layout: &Layout, o: &Options) -> Result<(Jobs, signals::Token)> {
     let shards = match slurm::submit(&args, &layout.script("shards")) {
         Ok(id) => id,
         Err(e) => {
+            // Cancelled now, and no longer for an interrupt or the guardian to cancel.
             cancel(std::slice::from_ref(&build));
+            token.release();
             return Err(e);
         }
     };
@@ -254,6 +256,7 @@ pub fn submit(layout: &Layout, o: &Options) -> Result<(Jobs, signals::Token)> {
         Ok(id) => id,
         Err(e) => {
             cancel(&[build, shards]);
+            token.release();
             return Err(e);
         }
     };
