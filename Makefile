@@ -111,8 +111,13 @@ bench-volume: build
 	@WITH_VOLPACK=1 scripts/install-tools.sh
 	scripts/bench-volume.sh
 
+# The whole workspace in one feature resolution: the cargo tests' build of rmapgen is the one
+# the Python extension (python/, target/debug/lib_rmapgen.so) links, so make test compiles the
+# crate once (a separate `maturin develop` compiled it again: pyo3's and numpy's features on
+# shared dependencies differ from a build of rmapgen alone).
 cargo-test:
-	$(CARGO) test
+	$(CARGO) build --workspace --lib --bins --tests
+	$(CARGO) test --workspace
 
 # Only the $$readmemh files of the default design, refreshed in place in $(OUT) (its other
 # files kept; refused if $(OUT) holds anything rmapgen did not write).
@@ -134,12 +139,13 @@ roms: build
 # each check's output whole when it ends (--output-sync), and stops at the first that fails.
 # The longest checks come first, so that the short ones fill in beside them. The checks run
 # the rmapgen that the cargo tests built and ran (target/debug: the dev profile, optimised,
-# with overflow checks on; `cargo test --no-run` only confirms it is current): a release
+# with overflow checks on; BUILD_CMD only confirms it is current), and the Python tests the
+# extension of the same build (python-built): a release
 # build as well would compile everything a second time for the same code (98 s of the
 # 1,028 s make test took here before the checks ran side by side).
 TEST_JOBS   ?= 2
 TEST_CHECKS  = mutants-sample slurm-test python-test docs report-browser explore-browser man gate-sim formal mutants-formal-sample formal-mult sim-all sim-handshake fpga-check-ecp5 fpga-check-gowin fpga-check axis-test synth lint
-TEST_BIN     = RMAPGEN=target/debug/rmapgen BUILD_CMD="$(CARGO) test --no-run"
+TEST_BIN     = RMAPGEN=target/debug/rmapgen BUILD_CMD="$(CARGO) build --workspace --lib --bins --tests" PY_INSTALL=python-built
 
 test: tools venv
 	$(MAKE) cargo-test
@@ -239,20 +245,28 @@ venv:
 explore-browser: build venv
 	$(VENV)/bin/python tests/browser/check_explore.py $(RMAPGEN)
 
-# ---- The Python package (python/, docs/PYTHON.md): rmapgen._rmapgen, built by maturin from
-# the same crate as the command line and installed into $(VENV) (editable: the extension sits
-# beside python/rmapgen/__init__.py). PY_BUILD=--release for speed (make python-bench); make
-# test builds it in the dev profile with rmapgen itself at opt-level 1 (python/.cargo/
-# config.toml), beside the slurm test, whose jobs mostly wait. python-test:
-# pytest (python/tests: bit for bit against the vectors the CLI writes, and the package's
-# checks of its input), then the cube-against-octahedral example on a small sphere.
-PY_BUILD ?=
-PY_ENV    = VIRTUAL_ENV=$(abspath $(VENV)) PATH="$(abspath $(VENV))/bin:$$PATH"
-.PHONY: python python-test python-bench
+# ---- The Python package (python/, docs/PYTHON.md): rmapgen._rmapgen, built from the same crate
+# as the command line and installed into $(VENV) editable (the extension sits beside
+# python/rmapgen/__init__.py; python/ is on the venv's path). make python: maturin develop,
+# PY_BUILD=--release for speed (make python-bench). make test installs the extension of its
+# own workspace build instead (python-built: PY_SO copied, and the .pth file maturin writes),
+# so that rmapgen is compiled once. python-test: pytest (python/tests: bit for bit against the
+# vectors the CLI writes, and the package's checks of its input), then the
+# cube-against-octahedral example on a small sphere.
+PY_BUILD   ?=
+PY_INSTALL ?= python
+PY_SO      ?= target/debug/lib_rmapgen.so
+PY_ENV      = VIRTUAL_ENV=$(abspath $(VENV)) PATH="$(abspath $(VENV))/bin:$$PATH"
+.PHONY: python python-built python-test python-bench
 python: venv
 	cd python && $(PY_ENV) maturin develop --quiet $(PY_BUILD)
 
-python-test: build python
+python-built: build venv
+	cp $(PY_SO) python/rmapgen/_rmapgen.abi3.so.new
+	mv -f python/rmapgen/_rmapgen.abi3.so.new python/rmapgen/_rmapgen.abi3.so
+	$(VENV)/bin/python -c 'import sys, sysconfig; open(sysconfig.get_paths()["purelib"] + "/rmapgen.pth", "w").write(sys.argv[1] + "\n")' $(abspath python)
+
+python-test: build $(PY_INSTALL)
 	RMAPGEN=$(abspath $(RMAPGEN)) $(VENV)/bin/python -m pytest -q -p no:cacheprovider python/tests
 	$(VENV)/bin/python python/examples/cube_vs_octahedral.py --size 128
 
