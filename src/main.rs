@@ -30,9 +30,10 @@ enum Command {
     Maps(cmd::maps::MapsArgs),
     /// Render the sphere test image with the model and the float reference, and measure the error.
     Render(cmd::render::RenderArgs),
-    /// Serve a page on 127.0.0.1 that renders the sphere as you change the widths, stages,
-    /// map fit, lights and material, with the float reference, the error and its figures;
-    /// clicking a pixel shows its path through every stage under the Verilog signal names.
+    /// Serve a page on 127.0.0.1 that renders the sphere or the synthetic engine block (a
+    /// volume) as you change the widths, stages, map fit, lights and material, with the float
+    /// reference, the error and its figures; clicking a pixel shows its path through every
+    /// stage under the Verilog signal names.
     Explore(cmd::explore::ExploreArgs),
     /// Write a large top-level vector stream for the Verilator C++ harness (tb/top_stream.cpp).
     Vectors(cmd::vectors::VectorsArgs),

@@ -3,11 +3,20 @@
 //!
 //! The page ([`PAGE`]) holds the configuration and the scene as fields; every change posts
 //! them to `/api/render`, which validates them as their TOML files are validated, renders the
-//! sphere exactly as `rmapgen render` does ([`crate::render::render_with`]: the same PNG
-//! bytes), and answers with the figures and the images' addresses. Clicking a pixel asks
-//! `/api/trace` for that sample's path through the design ([`crate::stages::path`]: every
-//! port of every stage under its Verilog name). `/api/config.toml` and `/api/scene.toml` are
-//! the files `generate --config` and `--scene` read.
+//! object the page shows and answers with the figures and the images' addresses:
+//! - the sphere, exactly as `rmapgen render` does ([`crate::render::render_with`]: the same
+//!   PNG bytes);
+//! - the volume: the synthetic engine block of the paper's Figures 9 and 10, exactly as
+//!   `rmapgen volume --synthetic` does ([`crate::volume::report::render`], the ray caster at
+//!   its defaults: the same PNG bytes). The block is built once per process ([`ENGINE`]) and
+//!   its gradients and bricks once per gradient width.
+//!
+//! Clicking a pixel asks `/api/trace` for that sample's path through the design
+//! ([`crate::stages::path`]: every port of every stage under its Verilog name). A volume pixel
+//! blends the samples along its ray: the answer lists them (weight, gradient, the design's and
+//! the reference's intensity) and traces the one of largest weight. `/api/config.toml` and
+//! `/api/scene.toml` are the files `generate --config` and `--scene` (or `volume --scene`)
+//! read.
 //!
 //! Bounds: a request body of at most [`MAX_BODY`] bytes, images of at most [`MAX_SIZE`]
 //! pixels a side, at most [`MAX_LIGHTS`] lights, and the last [`KEPT`] renders kept.
@@ -18,11 +27,18 @@ use crate::model::{MapSet, Model};
 use crate::render::{images, Options, Render};
 use crate::scene::Scene;
 use crate::toml_input::without_place;
+use crate::volume::cast::options::CastOptions;
+use crate::volume::prepared::Prepared;
+use crate::volume::renderer::Renderer;
+use crate::volume::report::VolumeRender;
+use crate::volume::shear::Classified;
+use crate::volume::{synthetic, Volume};
 use anyhow::{anyhow, bail, Context, Result};
 use serde::Serialize;
 use serde_json::{json, Value};
 use std::collections::VecDeque;
 use std::io::Read;
+use std::sync::OnceLock;
 use std::time::Instant;
 
 /// The page: fields, images, the trace table (no external resources).
@@ -37,21 +53,70 @@ pub const MAX_LIGHTS: usize = 8;
 /// Renders kept for their images and traces (the page shows the last).
 pub const KEPT: usize = 4;
 
+/// The volume the page shows: the synthetic engine block at its default size
+/// ([`synthetic::DIMS`], unit spacing), as `rmapgen volume --synthetic` builds it; built on
+/// the first volume render and kept for the process.
+pub static ENGINE: OnceLock<Volume> = OnceLock::new();
+
+fn engine() -> Result<&'static Volume> {
+    if let Some(v) = ENGINE.get() {
+        return Ok(v);
+    }
+    let v = synthetic::engine_block(synthetic::DIMS, [1.0; 3])?;
+    Ok(ENGINE.get_or_init(|| v))
+}
+
+/// What the page shows.
+#[derive(serde::Deserialize, Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+enum Object {
+    /// The sphere of `rmapgen render`.
+    #[default]
+    Sphere,
+    /// The engine block of `rmapgen volume --synthetic`.
+    Volume,
+}
+
+/// A finished render of either object.
+enum Shown {
+    Sphere(Render),
+    Volume(VolumeRender),
+}
+
+impl Shown {
+    fn cfg(&self) -> &Config {
+        match self {
+            Shown::Sphere(r) => &r.cfg,
+            Shown::Volume(r) => &r.cfg,
+        }
+    }
+
+    fn scene(&self) -> &Scene {
+        match self {
+            Shown::Sphere(r) => &r.scene,
+            Shown::Volume(r) => &r.scene,
+        }
+    }
+}
+
 /// One finished render and what its traces need.
 struct Kept {
     id: u64,
-    render: Render,
+    shown: Shown,
     model: Model,
+    /// The maps the design shades with (a volume's in its voxel-axis frame).
     maps: MapSet,
-    /// File name and PNG bytes, as `rmapgen render` writes them.
+    /// File name and PNG bytes, as `rmapgen render` (or `volume`) writes them.
     files: Vec<(&'static str, Vec<u8>)>,
 }
 
-/// The explorer's state: the last renders.
+/// The explorer's state: the last renders, and the engine block's gradients and bricks for
+/// the last gradient width.
 #[derive(Default)]
 pub struct Explorer {
     next: u64,
     kept: VecDeque<Kept>,
+    prepared: Option<(u32, Prepared<'static>)>,
 }
 
 /// An answer: status, content type, body and an optional file name to save it as.
@@ -77,14 +142,16 @@ impl Reply {
     }
 }
 
-/// The fields of the page that are not the scene's: the configuration as `config.toml` has
-/// it, and the image side.
+/// The page's fields: the configuration as `config.toml` has it, the scene as `scene.toml`
+/// has it, the image side and the object shown.
 #[derive(serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 struct Ask {
     config: serde_json::Map<String, Value>,
     scene: serde_json::Map<String, Value>,
     size: u32,
+    #[serde(default)]
+    object: Object,
 }
 
 /// A TOML file's text from the page's fields (a JSON object of the file's keys).
@@ -112,6 +179,10 @@ fn parse(ask: &Ask) -> Result<(Config, Scene)> {
         bail!("size {} is out of range; allowed 16..={MAX_SIZE}", ask.size);
     }
     scene.map_fit.check(&cfg)?;
+    if ask.object == Object::Volume {
+        // The volume's opacity comes from the scene's transfer function.
+        crate::volume::report::scene_transfer(&scene)?;
+    }
     Ok((cfg, scene))
 }
 
@@ -136,12 +207,21 @@ pub fn schema() -> Value {
         "comp_table": ["rom", "ram"],
         "map_fits": fits,
         "scene": serde_json::to_value(Scene::standard()).expect("a scene serialises"),
+        // The engine block's scene (scenes/engine.toml): its view and transfer function.
+        "volume_scene": serde_json::to_value(engine_scene()).expect("a scene serialises"),
+        "volume_dims": synthetic::DIMS,
         "max_size": MAX_SIZE,
         "max_lights": MAX_LIGHTS,
     })
 }
 
-/// A pixel's path, as the page's trace table shows it.
+/// The built-in scene of the engine block, as `rmapgen volume --synthetic` reads it.
+fn engine_scene() -> Scene {
+    Scene::from_toml_str(crate::volume::ENGINE_SCENE_TOML).expect("the built-in engine scene")
+}
+
+/// A pixel's path, as the page's trace table shows it: the sample's gradient, the pixel's
+/// value in the design's and the reference's image, and every signal of the sample's path.
 #[derive(Serialize)]
 struct PathReply {
     x: u32,
@@ -150,6 +230,22 @@ struct PathReply {
     model: u32,
     reference: u32,
     signals: Vec<crate::stages::Signal>,
+    /// A volume pixel's samples along its ray, front to back (the traced one is the
+    /// heaviest); its opacity.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    samples: Option<Vec<RaySample>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    alpha: Option<f32>,
+}
+
+/// One sample of a volume pixel's ray: its compositing weight, its gradient, and its
+/// intensity from the design and from the float reference.
+#[derive(Serialize)]
+struct RaySample {
+    weight: f32,
+    gradient: [i32; 3],
+    model: u32,
+    reference: u32,
 }
 
 impl Explorer {
@@ -183,7 +279,10 @@ impl Explorer {
                 Err(e) => Reply::error(400, &crate::toml_input::one_line(&format!("{e:#}"))),
             },
             ("GET", "/api/trace") => match (q("id"), q("x"), q("y")) {
-                (Some(id), Some(x), Some(y)) => self.trace(id, x, y),
+                (Some(id), Some(x), Some(y)) => match self.trace(id, x, y) {
+                    Ok(r) => r,
+                    Err(e) => Reply::error(500, &crate::toml_input::one_line(&format!("{e:#}"))),
+                },
                 _ => Reply::error(400, "trace needs id, x and y"),
             },
             ("GET", "/api/config.toml" | "/api/scene.toml") => {
@@ -191,9 +290,9 @@ impl Explorer {
                     return Reply::error(404, "no such render");
                 };
                 let (text, name) = if path.ends_with("config.toml") {
-                    (toml::to_string(&k.render.cfg), "config.toml")
+                    (toml::to_string(k.shown.cfg()), "config.toml")
                 } else {
-                    (toml::to_string(&k.render.scene), "scene.toml")
+                    (toml::to_string(k.shown.scene()), "scene.toml")
                 };
                 Reply {
                     status: 200,
@@ -212,24 +311,61 @@ impl Explorer {
         self.kept.iter().find(|k| k.id == id)
     }
 
+    /// The engine block's gradients and bricks for `grad_bits` (kept for the last width).
+    fn prepared(&mut self, grad_bits: u32) -> Result<&Prepared<'static>> {
+        if self.prepared.as_ref().map(|p| p.0) != Some(grad_bits) {
+            self.prepared = None;
+            let p = Prepared::try_new(engine()?, grad_bits, CastOptions::default().brick)?;
+            self.prepared = Some((grad_bits, p));
+        }
+        Ok(&self.prepared.as_ref().expect("just prepared").1)
+    }
+
     fn render(&mut self, body: &[u8]) -> Result<Value> {
         let t = Instant::now();
         let ask: Ask = serde_json::from_slice(body).context("the request")?;
         let (cfg, scene) = parse(&ask)?;
         let model = Model::new(&cfg);
-        let maps = scene.maps(&cfg);
-        let options = Options {
-            size: ask.size,
-            shrink: 0,
-        };
-        let render = crate::render::render_with(&model, &maps, &scene, options, None)?;
         let mut files = Vec::new();
-        for (name, img) in render.images() {
-            files.push((name, images::png(&img)?));
-        }
-        for (name, img) in render.pictures()?.into_iter().chain(render.color_images()) {
-            files.push((name, images::png_rgb(&img)?));
-        }
+        let (shown, maps, summary, metrics, worst) = match ask.object {
+            Object::Sphere => {
+                let maps = scene.maps(&cfg);
+                let options = Options {
+                    size: ask.size,
+                    shrink: 0,
+                };
+                let render = crate::render::render_with(&model, &maps, &scene, options, None)?;
+                for (name, img) in render.images() {
+                    files.push((name, images::png(&img)?));
+                }
+                for (name, img) in render.pictures()?.into_iter().chain(render.color_images()) {
+                    files.push((name, images::png_rgb(&img)?));
+                }
+                let (summary, metrics) = (render.summary(), serde_json::to_value(&render.metrics)?);
+                let worst = serde_json::to_value(render.worst())?;
+                (Shown::Sphere(render), maps, summary, metrics, worst)
+            }
+            Object::Volume => {
+                let opts = CastOptions {
+                    size: ask.size,
+                    ..CastOptions::default()
+                };
+                let p = self.prepared(cfg.grad_bits)?;
+                let render = crate::volume::report::render(p, &cfg, &scene, opts, None, false)?;
+                crate::volume::report::check_covered(&render, p.vol)?;
+                for (name, img) in render.images() {
+                    files.push((name, crate::volume::picture::png(&img)?));
+                }
+                for (name, img) in render.pictures()? {
+                    let img = image::DynamicImage::ImageRgb8(img);
+                    files.push((name, crate::volume::picture::png(&img)?));
+                }
+                let maps = p.vol.shading_scene(&scene).maps(&cfg);
+                let (summary, metrics) = (render.summary(), serde_json::to_value(&render.metrics)?);
+                let worst = serde_json::to_value(render.worst())?;
+                (Shown::Volume(render), maps, summary, metrics, worst)
+            }
+        };
         self.next += 1;
         let id = self.next;
         let addr = |name: &str| format!("/img/{id}/{name}");
@@ -240,9 +376,9 @@ impl Explorer {
         let reply = json!({
             "id": id,
             "ms": t.elapsed().as_millis() as u64,
-            "summary": render.summary(),
-            "metrics": serde_json::to_value(&render.metrics)?,
-            "worst": serde_json::to_value(render.worst())?,
+            "summary": summary,
+            "metrics": metrics,
+            "worst": worst,
             "config": toml::to_string(&cfg)?,
             "images": images,
             "rom_bits": cfg.rom_total_bits(),
@@ -250,7 +386,7 @@ impl Explorer {
         });
         self.kept.push_back(Kept {
             id,
-            render,
+            shown,
             model,
             maps: MapSet {
                 second: maps.clone(),
@@ -282,17 +418,26 @@ impl Explorer {
         }
     }
 
-    fn trace(&self, id: u64, x: u64, y: u64) -> Reply {
+    fn trace(&mut self, id: u64, x: u64, y: u64) -> Result<Reply> {
         let Some(k) = self.find(id) else {
-            return Reply::error(404, "no such render");
+            return Ok(Reply::error(404, "no such render"));
         };
-        let r = &k.render;
+        let r = match &k.shown {
+            Shown::Sphere(r) => r,
+            Shown::Volume(v) => {
+                let (cfg, scene, opts) = (v.cfg.clone(), v.scene.clone(), v.opts);
+                return self.trace_volume(id, &cfg, &scene, opts, x, y);
+            }
+        };
         let Some(i) = r
             .pixels
             .iter()
             .position(|p| p.0 as u64 == x && p.1 as u64 == y)
         else {
-            return Reply::error(404, &format!("pixel ({x}, {y}) is outside the sphere"));
+            return Ok(Reply::error(
+                404,
+                &format!("pixel ({x}, {y}) is outside the sphere"),
+            ));
         };
         let (px, py, g) = r.pixels[i];
         let rgb = if r.cfg.color {
@@ -307,8 +452,70 @@ impl Explorer {
             model: r.model[i],
             reference: r.reference[i],
             signals: crate::stages::path(&k.model, &k.maps, 0, g, rgb),
+            samples: None,
+            alpha: None,
         };
-        Reply::json(200, &serde_json::to_value(p).expect("a path serialises"))
+        Ok(Reply::json(200, &serde_json::to_value(p)?))
+    }
+
+    /// A volume pixel: the samples its ray composites (marched again by the same caster,
+    /// view and options), and the path of the one of largest weight.
+    fn trace_volume(
+        &mut self,
+        id: u64,
+        cfg: &Config,
+        scene: &Scene,
+        opts: CastOptions,
+        x: u64,
+        y: u64,
+    ) -> Result<Reply> {
+        let n = opts.size as u64;
+        if x >= n || y >= n {
+            return Ok(Reply::error(
+                404,
+                &format!("pixel ({x}, {y}) is outside the {n}x{n} image"),
+            ));
+        }
+        let (shading, (alpha, samples)) = {
+            let p = self.prepared(cfg.grad_bits)?;
+            let classified = Classified::new(p, crate::volume::report::scene_transfer(scene)?)?;
+            let caster = Renderer::new(&classified, scene.view.direction, opts)?;
+            let ray = caster.pixel(x as u32, y as u32);
+            (p.vol.shading_scene(scene), ray.unwrap_or((0.0, Vec::new())))
+        };
+        let reference = crate::reference::Reference::new(cfg, &shading);
+        let k = self.find(id).expect("found above");
+        let Shown::Volume(v) = &k.shown else {
+            unreachable!("a volume render")
+        };
+        let i = (y * n + x) as usize;
+        let Some(&(_, g)) = samples.iter().max_by(|a, b| a.0.total_cmp(&b.0)) else {
+            return Ok(Reply::error(
+                404,
+                &format!("pixel ({x}, {y}) shows no part of the volume"),
+            ));
+        };
+        let maps = &k.maps.scene;
+        let list = samples
+            .iter()
+            .map(|&(weight, gradient)| RaySample {
+                weight,
+                gradient,
+                model: k.model.intensity(maps, gradient),
+                reference: reference.intensity(gradient),
+            })
+            .collect();
+        let reply = PathReply {
+            x: x as u32,
+            y: y as u32,
+            gradient: g,
+            model: v.model[i],
+            reference: v.reference.as_ref().map_or(0, |r| r[i]),
+            signals: crate::stages::path(&k.model, &k.maps, 0, g, [0; 3]),
+            samples: Some(list),
+            alpha: Some(alpha),
+        };
+        Ok(Reply::json(200, &serde_json::to_value(reply)?))
     }
 }
 
@@ -429,6 +636,110 @@ mod tests {
             ex.answer("GET", url, b"").status,
             404,
             "only the last {KEPT} are kept"
+        );
+    }
+
+    #[test]
+    fn a_volume_render_is_the_volume_commands_and_a_pixel_lists_its_rays_samples() {
+        let mut ex = Explorer::default();
+        let scene = engine_scene();
+        let b = json!({"config": {"index_bits": 4}, "scene": serde_json::to_value(&scene).unwrap(),
+                       "size": 64, "object": "volume"});
+        let r = ex.answer("POST", "/api/render", b.to_string().as_bytes());
+        assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.body));
+        let v = body(&r);
+        let id = v["id"].as_u64().unwrap();
+        // The same bytes as `rmapgen volume --synthetic --size 64` writes.
+        let cfg = Config {
+            index_bits: 4,
+            ..Config::default()
+        };
+        let vol = synthetic::engine_block(synthetic::DIMS, [1.0; 3]).unwrap();
+        let p = Prepared::new(&vol, cfg.grad_bits, CastOptions::default().brick);
+        let opts = CastOptions {
+            size: 64,
+            ..CastOptions::default()
+        };
+        let want = crate::volume::report::render(&p, &cfg, &scene, opts, None, false).unwrap();
+        for (name, img) in want.images() {
+            let got = ex.answer("GET", v["images"][name].as_str().unwrap(), b"");
+            assert_eq!(
+                got.body,
+                crate::volume::picture::png(&img).unwrap(),
+                "{name}"
+            );
+        }
+        assert_eq!(
+            v["metrics"]["max_abs_error"],
+            json!(want.metrics.as_ref().unwrap().max_abs_error)
+        );
+        // Every covered pixel's samples blend to its value in the design's image, the traced
+        // sample is the heaviest, and its path ends in that sample's intensity.
+        let covered: Vec<usize> = (0..want.covered.len())
+            .filter(|&i| want.covered[i])
+            .collect();
+        assert!(covered.len() > 100);
+        for &i in covered.iter().step_by(covered.len() / 25) {
+            let (x, y) = (i % 64, i / 64);
+            let t = ex.answer("GET", &format!("/api/trace?id={id}&x={x}&y={y}"), b"");
+            assert_eq!(t.status, 200, "{}", String::from_utf8_lossy(&t.body));
+            let t = body(&t);
+            let samples = t["samples"].as_array().unwrap();
+            let blend: f32 = samples
+                .iter()
+                .map(|s| s["weight"].as_f64().unwrap() as f32 * s["model"].as_u64().unwrap() as f32)
+                .sum();
+            let pixel = (blend.round().max(0.0) as u32).min(cfg.map_max());
+            assert_eq!(json!(pixel), t["model"], "pixel ({x}, {y})");
+            assert_eq!(t["model"], json!(want.model[i]));
+            assert_eq!(t["reference"], json!(want.reference.as_ref().unwrap()[i]));
+            let heaviest = samples
+                .iter()
+                .max_by(|a, b| {
+                    a["weight"]
+                        .as_f64()
+                        .unwrap()
+                        .total_cmp(&b["weight"].as_f64().unwrap())
+                })
+                .unwrap();
+            assert_eq!(heaviest["gradient"], t["gradient"]);
+            let sig = t["signals"].as_array().unwrap();
+            let i_o = sig.iter().find(|s| s["name"] == "i_o").unwrap();
+            assert_eq!(i_o["value"], heaviest["model"]);
+        }
+        // A pixel showing nothing, one outside the image.
+        let empty = (0..want.covered.len()).find(|&i| !want.covered[i]).unwrap();
+        let t = ex.answer(
+            "GET",
+            &format!("/api/trace?id={id}&x={}&y={}", empty % 64, empty / 64),
+            b"",
+        );
+        assert_eq!(t.status, 404);
+        assert!(body(&t)["error"]
+            .as_str()
+            .unwrap()
+            .contains("no part of the volume"));
+        assert_eq!(
+            ex.answer("GET", &format!("/api/trace?id={id}&x=64&y=0"), b"")
+                .status,
+            404
+        );
+        // The scene saved is the one rendered: the engine's view and transfer function.
+        let s = ex.answer("GET", &format!("/api/scene.toml?id={id}"), b"");
+        let saved = Scene::from_toml_named(std::str::from_utf8(&s.body).unwrap(), "t").unwrap();
+        assert_eq!(saved.view.direction, scene.view.direction);
+        assert!(saved.transfer.is_some());
+        // The sphere's scene has no transfer function: the volume needs one.
+        let r = ex.answer("POST", "/api/render", &{
+            let mut b: Value = serde_json::from_slice(&ask(json!({}), 64)).unwrap();
+            b["object"] = json!("volume");
+            b.to_string().into_bytes()
+        });
+        assert_eq!(r.status, 400);
+        assert!(
+            body(&r)["error"].as_str().unwrap().contains("transfer"),
+            "{}",
+            body(&r)
         );
     }
 

@@ -51,6 +51,15 @@ impl<'a> Renderer<'a> {
         }
     }
 
+    /// One pixel's contributing samples and opacity ([`Caster::pixel`]): the ray caster's
+    /// only; a shear-warp pixel is warped from several intermediate pixels.
+    pub fn pixel(&self, x: u32, y: u32) -> Option<(f32, Vec<(f32, [i32; 3])>)> {
+        match self {
+            Renderer::Ray(c) => c.pixel(x, y),
+            Renderer::ShearWarp(_) => None,
+        }
+    }
+
     /// Fraction of the skipping units (bricks, or slice cells) empty for the transfer
     /// function.
     pub fn empty_fraction(&self) -> f64 {

@@ -13,7 +13,10 @@ for the new render. It checks:
 - the figures shown are that render's metrics.json;
 - a click on the worst pixel of the design's image shows its path: the gradient of that pixel,
   every stage's ports (u_sort_shift.m_o ... i_o), and i_o equal to the pixel's value;
-- the configuration the page saves is the render's configuration.
+- the configuration the page saves is the render's configuration;
+- switched to the volume, the page shows `RMAPGEN volume --synthetic` of the configuration and
+  scene it saves (pixels and bytes), and a click on its worst pixel lists the samples of that
+  pixel's ray and traces the heaviest: i_o equal to that sample's intensity in the list.
 Before that it shows that the check can fail: against the render of the configuration before
 the slider moved, the image must be refused. Exit 0 when all pass, 1 when not, 2 for bad input.
 """
@@ -111,6 +114,22 @@ def compare(page, render_dir, errors):
             errors.append(f"{sel}: its bytes are not the CLI's {name}")
 
 
+def figures(page, render_dir, errors, what):
+    """The render's metrics.json; the largest error the page shows must be its."""
+    m = json.loads((render_dir / "metrics.json").read_text())
+    shown = page.eval_on_selector("#max_abs_error", "e => e.textContent")
+    if shown != str(m["max_abs_error"]):
+        errors.append(f"{what}: largest error shown {shown}, metrics.json {m['max_abs_error']}")
+    return m
+
+
+def click_pixel(page, size, x, y):
+    """Clicks pixel (x, y) of the design's image and waits for its trace."""
+    box = page.eval_on_selector("#model", "e => [e.clientWidth, e.clientHeight]")
+    page.click("#model", position={"x": (x + 0.5) * box[0] / size, "y": (y + 0.5) * box[1] / size})
+    page.wait_for_function("(p) => document.body.dataset.traced === p", arg=f"{x},{y}", timeout=20000)
+
+
 def wait_render(page, after):
     page.wait_for_function(
         "(after) => document.body.dataset.renderId && document.body.dataset.renderId !== after"
@@ -167,17 +186,10 @@ def main() -> int:
             else:
                 print(f"self-test: the render before the move: refused ({wrong[0]})")
             compare(page, after, errors)
-            m = json.loads((after / "metrics.json").read_text())
-            shown = page.eval_on_selector("#max_abs_error", "e => e.textContent")
-            if shown != str(m["max_abs_error"]):
-                errors.append(f"largest error shown {shown}, metrics.json {m['max_abs_error']}")
+            m = figures(page, after, errors, "sphere")
             # Click the worst pixel: its path through the pipeline.
             wx, wy = m["worst"]["x"], m["worst"]["y"]
-            box = page.eval_on_selector("#model", "e => [e.clientWidth, e.clientHeight]")
-            page.click("#model", position={"x": (wx + 0.5) * box[0] / size,
-                                           "y": (wy + 0.5) * box[1] / size})
-            page.wait_for_function("(p) => document.body.dataset.traced === p",
-                                   arg=f"{wx},{wy}", timeout=20000)
+            click_pixel(page, size, wx, wy)
             names = page.eval_on_selector_all("#trace tr[data-name]", "rs => rs.map(r => r.dataset.name)")
             for want in ("u_sort_shift.m_o", "u_normalise.u_o", "u_atan_rom.pu_o",
                          "u_map_lookup.e00_o", "u_interpolate.i_o", "i_o"):
@@ -199,10 +211,36 @@ def main() -> int:
                 page.click("#save-config")
             if dl.value.suggested_filename != "config.toml":
                 errors.append(f"the save button saves {dl.value.suggested_filename}")
+            # The volume: the engine block, as `rmapgen volume --synthetic` renders it from the
+            # configuration and scene the page saves.
+            page.select_option("#object", "volume")
+            third = wait_render(page, rid)
+            cfg_file, scene_file = tmp / "v-config.toml", tmp / "v-scene.toml"
+            for f, what in ((cfg_file, "config"), (scene_file, "scene")):
+                f.write_bytes(urllib.request.urlopen(f"{url}api/{what}.toml?id={third}").read())
+            vol = tmp / "volume"
+            subprocess.run([a.rmapgen, "volume", "--synthetic", "--config", str(cfg_file),
+                            "--scene", str(scene_file), "--size", str(size), "--out", str(vol),
+                            "--force"], check=True, capture_output=True)
+            compare(page, vol, errors)
+            vm = figures(page, vol, errors, "volume")
+            vx, vy = vm["worst"]["x"], vm["worst"]["y"]
+            click_pixel(page, size, vx, vy)
+            rows = page.eval_on_selector_all("#samples tr", "rs => rs.length") - 1
+            heaviest = page.eval_on_selector("#samples tr.module td:nth-child(4)", "e => e.textContent")
+            v_i_o = page.eval_on_selector('#trace tr[data-name="i_o"] .value', "e => e.textContent")
+            head = page.eval_on_selector("#trace-head", "e => e.textContent")
+            if rows < 1:
+                errors.append("volume: the clicked pixel lists no samples")
+            if v_i_o != heaviest:
+                errors.append(f"volume: the trace's i_o is {v_i_o}, the heaviest sample's intensity {heaviest}")
+            if f"model {vm['worst']['model']}," not in head:
+                errors.append(f"volume: the trace is not of the worst pixel (model {vm['worst']['model']}): {head!r}")
             errors += [f"the page logged an error: {e}" for e in logged]
             browser.close()
             print(f"check_explore: renders {first} and {second}, index_bits {ib} -> {ib + 1}; "
-                  f"traced ({wx}, {wy}): i_o = {i_o}")
+                  f"traced ({wx}, {wy}): i_o = {i_o}; volume render {third}, pixel ({vx}, {vy}) "
+                  f"blends {rows} samples, the heaviest's i_o = {v_i_o}")
     finally:
         os.killpg(server.pid, 15)
         server.wait()
@@ -210,7 +248,8 @@ def main() -> int:
         print(f"check_explore: {e}")
     if errors:
         return 1
-    print("check_explore: the page shows the CLI's render pixel for pixel, its figures and the trace")
+    print("check_explore: the page shows the CLI's renders (sphere and volume) pixel for pixel, "
+          "their figures and the traces")
     return 0
 
 

@@ -152,6 +152,16 @@ impl<'a> Caster<'a> {
         }
     }
 
+    /// Pixel (x, y)'s contributing samples front to back, as (weight, gradient), and its
+    /// accumulated opacity: the fused render's value there is the sum of weight times
+    /// intensity ([`Caster::render`] marches the same ray). `None` when the ray misses the box.
+    pub fn pixel(&self, x: u32, y: u32) -> Option<(f32, Vec<(f32, [i32; 3])>)> {
+        let r = self.ray(x, y)?;
+        let mut samples = Vec::new();
+        let alpha = self.march(&r, &mut Stats::default(), |w, g| samples.push((w, g)));
+        Some((alpha, samples))
+    }
+
     /// Every sample the fused path would shade, for a batch shader; refused once more than
     /// [`MAX_BATCH_SAMPLES`] samples contribute.
     pub fn collect(&self) -> Result<Samples> {
