@@ -46,7 +46,10 @@ pub const PAGE: &str = include_str!("page.html");
 
 /// Largest request body: a configuration and a scene are a few hundred bytes.
 pub const MAX_BODY: u64 = 64 << 10;
-/// Largest image side the page may ask for.
+/// Smallest image side the page may ask for: below it too few pixels fall in a map cell.
+pub const MIN_SIZE: u32 = 16;
+/// Largest image side the page may ask for: a 512² volume frame with its reference renders
+/// in about 0.3 s.
 pub const MAX_SIZE: u32 = 512;
 /// Most lights a scene may have here.
 pub const MAX_LIGHTS: usize = 8;
@@ -175,8 +178,11 @@ fn parse(ask: &Ask) -> Result<(Config, Scene)> {
             scene.lights.len()
         );
     }
-    if !(16..=MAX_SIZE).contains(&ask.size) {
-        bail!("size {} is out of range; allowed 16..={MAX_SIZE}", ask.size);
+    if !(MIN_SIZE..=MAX_SIZE).contains(&ask.size) {
+        bail!(
+            "size {} is out of range; allowed {MIN_SIZE}..={MAX_SIZE}",
+            ask.size
+        );
     }
     scene.map_fit.check(&cfg)?;
     if ask.object == Object::Volume {
@@ -766,8 +772,58 @@ mod tests {
             .to_string()
             .into_bytes();
         assert!(say(&mut ex, b).contains("comp-table ram"));
+        let mut scene = serde_json::to_value(Scene::standard()).unwrap();
+        let light = scene["light"][0].clone();
+        scene["light"] = Value::Array(vec![light; MAX_LIGHTS + 1]);
+        let b = json!({"config": {}, "scene": scene, "size": 64});
+        assert_eq!(
+            say(&mut ex, b.to_string().into_bytes()),
+            format!(
+                "scene: {} lights; the explorer takes at most {MAX_LIGHTS}",
+                MAX_LIGHTS + 1
+            )
+        );
         assert_eq!(ex.answer("DELETE", "/", b"").status, 405);
         assert_eq!(ex.answer("GET", "/nothing", b"").status, 404);
+    }
+
+    /// The server refuses a body over [`MAX_BODY`] before the explorer sees it, and answers
+    /// one at the bound.
+    #[test]
+    fn a_request_body_beyond_the_bound_is_refused() {
+        use std::io::Write;
+        let (tx, rx) = std::sync::mpsc::channel();
+        // The server runs until the test process ends.
+        std::thread::spawn(move || {
+            serve(0, |url| {
+                tx.send(url.to_string()).unwrap();
+                Ok(())
+            })
+        });
+        let url = rx.recv().unwrap();
+        let addr = url.trim_start_matches("http://").trim_end_matches('/');
+        let post = |len: u64| {
+            let mut c = std::net::TcpStream::connect(addr).unwrap();
+            write!(
+                c,
+                "POST /api/render HTTP/1.1\r\nHost: x\r\nContent-Length: {len}\r\nConnection: close\r\n\r\n"
+            )
+            .unwrap();
+            c.write_all(&vec![b' '; len as usize]).unwrap();
+            let mut reply = String::new();
+            c.read_to_string(&mut reply).unwrap();
+            reply
+        };
+        let over = post(MAX_BODY + 1);
+        assert!(over.starts_with("HTTP/1.1 413"), "{over}");
+        assert!(
+            over.contains(&format!("at most {MAX_BODY} bytes")),
+            "{over}"
+        );
+        // At the bound the body is read and judged (spaces are no request).
+        let at = post(MAX_BODY);
+        assert!(at.starts_with("HTTP/1.1 400"), "{at}");
+        assert!(at.contains("the request"), "{at}");
     }
 
     #[test]

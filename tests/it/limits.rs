@@ -846,6 +846,14 @@ fn usage_limits_table_quotes_the_constants() {
         format!("`1..={}`", rmapgen::cmd::volume::MAX_REPEAT),
         format!("`(0, {}]` MHz", rmapgen::cmd::fpga::MAX_FREQ_MHZ),
         format!("`{}` bytes each", rmapgen::vectors::MAX_MAP_FILE_BYTES),
+        format!("`{}` bytes | a configuration", rmapgen::explore::MAX_BODY),
+        format!(
+            "`{}..={}` pixels, `{}` lights",
+            rmapgen::explore::MIN_SIZE,
+            rmapgen::explore::MAX_SIZE,
+            rmapgen::explore::MAX_LIGHTS
+        ),
+        format!("the last `{}`", rmapgen::explore::KEPT),
     ] {
         assert!(
             table.contains(&want),
