@@ -386,8 +386,8 @@ slurm-test: build
 # proof passes a mutant whose outputs differ. They run the release binary, the build users
 # run: the false proof of issue 31 was in the release build only.
 # mutants-sample (in make test): MUTANTS_SAMPLE Verilog mutants and one per memory file, the
-# ground truth only on those prove passes, ~4 min on 2 idle cores (30: the CI time target
-# of 30 minutes; 40 until 2026-12-06). mutants: the campaign, every
+# ground truth only on those prove passes, ~3 min on 2 idle cores (20: the CI time target
+# of 30 minutes; 40 until 2026-12-06, then 30). mutants: the campaign, every
 # mutant judged by direct, prove, sim and sim --gate (a benchmark-style run, hours; figures in
 # docs/VERIFICATION.md). MUTANTS_SEED picks another draw. Both keep a journal of outcomes
 # (build/mutants*/<design>.journal): a run stopped and started again by the same binary on
@@ -396,7 +396,7 @@ MUTANTS_BIN     := target/release/rmapgen
 MUTANTS_DESIGN  ?= build/mutants-design
 MUTANTS_FLAGS   ?= --grad-bits 8 --red-bits 6
 MUTANTS_SEED    ?= 1
-MUTANTS_SAMPLE  ?= 30
+MUTANTS_SAMPLE  ?= 20
 MUTANTS_COUNT   ?= 100
 MUTANTS_JOBS    ?= 2
 MUTANTS_METHODS ?= prove,sim,gate
@@ -431,12 +431,12 @@ mutants: mutants-design
 # difference in ready_o, valid_o, the tag and the map buffers read and written; the harness
 # claims those, not the datapath's results (prove's). The mutants are drawn from the modules of
 # the flow control (FORMAL_MUT_SELECT) of the narrow formal design; a flow difference the
-# harness proves is a soundness bug (exit 1). mutants-formal-sample (in make test): 10 of them,
-# the miter only on those the harness passes, ~2 min; mutants-formal: 60, every one judged by
-# both, ~20 min on 2 cores.
+# harness proves is a soundness bug (exit 1). mutants-formal-sample (in make test): 6 of them
+# (10 until 2026-12-06: the CI time target), the miter only on those the harness passes,
+# ~1.5 min; mutants-formal: 60, every one judged by both, ~20 min on 2 cores.
 FORMAL_MUT_DESIGN ?= build/rtl_formal_mut
 FORMAL_MUT_SELECT ?= rmap_top pipe_delay
-FORMAL_MUT_SAMPLE ?= 10
+FORMAL_MUT_SAMPLE ?= 6
 FORMAL_MUT_COUNT  ?= 60
 MUTANTS_FORMAL = $(MUTANTS_BIN) mutants $(FORMAL_MUT_DESIGN) --truth flow --select "$(FORMAL_MUT_SELECT)" \
 	  --seed $(MUTANTS_SEED) --jobs $(MUTANTS_JOBS) --python $(VENV)/bin/python
@@ -637,7 +637,7 @@ fpga-throughput: build venv
 # $(GATE_STREAM) random ones after the corners again. Exact agreement, memories included.
 # Netlist and logs in $(GATE_BUILD)/<design>/gate. Gate-level Icarus runs ~100-160 vectors/s
 # here, so the default design takes about 2 minutes on 2 cores (see docs/VERIFICATION.md).
-GATE_STREAM ?= 10000
+GATE_STREAM ?= 4000
 GATE_BUILD  ?= build/gate
 GATE_OUT    ?= build/rtl_ice40
 
