@@ -164,6 +164,84 @@ mod tests {
         );
     }
 
+    /// A record is read back as its file's; anything else at the record's name is not one.
+    #[test]
+    fn a_record_names_its_file_with_its_digest_and_nothing_else_is_a_record() {
+        let d = tempfile::tempdir().unwrap();
+        let target = d.path().join("maps.hex");
+        let rec = record_path(&target).unwrap();
+        assert_eq!(rec, d.path().join(".maps.hex.rmapgen-sha256"));
+        assert_eq!(read_record(&target), None, "no record yet");
+        let hash = "0123456789abcdef".repeat(4);
+        std::fs::write(&rec, record_text("maps.hex", &hash)).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(&rec).unwrap(),
+            format!("{hash}  maps.hex\n")
+        );
+        assert_eq!(read_record(&target), Some(Some(hash.clone())));
+        for bad in [
+            record_text("other.hex", &hash),
+            record_text("maps.hex", &hash[1..]),
+            record_text("maps.hex", &format!("{}g", &hash[1..])),
+            format!("{hash}  maps.hex"),
+            format!("{hash} maps.hex\n"),
+        ] {
+            std::fs::write(&rec, &bad).unwrap();
+            assert_eq!(read_record(&target), Some(None), "{bad:?}");
+        }
+        // Longer than a record can be, though well-formed at its start.
+        let mut long = record_text("maps.hex", &hash).into_bytes();
+        long.resize(4097, b'\n');
+        std::fs::write(&rec, &long).unwrap();
+        assert_eq!(read_record(&target), Some(None));
+        std::fs::remove_file(&rec).unwrap();
+        std::fs::create_dir(&rec).unwrap();
+        assert_eq!(read_record(&target), Some(None), "a directory");
+        // A name too long for its record's name is shortened to fit the limit.
+        let long_name = "m".repeat(super::super::NAME_MAX);
+        let p = record_path(&d.path().join(&long_name)).unwrap();
+        let n = p.file_name().unwrap().len();
+        assert!(
+            n <= super::super::NAME_MAX && n > super::super::NAME_MAX - 8,
+            "{n}"
+        );
+        assert!(p.to_str().unwrap().ends_with(RECORD_SUFFIX));
+    }
+
+    /// A stamp is read up to its bound, exactly; one byte more is no stamp.
+    #[test]
+    fn a_stamp_is_read_up_to_its_bound() {
+        let d = tempfile::tempdir().unwrap();
+        // Lines of 128 bytes: 64 hex digits, two spaces, a name of 61, a newline.
+        let line = |i: u64| format!("{}  {:0>61}\n", "a".repeat(64), i);
+        let lines = MAX_BYTES / 128;
+        let mut text: String = (0..lines).map(line).collect();
+        assert_eq!(text.len() as u64, MAX_BYTES);
+        std::fs::write(d.path().join(NAME), &text).unwrap();
+        assert_eq!(read(d.path()).map(|s| s.len() as u64), Some(lines));
+        // The last name one character longer: still well-formed, one byte over.
+        text.pop();
+        text.push_str("0\n");
+        assert_eq!(text.len() as u64, MAX_BYTES + 1);
+        std::fs::write(d.path().join(NAME), &text).unwrap();
+        assert!(read(d.path()).is_none());
+    }
+
+    /// A stamp written over a directory that holds one does not list itself; a directory at
+    /// the stamp's name is no stamp.
+    #[test]
+    fn a_stamp_does_not_list_itself() {
+        let d = tempfile::tempdir().unwrap();
+        std::fs::write(d.path().join("a.v"), "x").unwrap();
+        write(d.path()).unwrap();
+        write(d.path()).unwrap();
+        let s = read(d.path()).unwrap();
+        assert_eq!(s.keys().collect::<Vec<_>>(), ["a.v"]);
+        let e = tempfile::tempdir().unwrap();
+        std::fs::create_dir(e.path().join(NAME)).unwrap();
+        assert!(read(e.path()).is_none());
+    }
+
     #[test]
     fn a_malformed_stamp_is_no_stamp() {
         let d = tempfile::tempdir().unwrap();
@@ -171,6 +249,12 @@ mod tests {
             "notes about my design\n",
             "abc  a.v\n",
             &format!("{}  ../x\n", "0".repeat(64)),
+            &format!("{}  ./x\n", "0".repeat(64)),
+            &format!("{}  a//x\n", "0".repeat(64)),
+            &format!("{}  \n", "0".repeat(64)),
+            &format!("{}  a.v\n", "g".repeat(64)),
+            &format!("{}  a.v\n", "0".repeat(63)),
+            &format!("{} a.v\n", "0".repeat(64)),
         ] {
             std::fs::write(d.path().join(NAME), bad).unwrap();
             assert!(read(d.path()).is_none(), "{bad:?}");
