@@ -905,3 +905,29 @@ fn an_oversized_or_directory_map_file_is_refused() {
         &["maps"],
     );
 }
+
+/// A file at a single output's record name (`.NAME.rmapgen-sha256`) or at a directory's stamp
+/// name (`.rmapgen-files`) is judged from its size before it is read: one larger than such a
+/// file can be is "not rmapgen's" without being read into memory (a 64 MiB sparse file, under
+/// the counting allocator).
+#[test]
+fn a_large_file_at_a_record_or_stamp_name_is_not_read() {
+    use rmapgen::output::stamp;
+    let d = helpers::tempdir();
+    let target = d.path().join("maps.hex");
+    let rec = stamp::record_path(&target).unwrap();
+    std::fs::File::create(&rec)
+        .unwrap()
+        .set_len(64 << 20)
+        .unwrap();
+    let (r, peak) = peak_during(|| stamp::read_record(&target));
+    assert_eq!(r, Some(None), "a 64 MiB file is not a record");
+    assert!(peak < 1 << 20, "read_record allocated {peak} bytes");
+    std::fs::File::create(d.path().join(stamp::NAME))
+        .unwrap()
+        .set_len(64 << 20)
+        .unwrap();
+    let (r, peak) = peak_during(|| stamp::read(d.path()));
+    assert!(r.is_none(), "a 64 MiB file is not a stamp");
+    assert!(peak < 1 << 20, "stamp::read allocated {peak} bytes");
+}
