@@ -330,6 +330,10 @@ fn passes(
 
 /// The parts of a factored run, in the order they run.
 pub const FACTORED: [&str; 4] = ["structure", "states", "zero", "front"];
+/// The factored parts in two runs, the order in which `rmapgen mutants` judges a mutant by the
+/// proof: first the parts that take seconds to minutes, then the front's every gradient, only
+/// if they passed. Together they are [`FACTORED`], each once.
+pub const STAGED: [&[&str]; 2] = [&["structure", "states", "zero"], &["front"]];
 /// The parts of a `--direct` run.
 pub const DIRECT: [&str; 2] = ["structure", "direct"];
 
@@ -724,6 +728,11 @@ mod tests {
         assert!(!opts(true, &["structure"]).needs_top());
         assert_eq!(opts(true, &[]).names(), DIRECT);
         assert_eq!(all.names(), FACTORED);
+        assert_eq!(
+            STAGED.concat(),
+            FACTORED,
+            "the staged runs are the factored parts, once"
+        );
         // The zero part runs on the buffers as the last pass left them: the second map.
         assert_eq!(LAST_PASS.label, "buffer 1 written");
         assert_eq!(LAST_PASS.expect, 1);
