@@ -159,13 +159,13 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
         })
     } else {
         // The factored proof is judged on every mutant, so the design must be one it takes.
-        if let Err(e) = crate::prove::check_design(&design, false) {
+        if let Err(e) = crate::prove::check_design(&design, false, 1) {
             bail!("rmapgen mutants judges by rmapgen prove: {e}");
         }
         None
     };
     if truth == Method::Direct {
-        if let Err(e) = crate::prove::check_design(&design, true) {
+        if let Err(e) = crate::prove::check_design(&design, true, 1) {
             bail!("the ground truth of rmapgen mutants is prove --direct: {e}; give --truth stream for a sampled one");
         }
     }

@@ -28,7 +28,8 @@ pub struct ProveArgs {
     /// K-th; merge the N reports with --merge [N in 1..=1048576].
     #[arg(long, value_name = "K/N", allow_hyphen_values = true, value_parser = super::parse::named(Shard::parse))]
     pub shard: Option<Shard>,
-    /// Every gradient through the top instead of the factored proof (grad_bits <= 9).
+    /// Every gradient through the top instead of the factored proof (grad_bits <= 9 in one
+    /// run; wider in shards of at most as many samples: --shard K/512 for grad_bits 12).
     #[arg(long)]
     pub direct: bool,
     /// Only this part (repeat the flag or separate with commas): structure, states, zero,
@@ -102,7 +103,9 @@ pub fn run(a: &ProveArgs) -> Result<ExitCode> {
         parts: a.part.clone(),
         reuse: a.reuse.as_deref().map(absolute),
     };
-    prove::check_design(&design, opts.direct)?;
+    // Under --slurm the run is split into its --shards array tasks.
+    let shards = if a.slurm { a.shards } else { opts.shard.count };
+    prove::check_design(&design, opts.direct, shards)?;
     // Refused before the build directory or the report is claimed: bad input makes nothing.
     prove::check_options(&opts)?;
     let policy = a.force.policy(&[Some(design.path())]);

@@ -38,8 +38,17 @@ use std::time::Instant;
 
 /// The widest gradient a factored run takes: 2^36 gradients through the front.
 pub const MAX_GRAD_BITS: u32 = 12;
-/// The widest gradient `--direct` takes: 2^27 gradients through the top.
+/// The widest gradient a whole `--direct` run takes: 2^27 gradients through the top on each
+/// of the four passes, 2^29 samples. A wider design (up to [`MAX_GRAD_BITS`]) takes
+/// `--direct` in shards of at most as many samples each ([`direct_shards`]).
 pub const MAX_DIRECT_BITS: u32 = 9;
+
+/// The fewest shards a `--direct` run of gradients `grad_bits` wide is split into: 1 up to
+/// [`MAX_DIRECT_BITS`], then enough that no shard drives more top samples than a whole run
+/// of that width (512 for the default G = 12: 2^29 samples a shard, about two minutes).
+pub fn direct_shards(grad_bits: u32) -> u64 {
+    1 << (3 * grad_bits.saturating_sub(MAX_DIRECT_BITS))
+}
 /// Failure messages a report keeps (all are counted).
 pub const KEEP_FAILURES: usize = 20;
 
@@ -145,13 +154,15 @@ pub struct Options {
 }
 
 /// Checks that `rmapgen prove` takes this design.
-pub fn check_design(d: &DesignDir, direct: bool) -> Result<()> {
-    check_limits(&d.config, direct)
+/// `shards` is the number of shards the run is split into (a `--direct` run of a design wider
+/// than [`MAX_DIRECT_BITS`] must be split: [`direct_shards`]).
+pub fn check_design(d: &DesignDir, direct: bool, shards: u64) -> Result<()> {
+    check_limits(&d.config, direct, shards)
 }
 
-/// Checks that `rmapgen prove` takes a design of configuration `cfg` (the bounds of every
-/// allocation and loop of a run or a merge).
-pub fn check_limits(cfg: &Config, direct: bool) -> Result<()> {
+/// Checks that `rmapgen prove` takes a design of configuration `cfg` in a run split into
+/// `shards` (the bounds of every allocation and loop of a run or a merge).
+pub fn check_limits(cfg: &Config, direct: bool, shards: u64) -> Result<()> {
     let g = cfg.grad_bits;
     // The proof drives one rmap_top; in a lanes design the lanes' rmap_tops share ROMs
     // through ports of their own, so no single rmap_top of it stands alone.
@@ -161,16 +172,18 @@ pub fn check_limits(cfg: &Config, direct: bool) -> Result<()> {
         cfg.lanes,
         crate::stages::top(cfg).module(cfg)
     );
+    ensure!(
+        g <= MAX_GRAD_BITS,
+        "rmapgen prove covers 2^(3 grad_bits) gradients; grad_bits = {g} is above {MAX_GRAD_BITS}"
+    );
     if direct {
+        let least = direct_shards(g);
         ensure!(
-            g <= MAX_DIRECT_BITS,
-            "--direct drives all 2^(3 grad_bits) gradients through the top; grad_bits = {g} is above {MAX_DIRECT_BITS} (drop --direct for the factored proof)"
+            shards >= least,
+            "--direct drives all 2^(3 grad_bits) gradients through the top; grad_bits = {g} is above {MAX_DIRECT_BITS}, so split the run into at least {least} shards (--shard K/{least}, each at most the {} top samples of a whole grad_bits = {MAX_DIRECT_BITS} run; or drop --direct for the factored proof)",
+            part_total("direct", MAX_DIRECT_BITS, 0)
         );
     } else {
-        ensure!(
-            g <= MAX_GRAD_BITS,
-            "rmapgen prove covers 2^(3 grad_bits) gradients; grad_bits = {g} is above {MAX_GRAD_BITS}"
-        );
         ensure!(
             cfg.red_bits <= states::MAX_RED_BITS,
             "rmapgen prove keeps one bit per sort & shift state (24 x 2^(3 red_bits - 1)); red_bits = {} is above {}",
@@ -278,8 +291,9 @@ pub const PASSES: [Pass; 4] = [
 ];
 
 /// Runs the [`PASSES`] of a part of the top whose samples are `each` per pass (ordinal
-/// `pass * each + k` for sample k of a pass), those in `range`; `samples(visit)` visits a
-/// pass's samples in order with their index k. Every pass's steps run in every shard, so
+/// `pass * each + k` for sample k of a pass), those in `range`; `samples(ks, visit)` visits
+/// a pass's samples in order with their index k, at least those with k in `ks` (the shard's
+/// share of the pass; the rest are passed over). Every pass's steps run in every shard, so
 /// that the buffers hold what the pass expects.
 #[allow(clippy::too_many_arguments)]
 fn passes(
@@ -291,7 +305,10 @@ fn passes(
     range: std::ops::Range<u64>,
     fails: &mut Failures,
     progress: &Progress,
-    mut samples: impl FnMut(&mut dyn FnMut(u64, [i32; 3]) -> Result<()>) -> Result<()>,
+    mut samples: impl FnMut(
+        std::ops::Range<u64>,
+        &mut dyn FnMut(u64, [i32; 3]) -> Result<()>,
+    ) -> Result<()>,
 ) -> Result<()> {
     let second = crate::map_stream::writes(&model.cfg, maps.buffer(1));
     for (p, pass) in PASSES.iter().enumerate() {
@@ -308,7 +325,7 @@ fn passes(
         }
         let mut batch = top::Batch::new(top, model, maps.buffer(pass.expect), part, mine.start);
         batch.pass(pass.label);
-        samples(&mut |k, g| {
+        samples(mine.start - base..mine.end - base, &mut |k, g| {
             let ord = base + k;
             if mine.contains(&ord) {
                 batch.push(ord, g, fails, progress)?;
@@ -406,7 +423,8 @@ pub struct Built {
 /// `front` part. Writes [`BUILT_FILE`] last, so a directory that has it holds a whole build.
 /// Shards given `reuse` = `build` then load these instead of building their own.
 pub fn build_only(d: &DesignDir, build: &Path, opts: &Options) -> Result<Built> {
-    check_design(d, opts.direct)?;
+    // It drives nothing: what its shards drive is checked when each runs.
+    check_design(d, opts.direct, MAX_SHARDS)?;
     check_options(opts)?;
     let names = report::read_files(d);
     let files = report::hash_files(d, &names)?;
@@ -495,7 +513,7 @@ fn reusable(d: &DesignDir, dir: &Path, files: &[report::FileHash], opts: &Option
 
 /// Runs one shard on design `d`, building in `build` (a directory rmapgen owns).
 pub fn run(d: &DesignDir, build: &Path, opts: &Options, progress: &Progress) -> Result<Report> {
-    check_design(d, opts.direct)?;
+    check_design(d, opts.direct, opts.shard.count)?;
     check_options(opts)?;
     let wanted = |name: &str| opts.wants(name);
     let start = Instant::now();
@@ -547,8 +565,8 @@ pub fn run(d: &DesignDir, build: &Path, opts: &Options, progress: &Progress) -> 
             range.clone(),
             &mut fails,
             progress,
-            |visit| {
-                for idx in 0..total {
+            |ks, visit| {
+                for idx in ks {
                     let g =
                         front::gradient(cfg, idx).map(|v| crate::vectors::inputs::dec_grad(cfg, v));
                     visit(idx, g)?;
@@ -574,7 +592,7 @@ pub fn run(d: &DesignDir, build: &Path, opts: &Options, progress: &Progress) -> 
                 range.clone(),
                 &mut fails,
                 progress,
-                |visit| states::enumerate(cfg, &mut *visit).map(|_| ()),
+                |_, visit| states::enumerate(cfg, &mut *visit).map(|_| ()),
             )?;
             parts.push(Part::new("states", range, all, fails).since(t));
         }
@@ -685,17 +703,28 @@ mod tests {
             ..Config::default()
         };
         let (_t, d) = design(&g8);
-        assert!(check_design(&d, false).is_ok());
-        assert!(check_design(&d, true).is_ok());
+        assert!(check_design(&d, false, 1).is_ok());
+        assert!(check_design(&d, true, 1).is_ok());
         let (_t, d) = design(&Config::default());
-        assert!(check_design(&d, false).is_ok());
-        let e = check_design(&d, true).unwrap_err().to_string();
-        assert!(
-            e.starts_with("--direct drives all 2^(3 grad_bits) gradients"),
-            "{e}"
+        assert!(check_design(&d, false, 1).is_ok());
+        // The default design's 2^36 gradients go --direct only in shards of at most 2^27.
+        assert_eq!(
+            [8, 9, 10, 12].map(direct_shards),
+            [1, 1, 8, 512],
+            "the fewest --direct shards"
         );
+        for few in [1, 2, 511] {
+            let e = check_design(&d, true, few).unwrap_err().to_string();
+            assert!(
+                e.starts_with("--direct drives all 2^(3 grad_bits) gradients")
+                    && e.contains("at least 512 shards (--shard K/512"),
+                "{e}"
+            );
+        }
+        assert!(check_design(&d, true, 512).is_ok());
+        assert!(check_design(&d, true, MAX_SHARDS).is_ok());
         let (_t, d) = design(&Config { lanes: 2, ..g8 });
-        let e = check_design(&d, false).unwrap_err().to_string();
+        let e = check_design(&d, false, 1).unwrap_err().to_string();
         assert!(
             e.starts_with("rmapgen prove proves one rmap_top; this design has lanes = 2"),
             "{e}"

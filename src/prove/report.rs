@@ -350,7 +350,8 @@ pub fn merge(files: &[PathBuf]) -> Result<Merged> {
     let cfg = &first.config;
     cfg.validate()
         .with_context(|| format!("{}: config", files[0].display()))?;
-    super::check_limits(cfg, direct).with_context(|| format!("{}: config", files[0].display()))?;
+    super::check_limits(cfg, direct, n)
+        .with_context(|| format!("{}: config", files[0].display()))?;
     let totals = super::totals(cfg, direct)?;
     // Every report has exactly the run's parts, each once.
     for (r, f) in reports.iter().zip(files) {

@@ -167,6 +167,23 @@ fn a_small_design_is_proven_in_two_shards_and_every_part_catches_a_planted_fault
         "direct",
         &["direct (buffer 0 as loaded): sample", "gradient ["],
     );
+    // ... and in a --direct shard, which drives its own share only: the last quarter of the
+    // samples, the pass on buffer 1 as written.
+    let o = prove(
+        &d,
+        &build,
+        &["--direct", "--part", "direct", "--shard", "4/4"],
+    );
+    assert_fails(
+        &o,
+        "direct",
+        &[
+            "direct (buffer 1 written): sample",
+            " 16777216 of ",
+            " 67108864 inputs [50331648..67108864) ",
+        ],
+    );
+    assert!(!text(&o).contains("as loaded"), "{}", text(&o));
 
     // Sort & shift's leading-zero count off by one for x magnitudes 8..15.
     let d = tmp.path().join("shift");
@@ -510,7 +527,7 @@ fn bad_input_is_one_line_and_exit_2() {
     helpers::assert_error(&prove(&dir, &build, &[]), "grad_bits = 16 is above 12");
     helpers::assert_error(
         &prove(&dir, &build, &["--direct"]),
-        "grad_bits = 16 is above 9",
+        "grad_bits = 16 is above 12",
     );
     assert!(!build.exists(), "nothing written");
     // rmapgen mutants judges every mutant by prove, so it takes the designs prove takes,
