@@ -684,7 +684,8 @@ mod tests {
     }
 
     /// A design of `cfg` written into a scratch directory, opened as `prove` opens one.
-    fn design(cfg: &Config) -> (crate::output::Scratch, DesignDir) {
+    /// A design of `cfg`, written as `rmapgen generate` writes it, in a scratch directory.
+    pub(super) fn design(cfg: &Config) -> (crate::output::Scratch, DesignDir) {
         let tmp = crate::output::Scratch::new().unwrap();
         let out =
             crate::output::StagedDir::new(&tmp.path().join("d"), &Default::default()).unwrap();

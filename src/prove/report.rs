@@ -531,6 +531,106 @@ mod tests {
             .collect()
     }
 
+    #[test]
+    fn the_files_read_are_the_designs_verilog_memories_and_manifest_each_hashed() {
+        let (_t, d) = crate::prove::tests::design(&cfg());
+        let names = read_files(&d);
+        // Exactly the design's top-level Verilog and $readmemh files and its manifest: what
+        // the simulation, the netlist and the model read (not the testbenches or vectors).
+        let mut want: Vec<String> = std::fs::read_dir(d.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .filter(|n| n.ends_with(".v") || n.ends_with(".hex") || n == "manifest.json")
+            .collect();
+        want.sort();
+        assert_eq!(names, want);
+        assert_eq!(names.len(), 23, "{names:?}");
+        for n in [
+            "rmap_top.v",
+            "recip_rom.hex",
+            "map_x.hex",
+            "map2_z.hex",
+            "map_bank_11.hex",
+        ] {
+            assert!(names.iter().any(|x| x == n), "{n} is read");
+        }
+        let hashed = hash_files(&d, &names).unwrap();
+        assert_eq!(hashed.len(), names.len());
+        for (h, n) in hashed.iter().zip(&names) {
+            assert_eq!(&h.name, n);
+            assert_eq!(
+                h.sha256,
+                crate::output::stamp::digest(&d.path().join(n)).unwrap()
+            );
+            assert!(h.as_generated, "{n} is as generated");
+        }
+        assert!(edited(&hashed).is_empty());
+        // One entry of the reciprocal ROM changed: that file alone is edited, its hash new.
+        let rom = d.path().join("recip_rom.hex");
+        let text = std::fs::read_to_string(&rom).unwrap();
+        let changed = text.replacen(|c: char| c.is_ascii_hexdigit(), "f", 1);
+        let changed = if changed == text {
+            text.replacen('f', "0", 1)
+        } else {
+            changed
+        };
+        std::fs::write(&rom, changed).unwrap();
+        let after = hash_files(&d, &names).unwrap();
+        assert_eq!(edited(&after), ["recip_rom.hex"]);
+        for (a, h) in after.iter().zip(&hashed) {
+            assert_eq!(
+                a.sha256 == h.sha256,
+                a.name != "recip_rom.hex",
+                "{}",
+                a.name
+            );
+        }
+    }
+
+    #[test]
+    fn a_part_is_timed_in_wall_and_cpu_seconds_and_names_its_engine() {
+        // CPU seconds are this process's user and system time, as getrusage counts them.
+        let rusage = || {
+            let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+            assert_eq!(unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) }, 0);
+            let s = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 / 1e6;
+            (s(u.ru_utime), s(u.ru_stime))
+        };
+        // Enough system time (metadata calls) and user time (a busy loop) that a swapped
+        // field, a sign or a scale shows.
+        while rusage().1 < 0.05 {
+            for _ in 0..1000 {
+                let _ = std::fs::metadata("/");
+            }
+        }
+        let start = now();
+        assert!(start.1 >= 0.05, "{start:?}");
+        let (user0, _) = rusage();
+        let mut x = 1u64;
+        while rusage().0 < user0 + 0.2 {
+            for _ in 0..100_000 {
+                x = std::hint::black_box(x.wrapping_mul(6364136223846793005).wrapping_add(1));
+            }
+        }
+        let (user, sys) = rusage();
+        let mine = cpu_seconds();
+        assert!(
+            (mine - (user + sys)).abs() < 0.05,
+            "cpu_seconds {mine} against getrusage {user} + {sys}"
+        );
+        let p = Part::new("front", 0..1, 1, Failures::default())
+            .since(start)
+            .engine("gates");
+        assert_eq!(p.engine, "gates");
+        // The part's CPU seconds are those since its start: at least the busy loop's.
+        assert!(
+            p.cpu_seconds >= 0.15 && (p.cpu_seconds - (mine - start.1)).abs() < 0.021,
+            "{p:?} {mine} {start:?}"
+        );
+        assert!(p.seconds > 0.0 && p.seconds < 600.0, "{p:?}");
+        assert_eq!(Part::new("zero", 0..1, 1, Failures::default()).engine, "");
+    }
+
     /// The reports of an honest run of `n` shards that every part passed.
     fn run(n: u64, direct: bool) -> Vec<Report> {
         let cfg = cfg();
