@@ -180,7 +180,7 @@ pub fn check_limits(cfg: &Config, direct: bool, shards: u64) -> Result<()> {
         let least = direct_shards(g);
         ensure!(
             shards >= least,
-            "--direct drives all 2^(3 grad_bits) gradients through the top; grad_bits = {g} is above {MAX_DIRECT_BITS}, so split the run into at least {least} shards (--shard K/{least}, each at most the {} top samples of a whole grad_bits = {MAX_DIRECT_BITS} run; or drop --direct for the factored proof)",
+            "--direct drives all 2^(3 grad_bits) gradients through the top; grad_bits = {g} is above {MAX_DIRECT_BITS}, so split the run into at least {least} shards (--shard K/{least} or --slurm --shards {least}, each at most the {} top samples of a whole grad_bits = {MAX_DIRECT_BITS} run; or drop --direct for the factored proof)",
             part_total("direct", MAX_DIRECT_BITS, 0)
         );
     } else {

@@ -633,8 +633,12 @@ mod tests {
 
     /// The reports of an honest run of `n` shards that every part passed.
     fn run(n: u64, direct: bool) -> Vec<Report> {
-        let cfg = cfg();
-        let totals = crate::prove::totals(&cfg, direct).unwrap();
+        run_of(&cfg(), n, direct)
+    }
+
+    /// The same, of a design of `cfg`.
+    fn run_of(cfg: &Config, n: u64, direct: bool) -> Vec<Report> {
+        let totals = crate::prove::totals(cfg, direct).unwrap();
         (1..=n)
             .map(|k| {
                 let shard = Shard { index: k, count: n };
@@ -735,6 +739,11 @@ mod tests {
 
     #[test]
     fn merge_refuses_what_does_not_cover_the_whole_run() {
+        // A --direct run of the default design (G = 12) merges from 512 shards or more, as it
+        // runs; two shards claiming it are refused.
+        let g12 = Config::default();
+        assert!(merge_reports(&run_of(&g12, 512, true)).unwrap().passed);
+        refused(&run_of(&g12, 2, true), "at least 512 shards");
         let base = run(2, false);
         let edit = |f: &dyn Fn(&mut Vec<Report>)| {
             let mut r = base.clone();
