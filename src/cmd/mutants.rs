@@ -268,14 +268,15 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
         methods.extend(&plan.methods);
     }
     crate::outln!(
-        "{:<8} {:>7} {:>11} {:>15} {:>7} {:>9} {:>17}",
+        "{:<8} {:>7} {:>11} {:>15} {:>7} {:>9} {:>17} {:>18}",
         "method",
         "judged",
         "equivalent",
         "non-equivalent",
         "killed",
         "survived",
-        "killed unclassed"
+        "killed unclassed",
+        "failed equivalent"
     )?;
     let tallies: Vec<_> = methods
         .iter()
@@ -283,14 +284,15 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
         .collect();
     for t in &tallies {
         crate::outln!(
-            "{:<8} {:>7} {:>11} {:>15} {:>7} {:>9} {:>17}",
+            "{:<8} {:>7} {:>11} {:>15} {:>7} {:>9} {:>17} {:>18}",
             t.method,
             t.judged,
             t.equivalent,
             t.non_equivalent,
             t.killed,
             t.survived,
-            t.killed_unclassed
+            t.killed_unclassed,
+            t.failed_equivalent
         )?;
     }
     let unsound: Vec<&Outcome> = outcomes.iter().filter(|o| o.unsound()).collect();

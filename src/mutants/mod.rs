@@ -673,6 +673,11 @@ pub struct Tally {
     pub survived: usize,
     /// Killed without a ground-truth class (the quick plan's kills).
     pub killed_unclassed: usize,
+    /// Failed (or refused) though the ground truth passed it: under `--direct`, a check
+    /// stricter than the top's outputs or a false alarm; under a sampled truth (the stream),
+    /// most often a difference the sample missed, which the check's failure names (a
+    /// gradient to confirm by `prove --direct --shard`, docs/VERIFICATION.md).
+    pub failed_equivalent: usize,
 }
 
 /// The tally of `method` over `outcomes` (the null mutant left out).
@@ -687,7 +692,12 @@ pub fn tally(method: Method, outcomes: &[Outcome]) -> Tally {
         };
         t.judged += 1;
         match o.equivalent() {
-            Some(true) => t.equivalent += 1,
+            Some(true) => {
+                t.equivalent += 1;
+                if v.kills() {
+                    t.failed_equivalent += 1;
+                }
+            }
             Some(false) => {
                 t.non_equivalent += 1;
                 if v.kills() {
@@ -797,7 +807,11 @@ mod tests {
             ),
             (3, 1, 2, 1, 1)
         );
+        // m2: the stream passed it, prove failed it (a difference the sample missed, or a
+        // false alarm): counted apart, never as a kill; a truth never fails what it passed.
+        assert_eq!(t.failed_equivalent, 1);
         assert_eq!(tally(Stream, &sampled).judged, 3);
+        assert_eq!(tally(Stream, &sampled).failed_equivalent, 0);
         assert!(Stream.is_truth() && Direct.is_truth() && !Prove.is_truth());
         let d = tally(Direct, &all);
         assert_eq!(
