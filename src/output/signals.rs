@@ -409,6 +409,24 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_scratch_directory_is_registered_while_it_lives_and_forgotten_with_it() {
+        let registered = |p: &Path| {
+            hold()
+                .0
+                .live
+                .iter()
+                .any(|(_, u)| matches!(u, Undo::Remove(q) if q == p))
+        };
+        let s = crate::output::Scratch::new().unwrap();
+        let p = s.path().to_path_buf();
+        assert!(p.is_dir() && registered(&p), "{}", p.display());
+        drop(s);
+        // Removed, and no registration left behind to grow the registry or undo a path that
+        // another run may hold by then.
+        assert!(!p.exists() && !registered(&p), "{}", p.display());
+    }
+
+    #[test]
     fn registrations_reach_the_guardian_as_they_were() {
         let odd = PathBuf::from("/tmp/a b\nc/\u{e9}");
         for undo in [
