@@ -403,6 +403,11 @@ impl CreatedParents {
             missing.push(d.to_path_buf());
             p = d.parent();
         }
+        // The nearest parent that exists must be a directory; a file there fails every
+        // `create_dir` below it with an error that names nothing.
+        if let Some(d) = p.filter(|d| !d.as_os_str().is_empty() && !d.is_dir()) {
+            return Err(not_a_directory(d));
+        }
         let mut made = CreatedParents { dirs: Vec::new() };
         for d in missing.into_iter().rev() {
             let token = signals::register(Undo::RemoveIfEmpty(d.clone()));
@@ -414,9 +419,17 @@ impl CreatedParents {
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && d.is_dir() => {
                     token.release()
                 }
+                // Something that `exists()` did not see, such as a dangling symbolic link.
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                    token.release();
+                    return Err(not_a_directory(&d));
+                }
                 Err(e) => {
                     token.release();
-                    return Err(e);
+                    return Err(std::io::Error::new(
+                        e.kind(),
+                        format!("{}: {e}", d.display()),
+                    ));
                 }
             }
         }
@@ -429,6 +442,13 @@ impl CreatedParents {
             t.release();
         }
     }
+}
+
+fn not_a_directory(d: &Path) -> std::io::Error {
+    std::io::Error::new(
+        std::io::ErrorKind::NotADirectory,
+        format!("{} is not a directory", d.display()),
+    )
 }
 
 impl Drop for CreatedParents {

@@ -138,6 +138,29 @@ fn an_unwritable_output_names_its_path() {
     assert!(!build.exists(), "prove's build directory was not started");
 }
 
+/// An output below a file, or below a symbolic link to nothing, names that path: `create_dir`
+/// alone would say `Not a directory` or `File exists` and name nothing, and a link that
+/// `exists()` does not see must not be taken for a directory someone else made.
+#[test]
+fn an_output_below_a_file_or_a_dangling_link_names_it() {
+    let t = tempdir();
+    let file = t.path().join("file");
+    std::fs::write(&file, "mine\n").unwrap();
+    let link = t.path().join("link");
+    std::os::unix::fs::symlink(t.path().join("nowhere"), &link).unwrap();
+    for blocker in [&file, &link] {
+        for below in [blocker.clone(), blocker.join("sub")] {
+            let (hex, dir) = (below.join("m.hex"), below.join("d"));
+            for args in [["maps", "--out", s(&hex)], ["generate", "--out", s(&dir)]] {
+                let o = run(&args);
+                assert_error(&o, &format!("{} is not a directory", blocker.display()));
+                assert_eq!(helpers::entries(t.path()), ["file", "link"], "{args:?}");
+            }
+        }
+    }
+    assert_eq!(std::fs::read(&file).unwrap(), b"mine\n");
+}
+
 /// `fpga` on a design whose memories fall back to logic (generated for --target generic)
 /// fails naming the Yosys log: in the --logs directory, where it is after the command, not
 /// in the staging directory beside it that is gone.
