@@ -501,7 +501,7 @@ RUST_MUTANTS_TESTS_aig     := mult_proof|prove
 RUST_MUTANTS_FILES_prove   := -f 'src/prove/**' -e 'src/prove/mult/**' -e src/prove/aig.rs
 RUST_MUTANTS_TESTS_prove   := prove|errors
 RUST_MUTANTS_FILES_output  := -f 'src/output/**'
-RUST_MUTANTS_TESTS_output  := output_safety|nothing_left|init_files|stdout
+RUST_MUTANTS_TESTS_output  := output_safety|flag_and_path_errors|nothing_left|init_files|stdout
 RUST_MUTANTS_FILES_model   := -f 'src/model/**'
 RUST_MUTANTS_TESTS_model   := rtl_generate|model_stages|vectors|symmetry|stability|fast|map_fit|compare
 
