@@ -159,6 +159,14 @@ fn an_output_below_a_file_or_a_dangling_link_names_it() {
         }
     }
     assert_eq!(std::fs::read(&file).unwrap(), b"mine\n");
+    // Any other failure to make a parent names the parent and the system's reason.
+    for args in [
+        ["maps", "--out", "/sys/rmapgen-x/sub/m.hex"],
+        ["generate", "--out", "/sys/rmapgen-x/d"],
+    ] {
+        let o = run(&args);
+        assert_error(&o, "/sys/rmapgen-x: Operation not permitted");
+    }
 }
 
 /// `fpga` on a design whose memories fall back to logic (generated for --target generic)
