@@ -707,7 +707,9 @@ mod tests {
         let live = p.join(format!("{prefix}{}", std::process::id()));
         let unmarked = p.join(format!("{prefix}4000002"));
         let file = p.join(format!("{prefix}4000003"));
-        for d in [&dead, &dead_old, &live] {
+        // Marked, but no process id follows the prefix: not a name rmapgen gives.
+        let not_a_pid = p.join(format!("{prefix}4000004x"));
+        for d in [&dead, &dead_old, &live, &not_a_pid] {
             std::fs::create_dir(d).unwrap();
             std::fs::write(d.join(STAGING_MARK), b"").unwrap();
         }
@@ -715,7 +717,7 @@ mod tests {
         std::fs::write(&file, b"mine").unwrap();
         remove_stale(p, &prefix);
         assert!(!dead.exists() && !dead_old.exists());
-        assert!(live.is_dir() && unmarked.is_dir() && file.is_file());
+        assert!(live.is_dir() && unmarked.is_dir() && file.is_file() && not_a_pid.is_dir());
         assert!(process_alive(&std::process::id().to_string()));
         assert!(!process_alive("4000000"));
     }
