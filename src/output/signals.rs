@@ -27,7 +27,9 @@ const SETTLE: Duration = Duration::from_secs(3);
 /// What to undo for one registered path.
 #[derive(Debug, Clone)]
 pub enum Undo {
-    /// A staging directory, partial file or scratch directory: remove it whole.
+    /// A staging directory (a single file's partial file is written inside one) or scratch
+    /// directory: remove it whole. Anything else at its path (a file or a symbolic link that
+    /// took the name) was not made by rmapgen, and stays.
     Remove(PathBuf),
     /// A directory rmapgen created as the parent of its output: remove it if it is empty.
     RemoveIfEmpty(PathBuf),
@@ -57,8 +59,7 @@ impl Undo {
                 loop {
                     match std::fs::symlink_metadata(p) {
                         Ok(m) if m.is_dir() => std::fs::remove_dir_all(p).ok(),
-                        Ok(_) => std::fs::remove_file(p).ok(),
-                        Err(_) => break,
+                        _ => break,
                     };
                     if std::fs::symlink_metadata(p).is_err() || start.elapsed() > SETTLE {
                         break;
@@ -424,6 +425,31 @@ mod tests {
         // Removed, and no registration left behind to grow the registry or undo a path that
         // another run may hold by then.
         assert!(!p.exists() && !registered(&p), "{}", p.display());
+    }
+
+    #[test]
+    fn remove_takes_a_directory_whole_and_leaves_a_file_or_link_at_its_path() {
+        let t = tempfile::tempdir().unwrap();
+        let staging = t.path().join(".d.staging-1");
+        std::fs::create_dir_all(staging.join("sub")).unwrap();
+        std::fs::write(staging.join("sub/f"), b"x").unwrap();
+        let file = t.path().join(".f.staging-2");
+        std::fs::write(&file, b"mine").unwrap();
+        let kept = t.path().join("kept");
+        std::fs::create_dir(&kept).unwrap();
+        std::fs::write(kept.join("f"), b"mine").unwrap();
+        let link = t.path().join(".l.staging-3");
+        std::os::unix::fs::symlink(&kept, &link).unwrap();
+        let start = Instant::now();
+        for p in [&staging, &file, &link] {
+            Undo::Remove(p.clone()).run_now();
+        }
+        assert!(std::fs::symlink_metadata(&staging).is_err());
+        assert_eq!(std::fs::read(&file).unwrap(), b"mine");
+        assert!(std::fs::symlink_metadata(&link).unwrap().is_symlink());
+        assert_eq!(std::fs::read(kept.join("f")).unwrap(), b"mine");
+        // Left at once, not retried until the settling time is over.
+        assert!(start.elapsed() < SETTLE, "{:?}", start.elapsed());
     }
 
     #[test]
