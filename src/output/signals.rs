@@ -452,6 +452,27 @@ mod tests {
         assert!(start.elapsed() < SETTLE, "{:?}", start.elapsed());
     }
 
+    /// A directory that cannot be removed (here one of /proc, where nothing can be) is tried
+    /// again for [`SETTLE`] and then left: the cleanup of an interrupt ends.
+    #[test]
+    fn a_directory_that_cannot_be_removed_is_given_up_after_the_settling_time() {
+        let p = PathBuf::from("/proc/self/fdinfo");
+        let (tx, rx) = std::sync::mpsc::channel();
+        let start = Instant::now();
+        let q = p.clone();
+        std::thread::spawn(move || {
+            Undo::Remove(q).run_now();
+            tx.send(()).ok();
+        });
+        rx.recv_timeout(SETTLE * 3)
+            .expect("the removal gave up within the settling time");
+        assert!(
+            start.elapsed() >= SETTLE && p.is_dir(),
+            "{:?}",
+            start.elapsed()
+        );
+    }
+
     #[test]
     fn registrations_reach_the_guardian_as_they_were() {
         let odd = PathBuf::from("/tmp/a b\nc/\u{e9}");
