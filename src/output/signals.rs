@@ -452,6 +452,32 @@ mod tests {
         assert!(start.elapsed() < SETTLE, "{:?}", start.elapsed());
     }
 
+    /// A replacement changes what its own registration undoes, and no other: a commit that
+    /// moves an old output aside then removes it leaves an interrupt the old output to
+    /// remove, not the staging directory that has become the output.
+    #[test]
+    fn a_replacement_changes_its_own_registration_alone() {
+        let undoes = |t: &Token| {
+            let h = hold();
+            let e = h.0.live.iter().find(|(i, _)| *i == t.0);
+            e.map(|(_, u)| format!("{u:?}"))
+        };
+        let a = register(Undo::Remove(PathBuf::from("/nonexistent/rmapgen-a")));
+        let b = register(Undo::Remove(PathBuf::from("/nonexistent/rmapgen-b")));
+        let old = PathBuf::from("/nonexistent/rmapgen-b.old");
+        hold().replace(&b, Undo::Remove(old.clone()));
+        assert_eq!(undoes(&b), Some(format!("{:?}", Undo::Remove(old))));
+        assert_eq!(
+            undoes(&a),
+            Some(format!(
+                "{:?}",
+                Undo::Remove(PathBuf::from("/nonexistent/rmapgen-a"))
+            ))
+        );
+        a.release();
+        b.release();
+    }
+
     /// A directory that cannot be removed (here one of /proc, where nothing can be) is tried
     /// again for [`SETTLE`] and then left: the cleanup of an interrupt ends.
     #[test]
