@@ -409,3 +409,68 @@ fn other_commands_bad_input_leaves_no_directory() {
         refused_leaving_nothing(w, &args, needle);
     }
 }
+
+/// The guardian (`--rmapgen-guardian PID`, src/output/signals.rs) undoes what a run left
+/// registered when the run ended by a signal it could not catch. It is started by rmapgen
+/// alone: its parent's pid is the argument. It also takes over when that parent died before
+/// it looked (the pid is gone and the registrations wait on a pipe). Anything else is refused,
+/// and it undoes nothing: started by hand with a live pid, a pipe or not, or with a dead pid
+/// and no pipe.
+#[test]
+fn the_guardian_takes_over_from_a_dead_rmapgen_and_is_refused_by_hand() {
+    use std::io::Write;
+    let t = helpers::tempdir();
+    let hex = |p: &Path| -> String {
+        use std::os::unix::ffi::OsStrExt;
+        p.as_os_str()
+            .as_bytes()
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect()
+    };
+    // A pid that is surely gone: a child of this test, reaped.
+    let mut gone = std::process::Command::new("true").spawn().unwrap();
+    gone.wait().unwrap();
+    let dead = gone.id().to_string();
+    let guardian = |pid: &str, registrations: Option<&str>| {
+        let mut c = helpers::rmapgen();
+        c.arg("--rmapgen-guardian").arg(pid).stdout(Stdio::null());
+        c.stderr(Stdio::piped());
+        c.stdin(if registrations.is_some() {
+            Stdio::piped()
+        } else {
+            Stdio::null()
+        });
+        let mut child = c.spawn().unwrap();
+        if let Some(text) = registrations {
+            let mut pipe = child.stdin.take().unwrap();
+            // A refused guardian may have closed its end already.
+            pipe.write_all(text.as_bytes()).ok();
+        }
+        child.wait_with_output().unwrap()
+    };
+    let refused = "is started by rmapgen itself, not by hand";
+    let (undone, released) = (t.path().join("undone"), t.path().join("released"));
+    for d in [&undone, &released] {
+        std::fs::create_dir(d).unwrap();
+        std::fs::write(d.join("f"), "x").unwrap();
+    }
+    let lines = format!("+1 R {}\n+2 R {}\n-2\n", hex(&undone), hex(&released));
+    // By hand: a live process that is not its parent (pid 1), with a pipe and without; a
+    // dead pid without a pipe.
+    for (pid, regs) in [("1", Some(&*lines)), ("1", None), (&*dead, None)] {
+        let o = guardian(pid, regs);
+        assert_eq!(o.status.code(), Some(2), "{pid} {regs:?}");
+        assert!(String::from_utf8_lossy(&o.stderr).contains(refused));
+        assert!(
+            undone.is_dir() && released.is_dir(),
+            "{pid}: nothing undone"
+        );
+    }
+    // Its rmapgen died before it looked: it reads the registrations and undoes what is
+    // still registered when the pipe closes.
+    let o = guardian(&dead, Some(&lines));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(!undone.exists(), "a registered directory is removed");
+    assert!(released.join("f").is_file(), "a released one is kept");
+}
