@@ -105,7 +105,7 @@ pub fn summary(r: &Report) -> String {
         if r.overflow_checks {
             "on"
         } else {
-            "off (release build; the test profile runs with them on)"
+            "off (release build; a dev build, `cargo test`, runs with them on)"
         }
     );
     if let Some(st) = &r.search {
