@@ -479,7 +479,7 @@ mutants-default: build
 
 # ---- cargo-mutants over the Rust that issues verdicts (issue 31, part 2; figures in
 # docs/VERIFICATION.md): `make rust-mutants RUST_MUTANTS_GROUP=G` with G one of
-#   engines  the multiplier proof and its engines src/prove/mult/{mod,algebra,netlist}.rs
+#   engines  the multiplier proof, its engines and its run (src/prove/mult/)
 #   aig      the and-inverter graphs src/prove/aig.rs (the multiplier proof's and prove's gates)
 #   prove    src/prove but its engines (parts, shards, reports, --merge)
 #   output   src/output (what rmapgen writes and removes)
@@ -496,7 +496,7 @@ RUST_MUTANTS_SHARD ?= 0/1
 RUST_MUTANTS_ARGS  ?=
 # The multiplier proof's engines are used by `prove-mult` alone (the tests of mult_proof, 37 s
 # with the unit tests on 2 cores); aig.rs also by prove's gate-level front (129 s with prove's).
-RUST_MUTANTS_FILES_engines := -f src/prove/mult/mod.rs -f src/prove/mult/algebra.rs -f src/prove/mult/netlist.rs
+RUST_MUTANTS_FILES_engines := -f 'src/prove/mult/**'
 RUST_MUTANTS_TESTS_engines := mult_proof
 RUST_MUTANTS_FILES_aig     := -f src/prove/aig.rs
 RUST_MUTANTS_TESTS_aig     := mult_proof|prove
