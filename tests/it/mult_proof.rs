@@ -295,3 +295,81 @@ fn inferred_products_are_plain_and_proved_and_a_planted_fault_is_caught() {
     assert_eq!(failed.len(), 1, "{err}");
     assert!(failed[0].contains("prove-mult: color_mul.ng = "), "{err}");
 }
+
+/// `--tree` proves the trees it names and no other, and the exhaustive engine's count is every
+/// input of every tree proved. A `--tree` the design does not have is bad input beside one it
+/// has too (one line naming it, exit 2, nothing written), and so is a Yosys that is not there.
+#[test]
+fn the_trees_named_alone_are_proved_and_their_inputs_counted() {
+    if !require("yosys") {
+        return;
+    }
+    let tmp = tempdir();
+    let good = tmp.path().join("good");
+    generate(&good, FLAGS, 0);
+    let jobs = rmapgen::prove::mult::jobs(&crate::hdl::config_of(&good));
+    let inputs = |names: &[&str]| -> u128 {
+        jobs.iter()
+            .filter(|j| names.contains(&j.name().as_str()))
+            .map(|j| j.exhaustive_inputs())
+            .sum()
+    };
+    let run = |trees: &str, yosys: Option<&str>, logs: &str| {
+        let mut c = rmapgen();
+        c.arg("prove-mult")
+            .arg(&good)
+            .arg("--logs")
+            .arg(tmp.path().join(logs))
+            .args(["--engine", "exhaustive", "--tree", trees]);
+        if let Some(y) = yosys {
+            c.env("YOSYS", y);
+        }
+        let o = c.output().expect("rmapgen runs");
+        (
+            o.status.code(),
+            String::from_utf8_lossy(&o.stdout).into_owned(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    };
+    for names in [
+        &["normalise.pa"][..],
+        &["interpolate.r", "color_mul.ng"][..],
+    ] {
+        let (code, out, err) = run(&names.join(","), None, &names.join("+"));
+        assert_eq!(code, Some(0), "{names:?}: {out}{err}");
+        let proved: Vec<&str> = out
+            .lines()
+            .filter_map(|l| l.strip_prefix("prove-mult: "))
+            .filter_map(|l| l.split(" = ").next().filter(|_| l.contains(" = ")))
+            .collect();
+        assert_eq!(proved, names, "{out}");
+        let n = inputs(names);
+        assert!(n > 0);
+        assert!(
+            out.contains(&format!("all {} trees proved", names.len()))
+                && out.contains(&format!(
+                    " {} inputs evaluated",
+                    rmapgen::prove::mult::count(n)
+                )),
+            "{names:?}: {n} inputs: {out}"
+        );
+    }
+    for (trees, yosys, named) in [
+        (
+            "normalise.pa,normalise.pq",
+            None,
+            "--tree normalise.pq: no such tree",
+        ),
+        (
+            "normalise.pa",
+            Some("/nonexistent/yosys"),
+            "/nonexistent/yosys not found",
+        ),
+    ] {
+        let (code, out, err) = run(trees, yosys, "refused");
+        assert_eq!(code, Some(2), "{trees}: {out}{err}");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(err.contains(named), "{named}: {err}");
+        assert!(!tmp.path().join("refused").exists());
+    }
+}
