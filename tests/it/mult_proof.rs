@@ -119,6 +119,20 @@ fn proves_and_catches(tmp: &Path, good: &Path, engine: &str, how: &str) {
         assert!(line.contains(how), "{engine}: {line}");
     }
     assert!(out.contains("all 11 trees proved"), "{out}");
+    // The summary's SAT cases are the trees' own, summed (none under the other engines).
+    let cases: usize = out
+        .lines()
+        .filter_map(|l| {
+            l.strip_suffix(" SAT cases)")
+                .or_else(|| l.strip_suffix(" SAT case)"))
+        })
+        .map(|l| l.rsplit('(').next().unwrap().parse::<usize>().unwrap())
+        .sum();
+    assert_eq!(engine == "sat", cases > 0, "{engine}: {out}");
+    assert!(
+        out.contains(&format!("({cases} SAT cases, ")),
+        "{engine}: {cases} SAT cases: {out}"
+    );
 
     for (k, (what, file, old, new, tree)) in PLANTS.iter().enumerate() {
         let bad = tmp.join(format!("bad-{engine}-{k}"));
