@@ -62,16 +62,30 @@ const PLANTS: &[(&str, &str, &str, &str, &str)] = &[
 ];
 
 fn prove(dir: &Path, logs: &Path, engine: &str) -> (bool, String, String) {
-    let out = rmapgen()
-        .arg("prove-mult")
+    let (code, out, err) = prove_with(dir, logs, &["--engine", engine], None);
+    (code == Some(0), out, err)
+}
+
+/// `rmapgen prove-mult DIR --logs LOGS ARGS`, with `YOSYS` set to `yosys` if given: (exit
+/// code, stdout, stderr).
+fn prove_with(
+    dir: &Path,
+    logs: &Path,
+    args: &[&str],
+    yosys: Option<&str>,
+) -> (Option<i32>, String, String) {
+    let mut c = rmapgen();
+    c.arg("prove-mult")
         .arg(dir)
         .arg("--logs")
         .arg(logs)
-        .args(["--engine", engine])
-        .output()
-        .expect("rmapgen runs");
+        .args(args);
+    if let Some(y) = yosys {
+        c.env("YOSYS", y);
+    }
+    let out = c.output().expect("rmapgen runs");
     (
-        out.status.success(),
+        out.status.code(),
         String::from_utf8_lossy(&out.stdout).into_owned(),
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
@@ -329,21 +343,8 @@ fn the_trees_named_alone_are_proved_and_their_inputs_counted() {
             .sum()
     };
     let run = |trees: &str, yosys: Option<&str>, logs: &str| {
-        let mut c = rmapgen();
-        c.arg("prove-mult")
-            .arg(&good)
-            .arg("--logs")
-            .arg(tmp.path().join(logs))
-            .args(["--engine", "exhaustive", "--tree", trees]);
-        if let Some(y) = yosys {
-            c.env("YOSYS", y);
-        }
-        let o = c.output().expect("rmapgen runs");
-        (
-            o.status.code(),
-            String::from_utf8_lossy(&o.stdout).into_owned(),
-            String::from_utf8_lossy(&o.stderr).into_owned(),
-        )
+        let args = ["--engine", "exhaustive", "--tree", trees];
+        prove_with(&good, &tmp.path().join(logs), &args, yosys)
     };
     for names in [
         &["normalise.pa"][..],
@@ -353,8 +354,8 @@ fn the_trees_named_alone_are_proved_and_their_inputs_counted() {
         assert_eq!(code, Some(0), "{names:?}: {out}{err}");
         let proved: Vec<&str> = out
             .lines()
-            .filter_map(|l| l.strip_prefix("prove-mult: "))
-            .filter_map(|l| l.split(" = ").next().filter(|_| l.contains(" = ")))
+            .filter_map(|l| l.strip_prefix("prove-mult: ")?.split_once(" = "))
+            .map(|(tree, _)| tree)
             .collect();
         assert_eq!(proved, names, "{out}");
         let n = inputs(names);
