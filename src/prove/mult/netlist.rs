@@ -473,4 +473,225 @@ mod tests {
         let e = Netlist::parse(&bad, "t").err().unwrap().to_string();
         assert!(e.contains("g2") && e.contains("$dff"), "{e}");
     }
+
+    /// A netlist of one cell of type `ty` on the input ports a, b and s (nets 2, 3, 4),
+    /// driving the wire y (net 5).
+    fn one_cell(ty: &str) -> Netlist {
+        let pins = match ty {
+            "$_BUF_" | "$_NOT_" => r#""A": [2]"#,
+            "$_MUX_" | "$_NMUX_" => r#""A": [2], "B": [3], "S": [4]"#,
+            _ => r#""A": [2], "B": [3]"#,
+        };
+        let json = format!(
+            r#"{{"modules": {{"t": {{
+              "ports": {{"a": {{"direction": "input", "bits": [2]}},
+                        "b": {{"direction": "input", "bits": [3]}},
+                        "s": {{"direction": "input", "bits": [4]}}}},
+              "cells": {{"g": {{"type": "{ty}", "connections": {{{pins}, "Y": [5]}}}}}},
+              "netnames": {{"y": {{"bits": [5]}}}}}}}}}}"#
+        );
+        Netlist::parse(&json, "t").unwrap()
+    }
+
+    /// Every simple gate of Yosys's library computes the function Yosys's simcells.v gives
+    /// it, on all eight values of its inputs.
+    #[test]
+    fn every_simple_gate_computes_its_yosys_function() {
+        type F = fn(bool, bool, bool) -> bool;
+        let gates: [(&str, F); 12] = [
+            ("$_BUF_", |a, _, _| a),
+            ("$_NOT_", |a, _, _| !a),
+            ("$_AND_", |a, b, _| a & b),
+            ("$_NAND_", |a, b, _| !(a & b)),
+            ("$_OR_", |a, b, _| a | b),
+            ("$_NOR_", |a, b, _| !(a | b)),
+            ("$_XOR_", |a, b, _| a ^ b),
+            ("$_XNOR_", |a, b, _| !(a ^ b)),
+            ("$_ANDNOT_", |a, b, _| a & !b),
+            ("$_ORNOT_", |a, b, _| a | !b),
+            ("$_MUX_", |a, b, s| if s { b } else { a }),
+            ("$_NMUX_", |a, b, s| !(if s { b } else { a })),
+        ];
+        for (ty, f) in gates {
+            let c = one_cell(ty).simplify(&["y"], |_, _| None).unwrap();
+            assert_eq!(c.inputs.len(), 3, "{ty}");
+            for x in 0..8u32 {
+                let v: Vec<bool> = (0..3).map(|i| (x >> i) & 1 == 1).collect();
+                assert_eq!(c.eval(&v)[0], vec![f(v[0], v[1], v[2])], "{ty} on {v:?}");
+            }
+        }
+    }
+
+    /// The builders fold exactly the trivial cases (a constant operand, one variable twice)
+    /// and keep every node they make canonical: an AND's operands in order, an XOR's plain
+    /// (the complement on the result), a MUX's select plain, and none of them constant. On
+    /// every pair and triple of the literals of two inputs, the result evaluates to the
+    /// operation.
+    #[test]
+    fn the_builders_fold_the_trivial_cases_and_keep_nodes_canonical() {
+        let fresh = || Circuit {
+            inputs: vec![("a".into(), 0), ("b".into(), 0)],
+            nodes: Vec::new(),
+            outputs: Vec::new(),
+        };
+        let value = |c: &mut Circuit, l: Lit, v: &[bool]| {
+            c.outputs = vec![vec![l]];
+            c.eval(v)[0][0]
+        };
+        let lits: Vec<Lit> = (0..6).collect();
+        let same_var = |a: Lit, b: Lit| a / 2 == b / 2;
+        let assignments = [[false, false], [true, false], [false, true], [true, true]];
+        for &a in &lits {
+            for &b in &lits {
+                let trivial = a < 2 || b < 2 || same_var(a, b);
+                let mut c = fresh();
+                let l = c.and(a, b);
+                assert_eq!(c.nodes.len(), usize::from(!trivial), "and({a}, {b})");
+                if let Some(&Node::And(x, y)) = c.nodes.first() {
+                    assert!(1 < x && x < y, "and({a}, {b}) made And({x}, {y})");
+                }
+                for v in &assignments {
+                    let (va, vb) = (value(&mut c, a, v), value(&mut c, b, v));
+                    assert_eq!(value(&mut c, l, v), va & vb, "and({a}, {b}) on {v:?}");
+                }
+                let mut c = fresh();
+                let l = c.xor(a, b);
+                assert_eq!(c.nodes.len(), usize::from(!trivial), "xor({a}, {b})");
+                if let Some(&Node::Xor(x, y)) = c.nodes.first() {
+                    assert!(
+                        x % 2 == 0 && y % 2 == 0 && 0 < x && x < y,
+                        "xor made Xor({x}, {y})"
+                    );
+                }
+                for v in &assignments {
+                    let (va, vb) = (value(&mut c, a, v), value(&mut c, b, v));
+                    assert_eq!(value(&mut c, l, v), va ^ vb, "xor({a}, {b}) on {v:?}");
+                }
+                for &s in &lits {
+                    let mut c = fresh();
+                    let l = c.mux(s, a, b);
+                    if s < 2 || a == b {
+                        assert!(c.nodes.is_empty(), "mux({s}, {a}, {b}): {:?}", c.nodes);
+                    } else if a == 0 || b == 0 {
+                        assert!(
+                            c.nodes.iter().all(|n| matches!(n, Node::And(..))),
+                            "mux({s}, {a}, {b})"
+                        );
+                    } else {
+                        assert_eq!(c.nodes.len(), 1, "mux({s}, {a}, {b})");
+                        let Node::Mux(x, y, z) = c.nodes[0] else {
+                            panic!("mux({s}, {a}, {b}): {:?}", c.nodes)
+                        };
+                        assert!(x % 2 == 0 && x > 1 && y != z, "mux made Mux({x}, {y}, {z})");
+                    }
+                    for v in &assignments {
+                        let (vs, va, vb) = (
+                            value(&mut c, s, v),
+                            value(&mut c, a, v),
+                            value(&mut c, b, v),
+                        );
+                        let want = if vs { vb } else { va };
+                        assert_eq!(value(&mut c, l, v), want, "mux({s}, {a}, {b}) on {v:?}");
+                    }
+                }
+            }
+        }
+        // node() numbers the nodes after the constant and the inputs.
+        let mut c = fresh();
+        let l = c.and(2, 4);
+        assert_eq!(l, 6);
+        assert_eq!(c.node(0), None);
+        assert_eq!(c.node(2), None);
+        assert_eq!(c.node(3), Some(&Node::And(2, 4)));
+        assert_eq!(c.node(4), None);
+    }
+
+    /// Structural faults of a netlist are refused, each naming what is wrong.
+    #[test]
+    fn refuses_loops_second_drivers_driven_inputs_and_wide_pins() {
+        let refused = |from: &str, to: &str, want: &str| {
+            let bad = JSON.replace(from, to);
+            assert_ne!(bad, JSON, "{from}");
+            let e = Netlist::parse(&bad, "t")
+                .and_then(|n| n.simplify(&["y", "z"], |_, _| None).map(|_| ()))
+                .err()
+                .unwrap_or_else(|| panic!("{to}: accepted"))
+                .to_string();
+            assert!(e.contains(want), "{to}: {e}");
+        };
+        // g1 reads g2's output: y = ((y & !b) ^ c).
+        refused(
+            r#""A": [2], "B": [3], "Y": [6]"#,
+            r#""A": [7], "B": [3], "Y": [6]"#,
+            "combinational loop through net",
+        );
+        refused(
+            r#""A": [4], "B": [2], "S": [5], "Y": [8]"#,
+            r#""A": [4], "B": [2], "S": [5], "Y": [7]"#,
+            "net 7 has two drivers",
+        );
+        refused(
+            r#""A": [4], "B": [2], "S": [5], "Y": [8]"#,
+            r#""A": [4], "B": [2], "S": [5], "Y": [3]"#,
+            "input b is driven by a gate",
+        );
+        refused(
+            r#""A": [4], "B": [2], "S": [5], "Y": [8]"#,
+            r#""A": [4], "B": [2], "S": [5], "Y": ["0"]"#,
+            "cell g3 drives a constant",
+        );
+        refused(
+            r#""A": [4], "B": [2], "S": [5]"#,
+            r#""A": [4, 2], "B": [2], "S": [5]"#,
+            "g3.A: 2 bits, a simple gate has one",
+        );
+        refused(
+            r#""A": [4], "B": [2], "S": [5]"#,
+            r#""A": ["z"], "B": [2], "S": [5]"#,
+            "g3.A: the bit \"z\" is undefined",
+        );
+        refused(
+            r#""A": [4], "B": [2], "S": [5]"#,
+            r#""A": [-4], "B": [2], "S": [5]"#,
+            "g3.A: bad net -4",
+        );
+        refused(
+            r#""s": {"direction": "input", "bits": [5]}"#,
+            r#""s": {"direction": "input", "bits": ["x"]}"#,
+            "s: the bit",
+        );
+    }
+
+    /// A net held by several wires is named by the one a user would look for: a public name
+    /// (not Yosys's `$...`) before a generated one, then the first in order; the bit is its
+    /// place in that wire.
+    #[test]
+    fn an_undriven_net_is_named_by_its_plainest_wire() {
+        let open = JSON
+            .replace(r#""c": {"direction": "input", "bits": [4]}, "#, "")
+            .replace(
+                r#""y": {"bits": [7]}"#,
+                r#""y": {"bits": [7]}, "$auto$c": {"bits": [4]}, "u_dut.d": {"bits": [9, 4]}, "u_dut.e": {"bits": [4]}"#,
+            );
+        let n = Netlist::parse(&open, "t").unwrap();
+        let c = n.simplify(&["y"], |_, _| None).unwrap();
+        assert_eq!(c.inputs.last(), Some(&("u_dut.d".to_string(), 1)));
+        // Held by no wire at all: `net N`.
+        let nameless = JSON
+            .replace(r#""c": {"direction": "input", "bits": [4]}, "#, "")
+            .replace(r#""A": [6], "B": [4]"#, r#""A": [6], "B": [11]"#);
+        let c = Netlist::parse(&nameless, "t")
+            .unwrap()
+            .simplify(&["y"], |_, _| None)
+            .unwrap();
+        assert_eq!(c.inputs.last(), Some(&("net 11".to_string(), 0)));
+        assert_eq!(
+            n.input_ports(),
+            [
+                ("a".to_string(), 1),
+                ("b".to_string(), 1),
+                ("s".to_string(), 1)
+            ]
+        );
+    }
 }
