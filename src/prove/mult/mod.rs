@@ -677,6 +677,353 @@ pub fn results(jobs: &[Job], log: &str) -> Vec<TreeResult> {
 mod tests {
     use super::*;
     use crate::grid;
+    use crate::hdl::adder_tree::{Sig, Sum};
+    use crate::hdl::tree_spec::{Product, Split};
+
+    fn sig(name: &str, width: u32) -> Sig {
+        Sig::new(name, width)
+    }
+
+    /// A tree of every kind of term: `((a * w) << 1) + b * 3 + 2` into the 6-bit node
+    /// `t_l2_s0` that holds the sum shifted right once, `b <= 9`, split on `w` in 0..=5 with
+    /// `v = 5 - w`; `a` and `v` are input ports of the stage `m`, `w` and `b` are not.
+    fn example() -> Job {
+        Job {
+            module: "m".into(),
+            spec: TreeSpec {
+                tree: "t".into(),
+                title: "a w 2 + 3 b + 2".into(),
+                products: vec![
+                    Product {
+                        a: sig("a", 4),
+                        b: Factor::Sig(sig("w", 3)),
+                        shift: 1,
+                    },
+                    Product {
+                        a: sig("b", 4),
+                        b: Factor::Const(3),
+                        shift: 0,
+                    },
+                ],
+                constant: 2,
+                sum: Sum {
+                    sig: sig("t_l2_s0", 6),
+                    shift: 1,
+                },
+                at_most: vec![(sig("b", 4), 9)],
+                split: Some(Split {
+                    sig: sig("w", 3),
+                    last: 5,
+                    complement: Some((sig("v", 3), 5)),
+                }),
+            },
+            input_ports: vec!["clk_i".into(), "a".into(), "v".into()],
+        }
+    }
+
+    /// A job of one product `a * b` of `wa` and `wb` bits, unsplit: 2^(wa + wb) inputs.
+    fn unsplit(wa: u32, wb: u32) -> Job {
+        let mut j = example();
+        j.spec.products = vec![Product {
+            a: sig("a", wa),
+            b: Factor::Sig(sig("b", wb)),
+            shift: 0,
+        }];
+        j.spec.split = None;
+        j.spec.at_most.clear();
+        j
+    }
+
+    /// A job's names, inputs, cut and cases follow from its specification alone.
+    #[test]
+    fn a_job_is_named_counted_and_split_from_its_specification() {
+        let j = example();
+        assert_eq!(j.name(), "m.t");
+        assert_eq!(j.wrapper_name(), "mult_proof_m_t");
+        assert_eq!(
+            j.aig_files(),
+            ("mult_proof_m_t.aag".into(), "mult_proof_m_t.map".into())
+        );
+        assert_eq!(j.json_file(), "mult_proof_m_t.json");
+        assert_eq!(j.cut(), ["w", "b"]);
+        // a, w, b, v: 14 bits, of which the split fixes w and v.
+        assert_eq!(j.free_bits(), 8);
+        let cases = j.cases();
+        assert_eq!(cases.len(), 6);
+        for (k, c) in cases.iter().enumerate() {
+            assert_eq!(
+                *c,
+                [
+                    ("w".to_string(), k as u128),
+                    ("v".to_string(), 5 - k as u128)
+                ]
+            );
+        }
+        assert_eq!(j.exhaustive_inputs(), 6 << 8);
+        // Unsplit: one case, every bit free.
+        let u = unsplit(5, 4);
+        assert_eq!(u.cases(), vec![Vec::new()]);
+        assert_eq!((u.free_bits(), u.exhaustive_inputs()), (9, 512));
+        // Past 128 free bits the count saturates rather than wrapping.
+        assert_eq!(unsplit(100, 40).exhaustive_inputs(), u128::MAX);
+        assert_eq!(count(1 << 32), "2^32");
+        assert_eq!(count(1), "2^0");
+        assert_eq!(count(1536), "1536");
+        assert_eq!(count(u128::MAX), u128::MAX.to_string());
+    }
+
+    /// `auto` is exhaustive up to AUTO_EXHAUSTIVE_INPUTS inclusive, `exhaustive` up to
+    /// MAX_EXHAUSTIVE_INPUTS inclusive; `algebra` and `sat` are what they say whatever the
+    /// size.
+    #[test]
+    fn the_engine_bounds_are_inclusive() {
+        let at_auto = unsplit(17, 17);
+        assert_eq!(at_auto.exhaustive_inputs(), AUTO_EXHAUSTIVE_INPUTS);
+        assert_eq!(
+            at_auto.engine(EngineChoice::Auto).unwrap(),
+            Engine::Exhaustive
+        );
+        let above_auto = unsplit(17, 18);
+        assert_eq!(
+            above_auto.engine(EngineChoice::Auto).unwrap(),
+            Engine::Algebra
+        );
+        assert_eq!(
+            above_auto.engine(EngineChoice::Exhaustive).unwrap(),
+            Engine::Exhaustive
+        );
+        let at_max = unsplit(18, 18);
+        assert_eq!(at_max.exhaustive_inputs(), MAX_EXHAUSTIVE_INPUTS);
+        assert_eq!(
+            at_max.engine(EngineChoice::Exhaustive).unwrap(),
+            Engine::Exhaustive
+        );
+        let e = unsplit(18, 19)
+            .engine(EngineChoice::Exhaustive)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "--engine exhaustive: m.t has 2^37 inputs, more than 2^36 (use --engine auto or sat)"
+        );
+        let small = unsplit(2, 2);
+        assert_eq!(
+            small.engine(EngineChoice::Algebra).unwrap(),
+            Engine::Algebra
+        );
+        assert_eq!(small.engine(EngineChoice::Sat).unwrap(), Engine::Sat);
+        assert_eq!(
+            small.engine(EngineChoice::Auto).unwrap(),
+            Engine::Exhaustive
+        );
+    }
+
+    /// The miter of the example, whole: the cut inputs driven through `expose -cut`'s
+    /// escaped names, the ports as they are, the specification as Verilog arithmetic in the
+    /// bits of its largest value (2 * 15 * 7 + 3 * 9 + 2 = 239: 8 bits, above the sum's
+    /// 6), the sum widened and shifted back, and the premise.
+    #[test]
+    fn the_miter_states_the_specification_as_arithmetic() {
+        let want = "\
+// rmapgen prove-mult: m.t = a w 2 + 3 b + 2 (generated from the plan's specification)
+module mult_proof_m_t (
+  input wire clk_i,
+  input wire [3:0] a,
+  input wire [2:0] w,
+  input wire [3:0] b,
+  input wire [2:0] v,
+  output wire ok
+);
+  wire [5:0] sum;
+  m u_dut (
+    .clk_i (clk_i),
+    .a (a),
+    .\\w.i (w),
+    .\\b.i (b),
+    .v (v),
+    .t_l2_s0 (sum)
+  );
+  // The plain arithmetic, evaluated in 8 bits (no overflow: the largest value fits).
+  wire [7:0] spec;
+  assign spec = ((a * w) << 1) + (b * 8'd3) + 8'd2;
+  wire [7:0] got;
+  assign got = {{2{1'b0}}, sum} << 1;
+  assign ok = !((b <= 4'd9)) || (got == spec);
+endmodule
+";
+        assert_eq!(wrapper(&example()), want);
+        // No premise, no constant, a sum as wide as the arithmetic.
+        let mut u = unsplit(3, 2);
+        u.spec.constant = 0;
+        u.spec.sum.shift = 0;
+        u.spec.sum.sig.width = 5;
+        let w = wrapper(&u);
+        assert!(w.contains("  assign spec = (a * b);\n"), "{w}");
+        assert!(w.contains("  assign got = {{0{1'b0}}, sum} << 0;\n"), "{w}");
+        assert!(
+            w.contains("  assign ok = !(1'b1) || (got == spec);\n"),
+            "{w}"
+        );
+        // A premise's bound wider than its signal is compared in the bound's bits.
+        let mut p = example();
+        p.spec.at_most = vec![(sig("b", 4), 40)];
+        assert!(wrapper(&p).contains("!((b <= 6'd40))"));
+    }
+
+    /// The script of three jobs, one per engine: the design read once and saved, each job
+    /// from the saved design with its cut, its sum exposed and its miter; the exhaustive
+    /// job's AIGER, the algebraic job's gate netlist (the ripple carry map), the SAT job's
+    /// marker and one `sat` per case.
+    #[test]
+    fn the_script_proves_each_job_with_its_engine() {
+        let mut k = unsplit(3, 2);
+        k.module = "n".into();
+        k.spec.tree = "u".into();
+        let jobs = vec![example(), k, example()];
+        let s = script(
+            &["d1.v".into(), "d2.v".into()],
+            &jobs,
+            &[Engine::Exhaustive, Engine::Algebra, Engine::Sat],
+            &["w1.v".into(), "w2.v".into(), "w3.v".into()],
+            "tr.v",
+        );
+        let common = |cut: &str, m: &str, file: &str, top: &str| {
+            format!(
+                "design -load rmapgen_base\nexpose -cut {cut}\nexpose {m}/t_l2_s0\nread_verilog {file}\n\
+                 hierarchy -top {top}\nproc\nflatten\nopt_clean\nopt_dff\ntechmap -map tr.v\nopt -fast\n"
+            )
+        };
+        let want = format!(
+            "read_verilog d1.v d2.v\nproc\ndesign -save rmapgen_base\n\
+             {}techmap\nopt -fast\naigmap\nopt_clean\n\
+             write_aiger -ascii -map mult_proof_m_t.map mult_proof_m_t.aag\n\
+             {}techmap -map +/techmap.v -map ripple_lcu.v\nopt -fast\nopt_clean\n\
+             write_json mult_proof_n_u.json\n\
+             {}log rmapgen-mult: tree m t\n{}",
+            common("m/w m/b", "m", "w1.v", "mult_proof_m_t"),
+            common("n/b", "n", "w2.v", "mult_proof_n_u"),
+            common("m/w m/b", "m", "w3.v", "mult_proof_m_t"),
+            (0..=5)
+                .map(|w| format!(
+                    "sat -set w {w} -set v {} -prove ok 1 mult_proof_m_t\n",
+                    5 - w
+                ))
+                .collect::<String>()
+        );
+        assert_eq!(s, want);
+        // A job whose inputs are all ports is cut nowhere.
+        let mut all_ports = unsplit(3, 2);
+        all_ports.input_ports = vec!["a".into(), "b".into()];
+        let s = script(
+            &["d.v".into()],
+            &[all_ports],
+            &[Engine::Sat],
+            &["w.v".into()],
+            "t.v",
+        );
+        assert!(!s.contains("expose -cut"), "{s}");
+        assert!(s.contains("\nsat -prove ok 1 mult_proof_m_t\n"), "{s}");
+    }
+
+    /// The SAT results are read from the log by tree: each SUCCESS after a tree's marker is
+    /// one case proved, the first FAIL names its case by its place among the tree's cases; a
+    /// result before any marker or after an unknown tree's counts for no tree.
+    #[test]
+    fn the_sat_log_is_read_tree_by_tree() {
+        let mut k = unsplit(3, 2);
+        k.spec.tree = "u".into();
+        let jobs = vec![example(), k];
+        let ok = "SAT proof finished - no model found: SUCCESS!";
+        let fail = "SAT proof finished - model found: FAIL!";
+        let log = [
+            ok,
+            "  rmapgen-mult: tree m t",
+            ok,
+            ok,
+            fail,
+            ok,
+            fail,
+            "rmapgen-mult: tree m nosuch",
+            ok,
+            "rmapgen-mult: tree m u",
+            ok,
+        ]
+        .join("\n");
+        let r = results(&jobs, &log);
+        assert_eq!(r.len(), 2);
+        assert_eq!(
+            (r[0].name.as_str(), r[0].engine, r[0].cases),
+            ("m.t", Engine::Sat, 6)
+        );
+        assert_eq!(r[0].proved, 3);
+        assert_eq!(r[0].failed.as_deref(), Some("w = 2, v = 3"));
+        assert!(!r[0].passed());
+        assert_eq!((r[1].name.as_str(), r[1].cases, r[1].proved), ("m.u", 1, 1));
+        assert_eq!(r[1].failed, None);
+        assert!(r[1].passed());
+        // A tree never reached proved nothing, and did not pass.
+        let r = results(&jobs, "");
+        assert_eq!((r[1].proved, r[1].failed.as_deref()), (0, None));
+        assert!(!r[1].passed());
+        // Undecided is not passed, whatever the count.
+        let mut t = results(&jobs, &log).remove(1);
+        t.undecided = Some("why".into());
+        assert!(!t.passed());
+    }
+
+    /// The specification's polynomial, evaluated on every value of the example's free bits
+    /// in every case, is the specification's arithmetic (modulo 2^64), and its bound is the
+    /// largest value under the premises: 2 * 15 * w + 3 * 9 + 2 in case w.
+    #[test]
+    fn the_specification_polynomial_is_the_arithmetic() {
+        let j = example();
+        let t = &j.spec;
+        for case in j.cases() {
+            let w = case[0].1;
+            // b's bits from 4 up are fixed by the premise only in the engine; here b is
+            // free in all of its 4 bits, a in its 4; w and v fixed by the case.
+            let fixed = |p: &str, i: usize| -> Option<bool> {
+                case.iter()
+                    .find(|(s, _)| s == p)
+                    .map(|(_, v)| (v >> i) & 1 == 1)
+            };
+            let free: Vec<(String, u32)> = (0..4)
+                .map(|i| ("a".to_string(), i))
+                .chain((0..4).map(|i| ("b".to_string(), i)))
+                .collect();
+            let (terms, max) = spec_polynomial(t, &free, &fixed).unwrap();
+            assert_eq!(max, 2 * 15 * w + 3 * 9 + 2, "w = {w}");
+            for x in 0..256u64 {
+                let (a, b) = (x & 15, x >> 4);
+                let value = terms.iter().fold(0u64, |acc, (vars, k)| {
+                    let on = vars.iter().all(|&v| (x >> (v - 1)) & 1 == 1);
+                    acc.wrapping_add(if on { *k } else { 0 })
+                });
+                assert_eq!(
+                    value,
+                    2 * a * w as u64 + 3 * b + 2,
+                    "w = {w}, a = {a}, b = {b}"
+                );
+            }
+        }
+        // A bit neither fixed nor free is an error naming it.
+        let e = spec_polynomial(t, &[], &|_: &str, _| None)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "input bit a[0] is neither free nor fixed in the netlist");
+        // Past 2^64 the coefficients wrap: (3 a) << 63 is a[0] 2^63 (3 * 2^63 modulo 2^64), and
+        // a[1]'s 3 * 2^64 vanishes.
+        let mut wide = unsplit(2, 1);
+        wide.spec.products = vec![Product {
+            a: sig("a", 2),
+            b: Factor::Const(3),
+            shift: 63,
+        }];
+        let free = [("a".to_string(), 0), ("a".to_string(), 1)];
+        let (terms, _) = spec_polynomial(&wide.spec, &free, &|_: &str, _| None).unwrap();
+        assert_eq!(terms[0], (vec![1], 1u64 << 63));
+        assert_eq!(terms[1], (vec![2], 0));
+    }
 
     /// `auto` takes every tree of every row of the grid, exhaustive where it is cheap: the
     /// widest normalise tree (2^32 inputs) is exhaustive, the widest interpolate sum algebra;
