@@ -659,12 +659,7 @@ pub fn results(jobs: &[Job], log: &str) -> Vec<TreeResult> {
             if let Some(i) = cur {
                 if out[i].failed.is_none() {
                     let case = jobs[i].cases().into_iter().nth(seen).unwrap_or_default();
-                    out[i].failed = Some(
-                        case.iter()
-                            .map(|(x, v)| format!("{x} = {v}"))
-                            .collect::<Vec<_>>()
-                            .join(", "),
-                    );
+                    out[i].failed = Some(assignment_text(&case));
                 }
                 seen += 1;
             }
@@ -770,6 +765,9 @@ mod tests {
         assert_eq!(count(1), "2^0");
         assert_eq!(count(1536), "1536");
         assert_eq!(count(u128::MAX), u128::MAX.to_string());
+        // A failing input as the messages give it.
+        assert_eq!(assignment_text(&cases[2]), "w = 2, v = 3");
+        assert_eq!(assignment_text(&[]), "");
     }
 
     /// `auto` is exhaustive up to AUTO_EXHAUSTIVE_INPUTS inclusive, `exhaustive` up to
@@ -1025,6 +1023,154 @@ endmodule
         assert_eq!(terms[1], (vec![2], 0));
     }
 
+    /// The gates of `got = a * w`, a 3-bit `a` by a 2-bit `w` (shift-and-add: six partial
+    /// products, then a row of half and full adders), as Yosys writes a miter's netlist
+    /// (`write_json`): module `mult_proof_m_t`, input ports `a` (nets 2 to 4) and `w` (5 and
+    /// 6), the wire `got` widened by a constant 0. The tests below edit it to plant faults.
+    fn product_netlist() -> serde_json::Value {
+        use serde_json::json;
+        let mut cells = serde_json::Map::new();
+        let mut next = 10u64;
+        let mut gate = |name: &str, ty: &str, a: u64, b: u64| -> u64 {
+            next += 1;
+            let conn = json!({"A": [a], "B": [b], "Y": [next]});
+            cells.insert(name.into(), json!({"type": ty, "connections": conn}));
+            next
+        };
+        let (a, w) = ([2u64, 3, 4], [5u64, 6]);
+        let p0: Vec<u64> = (0..3)
+            .map(|i| gate(&format!("p0_{i}"), "$_AND_", a[i], w[0]))
+            .collect();
+        let p1: Vec<u64> = (0..3)
+            .map(|i| gate(&format!("p1_{i}"), "$_AND_", a[i], w[1]))
+            .collect();
+        let s1 = gate("s1", "$_XOR_", p0[1], p1[0]);
+        let c1 = gate("c1", "$_AND_", p0[1], p1[0]);
+        let t2 = gate("t2", "$_XOR_", p0[2], p1[1]);
+        let s2 = gate("s2", "$_XOR_", t2, c1);
+        let g2 = gate("g2", "$_AND_", p0[2], p1[1]);
+        let u2 = gate("u2", "$_AND_", t2, c1);
+        let c2 = gate("c2", "$_OR_", g2, u2);
+        let s3 = gate("s3", "$_XOR_", p1[2], c2);
+        let c3 = gate("c3", "$_AND_", p1[2], c2);
+        json!({"modules": {"mult_proof_m_t": {
+            "ports": {"a": {"direction": "input", "bits": a},
+                      "w": {"direction": "input", "bits": w}},
+            "cells": cells,
+            "netnames": {"got": {"bits": [p0[0], s1, s2, s3, c3, "0"]}}
+        }}})
+    }
+
+    /// The job of [`product_netlist`]: `a * w`, split on `w`, `a <= bound` when given.
+    fn product_job(bound: Option<u128>) -> Job {
+        let mut j = example();
+        j.spec.products = vec![Product {
+            a: sig("a", 3),
+            b: Factor::Sig(sig("w", 2)),
+            shift: 0,
+        }];
+        j.spec.constant = 0;
+        j.spec.at_most = bound.map(|b| (sig("a", 3), b)).into_iter().collect();
+        j.spec.split = Some(Split {
+            sig: sig("w", 2),
+            last: 3,
+            complement: None,
+        });
+        j
+    }
+
+    /// The algebraic engine on a netlist: the product proved in each of its four cases; a
+    /// planted fault failed with the input that shows it (the case's values, the free bits,
+    /// an open net by its wire); a premise fixes the input bits above its bound's length,
+    /// and a difference only where a premise does not hold is undecided, not failed; a sum
+    /// bit above the specification's width is compared too; words past 64 bits and a case
+    /// signal the netlist lacks are refused.
+    #[test]
+    fn the_algebraic_engine_proves_fails_and_respects_premises() {
+        let run = |job: &Job, edit: &dyn Fn(&mut serde_json::Value)| {
+            let mut v = product_netlist();
+            edit(&mut v["modules"]["mult_proof_m_t"]);
+            algebraic(job, &v.to_string()).unwrap()
+        };
+        let cell = |name: &'static str, ty: &'static str, a: Option<u64>| {
+            move |m: &mut serde_json::Value| {
+                m["cells"][name]["type"] = ty.into();
+                if let Some(a) = a {
+                    m["cells"][name]["connections"]["B"] = serde_json::json!([a]);
+                }
+            }
+        };
+        let r = run(&product_job(None), &|_| {});
+        assert_eq!((r.name.as_str(), r.engine), ("m.t", Engine::Algebra));
+        assert_eq!((r.cases, r.proved), (4, 4));
+        assert!(r.passed() && r.peak_terms > 0, "{r:?}");
+        // a1 & w1 made an XOR: with w = 0 it is a1.
+        let r = run(&product_job(None), &cell("p1_1", "$_XOR_", None));
+        assert_eq!(r.failed.as_deref(), Some("a = 2, w = 0"), "{r:?}");
+        assert_eq!((r.proved, r.undecided.as_deref()), (0, None));
+        // The half adder of bit 1 reads an open net (a stage input the miter leaves open).
+        let r = run(&product_job(None), &|m| {
+            m["cells"]["s1"]["connections"]["B"] = serde_json::json!([77]);
+            m["netnames"]["u_dut.open"] = serde_json::json!({"bits": [77]});
+        });
+        assert_eq!(
+            r.failed.as_deref(),
+            Some("a = 0, w = 0, u_dut.open = 1"),
+            "{r:?}"
+        );
+        // a2 & w0 made a2 alone: wrong wherever a >= 4 and w is even.
+        let buf = cell("p0_2", "$_BUF_", None);
+        let r = run(&product_job(None), &buf);
+        assert_eq!(r.failed.as_deref(), Some("a = 4, w = 0"), "{r:?}");
+        let r = run(&product_job(Some(4)), &buf);
+        assert_eq!(r.failed.as_deref(), Some("a = 4, w = 0"), "{r:?}");
+        // Under a <= 3, a2 is fixed at 0 and the tree is right.
+        let r = run(&product_job(Some(3)), &buf);
+        assert!(r.passed(), "{r:?}");
+        // a1 & w0 made a1 & a2: wrong only at a = 6 or 7, beyond a <= 5.
+        let and_a2 = cell("p0_1", "$_AND_", Some(4));
+        let r = run(&product_job(Some(6)), &and_a2);
+        assert_eq!(r.failed.as_deref(), Some("a = 6, w = 0"), "{r:?}");
+        let r = run(&product_job(Some(5)), &and_a2);
+        assert_eq!(r.failed, None);
+        assert_eq!(
+            r.undecided.as_deref(),
+            Some("the sum and the specification differ at a = 6, w = 0, where the premise a <= 5 does not hold (the polynomial identity is needed on every input below the bound's bit length)")
+        );
+        assert!(!r.passed());
+        // got's top bit, a constant 0 of the miter, driven by a0 & w0: 32 too many at a = 1,
+        // w = 1, above the 3 bits of the case's largest value (7).
+        let r = run(&product_job(None), &|m| {
+            let p = m["cells"]["p0_0"]["connections"]["Y"][0].clone();
+            m["netnames"]["got"]["bits"][5] = p;
+        });
+        assert_eq!(
+            (r.proved, r.failed.as_deref()),
+            (1, Some("a = 1, w = 1")),
+            "{r:?}"
+        );
+        // A specification past 64 bits: 0 in case w = 0 (proved), 7 << 62 in case w = 1.
+        let mut wide = product_job(None);
+        wide.spec.products[0].shift = 62;
+        let r = run(&wide, &|_| {});
+        assert_eq!(
+            (r.proved, r.undecided.as_deref()),
+            (1, Some("its words have 65 bits, over the engine's 64"))
+        );
+        // Exactly 64 bits (7 << 61) are compared, and differ: a against a << 61.
+        wide.spec.products[0].shift = 61;
+        let r = run(&wide, &|_| {});
+        assert_eq!(
+            (r.undecided, r.failed.as_deref()),
+            (None, Some("a = 1, w = 1"))
+        );
+        // A case on a signal the netlist does not have.
+        let mut other = product_job(None);
+        other.spec.split.as_mut().unwrap().sig = sig("v", 2);
+        let e = algebraic(&other, &product_netlist().to_string()).unwrap_err();
+        assert!(e.to_string().contains("v"), "{e}");
+    }
+
     /// `auto` takes every tree of every row of the grid, exhaustive where it is cheap: the
     /// widest normalise tree (2^32 inputs) is exhaustive, the widest interpolate sum algebra;
     /// `--engine exhaustive` refuses that one, naming it.
@@ -1079,6 +1225,23 @@ endmodule
                 let own = w.matches(&j.spec.sum.sig.name).count();
                 assert_eq!(nodes, own, "{}: {w}", j.name());
                 assert!(!j.cases().is_empty());
+            }
+        }
+    }
+
+    /// A job's ports are its stage's input ports (lowRISC: `_i`, `_ni`), the clock the miter drives
+    /// among them, and no output port.
+    #[test]
+    fn a_jobs_ports_are_its_stages_inputs() {
+        for r in grid::rows() {
+            for j in jobs(&r.config) {
+                let p = &j.input_ports;
+                assert!(p.iter().any(|x| x == "clk_i"), "{}: {p:?}", j.name());
+                assert!(
+                    p.iter().all(|x| x.ends_with("_i") || x.ends_with("_ni")),
+                    "{}: {p:?}",
+                    j.name()
+                );
             }
         }
     }
