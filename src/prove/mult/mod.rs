@@ -642,6 +642,8 @@ pub fn results(jobs: &[Job], log: &str) -> Vec<TreeResult> {
             peak_terms: 0,
         })
         .collect();
+    // The tree whose cases the log is in, and its cases finished so far: a FAIL is the case
+    // after those.
     let mut cur: Option<usize> = None;
     let mut seen = 0usize;
     for line in log.lines() {
@@ -661,7 +663,7 @@ pub fn results(jobs: &[Job], log: &str) -> Vec<TreeResult> {
                     let case = jobs[i].cases().into_iter().nth(seen).unwrap_or_default();
                     out[i].failed = Some(assignment_text(&case));
                 }
-                seen += 1;
+                // The tree has failed: what follows in it is not read, so no count.
             }
         }
     }
@@ -1018,7 +1020,12 @@ endmodule
             shift: 63,
         }];
         let free = [("a".to_string(), 0), ("a".to_string(), 1)];
-        let (terms, _) = spec_polynomial(&wide.spec, &free, &|_: &str, _| None).unwrap();
+        let (terms, max) = spec_polynomial(&wide.spec, &free, &|_: &str, _| None).unwrap();
+        assert_eq!(
+            max,
+            (9 << 63) + 2,
+            "the bound (constant 2 included) is exact, in 128 bits"
+        );
         assert_eq!(terms[0], (vec![1], 1u64 << 63));
         assert_eq!(terms[1], (vec![2], 0));
     }
@@ -1108,14 +1115,15 @@ endmodule
         let r = run(&product_job(None), &cell("p1_1", "$_XOR_", None));
         assert_eq!(r.failed.as_deref(), Some("a = 2, w = 0"), "{r:?}");
         assert_eq!((r.proved, r.undecided.as_deref()), (0, None));
-        // The half adder of bit 1 reads an open net (a stage input the miter leaves open).
+        // The half adder of bit 1 reads an open net (a stage input the miter leaves open),
+        // bit 1 of the wire that names it.
         let r = run(&product_job(None), &|m| {
             m["cells"]["s1"]["connections"]["B"] = serde_json::json!([77]);
-            m["netnames"]["u_dut.open"] = serde_json::json!({"bits": [77]});
+            m["netnames"]["u_dut.open"] = serde_json::json!({"bits": [76, 77]});
         });
         assert_eq!(
             r.failed.as_deref(),
-            Some("a = 0, w = 0, u_dut.open = 1"),
+            Some("a = 0, w = 0, u_dut.open = 2"),
             "{r:?}"
         );
         // a2 & w0 made a2 alone: wrong wherever a >= 4 and w is even.
