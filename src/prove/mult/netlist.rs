@@ -474,27 +474,53 @@ mod tests {
         assert!(e.contains("g2") && e.contains("$dff"), "{e}");
     }
 
-    /// A netlist of one cell of type `ty` on the input ports a, b and s (nets 2, 3, 4),
-    /// driving the wire y (net 5).
-    fn one_cell(ty: &str) -> Netlist {
+    /// How [`one_cell`]'s cell reads the ports a, b and s (nets 2, 3, 4).
+    #[derive(Clone, Copy, Debug)]
+    enum Wiring {
+        /// A, B and S are the ports.
+        Plain,
+        /// Each through a NOT cell (nets 6, 7, 8): the cell's operands are complemented
+        /// literals.
+        Inverted,
+        /// A through a NOT (net 6), B and S the ports: one operand complemented.
+        OneInverted,
+        /// A and B both !a, S the port s.
+        SameInverted,
+    }
+
+    /// A netlist of one cell of type `ty` reading the input ports a, b and s as `wiring`
+    /// says, driving the wire y (net 5).
+    fn one_cell(ty: &str, wiring: Wiring) -> Netlist {
+        let (a, b, s) = match wiring {
+            Wiring::Plain => (2, 3, 4),
+            Wiring::Inverted => (6, 7, 8),
+            Wiring::OneInverted => (6, 3, 4),
+            Wiring::SameInverted => (6, 6, 4),
+        };
         let pins = match ty {
-            "$_BUF_" | "$_NOT_" => r#""A": [2]"#,
-            "$_MUX_" | "$_NMUX_" => r#""A": [2], "B": [3], "S": [4]"#,
-            _ => r#""A": [2], "B": [3]"#,
+            "$_BUF_" | "$_NOT_" => format!(r#""A": [{a}]"#),
+            "$_MUX_" | "$_NMUX_" => format!(r#""A": [{a}], "B": [{b}], "S": [{s}]"#),
+            _ => format!(r#""A": [{a}], "B": [{b}]"#),
         };
         let json = format!(
             r#"{{"modules": {{"t": {{
               "ports": {{"a": {{"direction": "input", "bits": [2]}},
                         "b": {{"direction": "input", "bits": [3]}},
                         "s": {{"direction": "input", "bits": [4]}}}},
-              "cells": {{"g": {{"type": "{ty}", "connections": {{{pins}, "Y": [5]}}}}}},
+              "cells": {{"g": {{"type": "{ty}", "connections": {{{pins}, "Y": [5]}}}},
+                        "na": {{"type": "$_NOT_", "connections": {{"A": [2], "Y": [6]}}}},
+                        "nb": {{"type": "$_NOT_", "connections": {{"A": [3], "Y": [7]}}}},
+                        "ns": {{"type": "$_NOT_", "connections": {{"A": [4], "Y": [8]}}}}}},
               "netnames": {{"y": {{"bits": [5]}}}}}}}}}}"#
         );
         Netlist::parse(&json, "t").unwrap()
     }
 
     /// Every simple gate of Yosys's library computes the function Yosys's simcells.v gives
-    /// it, on all eight values of its inputs.
+    /// it, on all eight values of its inputs: read from the ports, from complemented
+    /// literals (each operand through a NOT, or only the first), and with both data operands one complemented
+    /// net (where the builders fold and the gate's own complement applies to a literal that
+    /// is already complemented).
     #[test]
     fn every_simple_gate_computes_its_yosys_function() {
         type F = fn(bool, bool, bool) -> bool;
@@ -512,12 +538,27 @@ mod tests {
             ("$_MUX_", |a, b, s| if s { b } else { a }),
             ("$_NMUX_", |a, b, s| !(if s { b } else { a })),
         ];
-        for (ty, f) in gates {
-            let c = one_cell(ty).simplify(&["y"], |_, _| None).unwrap();
-            assert_eq!(c.inputs.len(), 3, "{ty}");
-            for x in 0..8u32 {
-                let v: Vec<bool> = (0..3).map(|i| (x >> i) & 1 == 1).collect();
-                assert_eq!(c.eval(&v)[0], vec![f(v[0], v[1], v[2])], "{ty} on {v:?}");
+        let wirings = [
+            Wiring::Plain,
+            Wiring::Inverted,
+            Wiring::OneInverted,
+            Wiring::SameInverted,
+        ];
+        for wiring in wirings {
+            for (ty, f) in gates {
+                let c = one_cell(ty, wiring).simplify(&["y"], |_, _| None).unwrap();
+                assert_eq!(c.inputs.len(), 3, "{ty}");
+                for x in 0..8u32 {
+                    let v: Vec<bool> = (0..3).map(|i| (x >> i) & 1 == 1).collect();
+                    let (a, b, s) = (v[0], v[1], v[2]);
+                    let want = match wiring {
+                        Wiring::Plain => f(a, b, s),
+                        Wiring::Inverted => f(!a, !b, !s),
+                        Wiring::OneInverted => f(!a, b, s),
+                        Wiring::SameInverted => f(!a, !a, s),
+                    };
+                    assert_eq!(c.eval(&v)[0], vec![want], "{ty} {wiring:?} on {v:?}");
+                }
             }
         }
     }
