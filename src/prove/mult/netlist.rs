@@ -444,16 +444,21 @@ mod tests {
         assert_eq!(c.outputs, vec![vec![4], vec![4]]);
     }
 
+    /// [`JSON`] without the input port c: its net 4 is driven by nothing. `wires` are more
+    /// net names (`, "w": {"bits": [4]}`).
+    fn without_port_c(wires: &str) -> String {
+        JSON.replace(r#""c": {"direction": "input", "bits": [4]}, "#, "")
+            .replace(
+                r#""y": {"bits": [7]}"#,
+                &format!(r#""y": {{"bits": [7]}}{wires}"#),
+            )
+    }
+
     /// A net nothing drives (a stage input the miter leaves open) is a free input, named by
     /// a wire that holds it.
     #[test]
     fn an_undriven_net_is_a_free_input() {
-        let open = JSON
-            .replace(r#""c": {"direction": "input", "bits": [4]}, "#, "")
-            .replace(
-                r#""y": {"bits": [7]}"#,
-                r#""y": {"bits": [7]}, "u_dut.c": {"bits": [4]}"#,
-            );
+        let open = without_port_c(r#", "u_dut.c": {"bits": [4]}"#);
         let n = Netlist::parse(&open, "t").unwrap();
         let c = n.simplify(&["y"], |_, _| None).unwrap();
         let names: Vec<&str> = c.inputs.iter().map(|(n, _)| n.as_str()).collect();
@@ -660,47 +665,53 @@ mod tests {
                 .to_string();
             assert!(e.contains(want), "{to}: {e}");
         };
-        // g1 reads g2's output: y = ((y & !b) ^ c).
-        refused(
-            r#""A": [2], "B": [3], "Y": [6]"#,
-            r#""A": [7], "B": [3], "Y": [6]"#,
-            "combinational loop through net",
-        );
-        refused(
-            r#""A": [4], "B": [2], "S": [5], "Y": [8]"#,
-            r#""A": [4], "B": [2], "S": [5], "Y": [7]"#,
-            "net 7 has two drivers",
-        );
-        refused(
-            r#""A": [4], "B": [2], "S": [5], "Y": [8]"#,
-            r#""A": [4], "B": [2], "S": [5], "Y": [3]"#,
-            "input b is driven by a gate",
-        );
-        refused(
-            r#""A": [4], "B": [2], "S": [5], "Y": [8]"#,
-            r#""A": [4], "B": [2], "S": [5], "Y": ["0"]"#,
-            "cell g3 drives a constant",
-        );
-        refused(
-            r#""A": [4], "B": [2], "S": [5]"#,
-            r#""A": [4, 2], "B": [2], "S": [5]"#,
-            "g3.A: 2 bits, a simple gate has one",
-        );
-        refused(
-            r#""A": [4], "B": [2], "S": [5]"#,
-            r#""A": ["z"], "B": [2], "S": [5]"#,
-            "g3.A: the bit \"z\" is undefined",
-        );
-        refused(
-            r#""A": [4], "B": [2], "S": [5]"#,
-            r#""A": [-4], "B": [2], "S": [5]"#,
-            "g3.A: bad net -4",
-        );
-        refused(
-            r#""s": {"direction": "input", "bits": [5]}"#,
-            r#""s": {"direction": "input", "bits": ["x"]}"#,
-            "s: the bit",
-        );
+        // (what the good netlist says, what the bad one says instead, what the error names)
+        let cases = [
+            // g1 reads g2's output: y = ((y & !b) ^ c).
+            (
+                r#""A": [2], "B": [3], "Y": [6]"#,
+                r#""A": [7], "B": [3], "Y": [6]"#,
+                "combinational loop through net",
+            ),
+            (
+                r#""A": [4], "B": [2], "S": [5], "Y": [8]"#,
+                r#""A": [4], "B": [2], "S": [5], "Y": [7]"#,
+                "net 7 has two drivers",
+            ),
+            (
+                r#""A": [4], "B": [2], "S": [5], "Y": [8]"#,
+                r#""A": [4], "B": [2], "S": [5], "Y": [3]"#,
+                "input b is driven by a gate",
+            ),
+            (
+                r#""A": [4], "B": [2], "S": [5], "Y": [8]"#,
+                r#""A": [4], "B": [2], "S": [5], "Y": ["0"]"#,
+                "cell g3 drives a constant",
+            ),
+            (
+                r#""A": [4], "B": [2], "S": [5]"#,
+                r#""A": [4, 2], "B": [2], "S": [5]"#,
+                "g3.A: 2 bits, a simple gate has one",
+            ),
+            (
+                r#""A": [4], "B": [2], "S": [5]"#,
+                r#""A": ["z"], "B": [2], "S": [5]"#,
+                "g3.A: the bit \"z\" is undefined",
+            ),
+            (
+                r#""A": [4], "B": [2], "S": [5]"#,
+                r#""A": [-4], "B": [2], "S": [5]"#,
+                "g3.A: bad net -4",
+            ),
+            (
+                r#""s": {"direction": "input", "bits": [5]}"#,
+                r#""s": {"direction": "input", "bits": ["x"]}"#,
+                "s: the bit",
+            ),
+        ];
+        for (from, to, want) in cases {
+            refused(from, to, want);
+        }
     }
 
     /// A net held by several wires is named by the one a user would look for: a public name
@@ -708,19 +719,15 @@ mod tests {
     /// place in that wire.
     #[test]
     fn an_undriven_net_is_named_by_its_plainest_wire() {
-        let open = JSON
-            .replace(r#""c": {"direction": "input", "bits": [4]}, "#, "")
-            .replace(
-                r#""y": {"bits": [7]}"#,
-                r#""y": {"bits": [7]}, "$auto$c": {"bits": [4]}, "u_dut.d": {"bits": [9, 4]}, "u_dut.e": {"bits": [4]}"#,
-            );
+        let open = without_port_c(
+            r#", "$auto$c": {"bits": [4]}, "u_dut.d": {"bits": [9, 4]}, "u_dut.e": {"bits": [4]}"#,
+        );
         let n = Netlist::parse(&open, "t").unwrap();
         let c = n.simplify(&["y"], |_, _| None).unwrap();
         assert_eq!(c.inputs.last(), Some(&("u_dut.d".to_string(), 1)));
         // Held by no wire at all: `net N`.
-        let nameless = JSON
-            .replace(r#""c": {"direction": "input", "bits": [4]}, "#, "")
-            .replace(r#""A": [6], "B": [4]"#, r#""A": [6], "B": [11]"#);
+        let nameless =
+            without_port_c("").replace(r#""A": [6], "B": [4]"#, r#""A": [6], "B": [11]"#);
         let c = Netlist::parse(&nameless, "t")
             .unwrap()
             .simplify(&["y"], |_, _| None)
