@@ -677,10 +677,6 @@ mod tests {
     use crate::hdl::adder_tree::{Sig, Sum};
     use crate::hdl::tree_spec::{Product, Split};
 
-    fn sig(name: &str, width: u32) -> Sig {
-        Sig::new(name, width)
-    }
-
     /// A tree of every kind of term: `((a * w) << 1) + b * 3 + 2` into the 6-bit node
     /// `t_l2_s0` that holds the sum shifted right once, `b <= 9`, split on `w` in 0..=5 with
     /// `v = 5 - w`; `a` and `v` are input ports of the stage `m`, `w` and `b` are not.
@@ -692,26 +688,26 @@ mod tests {
                 title: "a w 2 + 3 b + 2".into(),
                 products: vec![
                     Product {
-                        a: sig("a", 4),
-                        b: Factor::Sig(sig("w", 3)),
+                        a: Sig::new("a", 4),
+                        b: Factor::Sig(Sig::new("w", 3)),
                         shift: 1,
                     },
                     Product {
-                        a: sig("b", 4),
+                        a: Sig::new("b", 4),
                         b: Factor::Const(3),
                         shift: 0,
                     },
                 ],
                 constant: 2,
                 sum: Sum {
-                    sig: sig("t_l2_s0", 6),
+                    sig: Sig::new("t_l2_s0", 6),
                     shift: 1,
                 },
-                at_most: vec![(sig("b", 4), 9)],
+                at_most: vec![(Sig::new("b", 4), 9)],
                 split: Some(Split {
-                    sig: sig("w", 3),
+                    sig: Sig::new("w", 3),
                     last: 5,
-                    complement: Some((sig("v", 3), 5)),
+                    complement: Some((Sig::new("v", 3), 5)),
                 }),
             },
             input_ports: vec!["clk_i".into(), "a".into(), "v".into()],
@@ -722,8 +718,8 @@ mod tests {
     fn unsplit(wa: u32, wb: u32) -> Job {
         let mut j = example();
         j.spec.products = vec![Product {
-            a: sig("a", wa),
-            b: Factor::Sig(sig("b", wb)),
+            a: Sig::new("a", wa),
+            b: Factor::Sig(Sig::new("b", wb)),
             shift: 0,
         }];
         j.spec.split = None;
@@ -866,7 +862,7 @@ endmodule
         );
         // A premise's bound wider than its signal is compared in the bound's bits.
         let mut p = example();
-        p.spec.at_most = vec![(sig("b", 4), 40)];
+        p.spec.at_most = vec![(Sig::new("b", 4), 40)];
         assert!(wrapper(&p).contains("!((b <= 6'd40))"));
     }
 
@@ -1015,7 +1011,7 @@ endmodule
         // a[1]'s 3 * 2^64 vanishes.
         let mut wide = unsplit(2, 1);
         wide.spec.products = vec![Product {
-            a: sig("a", 2),
+            a: Sig::new("a", 2),
             b: Factor::Const(3),
             shift: 63,
         }];
@@ -1072,14 +1068,14 @@ endmodule
     fn product_job(bound: Option<u128>) -> Job {
         let mut j = example();
         j.spec.products = vec![Product {
-            a: sig("a", 3),
-            b: Factor::Sig(sig("w", 2)),
+            a: Sig::new("a", 3),
+            b: Factor::Sig(Sig::new("w", 2)),
             shift: 0,
         }];
         j.spec.constant = 0;
-        j.spec.at_most = bound.map(|b| (sig("a", 3), b)).into_iter().collect();
+        j.spec.at_most = bound.map(|b| (Sig::new("a", 3), b)).into_iter().collect();
         j.spec.split = Some(Split {
-            sig: sig("w", 2),
+            sig: Sig::new("w", 2),
             last: 3,
             complement: None,
         });
@@ -1174,7 +1170,7 @@ endmodule
         );
         // A case on a signal the netlist does not have.
         let mut other = product_job(None);
-        other.spec.split.as_mut().unwrap().sig = sig("v", 2);
+        other.spec.split.as_mut().unwrap().sig = Sig::new("v", 2);
         let e = algebraic(&other, &product_netlist().to_string()).unwrap_err();
         assert!(e.to_string().contains("v"), "{e}");
     }
