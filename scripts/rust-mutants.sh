@@ -19,6 +19,7 @@ out=$1 shard=$2 tests=$3
 shift 3
 cargo=${CARGO:-cargo}
 common="--profile mutants --test-tool nextest"
+mkdir -p "$out"  # cargo-mutants makes OUT/mutants.out, not OUT
 
 # shellcheck disable=SC2086
 $cargo mutants $common "$@" --cargo-arg=--lib --shard "$shard" --sharding round-robin \

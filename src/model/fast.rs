@@ -482,4 +482,81 @@ mod tests {
         assert!(e(maps.clone().with_table(&cfg, past)).contains("entry 5"));
         assert!(e(rom_maps.with_table(&rom_cfg, vec![0; n as usize])).contains("comp_table = rom"));
     }
+
+    /// Each kind of table the fast path builds (one- and two-byte entries, positions fused
+    /// or split, intensities fused or direct) gives the model's intensity, one sample at a
+    /// time, in a batch and in a parallel batch of several chunks.
+    #[test]
+    fn every_table_kind_and_the_parallel_batch_equal_the_model() {
+        let base = Config::default();
+        let cases = [
+            // (configuration, fused, positions two bytes, intensities two bytes)
+            (base.clone(), (true, true), false, false),
+            (
+                Config {
+                    map_bits: 10,
+                    ..base.clone()
+                },
+                (true, true),
+                false,
+                true,
+            ),
+            // pos_bits 9: two-byte positions, and too many positions to fuse intensities.
+            (
+                Config {
+                    index_bits: 5,
+                    interp_bits: 4,
+                    map_bits: 10,
+                    ..base.clone()
+                },
+                (true, false),
+                true,
+                false,
+            ),
+            // red_bits 11: 2^21 position entries, past FUSED_POSITIONS_MAX.
+            (
+                Config {
+                    red_bits: 11,
+                    ..base.clone()
+                },
+                (false, true),
+                false,
+                false,
+            ),
+        ];
+        let mut rng = crate::rng::SplitMix64::new(5);
+        let grads: Vec<[i32; 3]> = (0..3 * PAR_CHUNK + 5)
+            .map(|k| {
+                let span = if k % 3 == 0 { 64 } else { 4096 };
+                [0; 3].map(|_| (rng.next_u64() % span) as i32 - span as i32 / 2)
+            })
+            .collect();
+        for (cfg, fused, wide_positions, wide_intensities) in cases {
+            let model = Model::new(&cfg);
+            let data = (0..3 * cfg.map_entries())
+                .map(|_| (rng.next_u64() % (cfg.map_max() as u64 + 1)) as u32)
+                .collect();
+            let maps = Maps::from_data(&cfg, data);
+            let fast = FastShader::new(&model, &maps);
+            assert_eq!(fast.fused(), fused, "{}", cfg.summary());
+            if let Positions::Fused { table, .. } = &fast.positions {
+                assert_eq!(matches!(table, Table::U16(_)), wide_positions);
+            }
+            if let Intensities::Fused { table, .. } = &fast.intensities {
+                assert_eq!(matches!(table, Table::U16(_)), wide_intensities);
+            }
+            let want: Vec<u16> = grads
+                .iter()
+                .map(|g| model.intensity(&maps, *g) as u16)
+                .collect();
+            assert!(want.iter().any(|&i| i > 255) == (cfg.map_bits > 8));
+            let (mut out, mut par) = (vec![0u16; grads.len()], vec![0u16; grads.len()]);
+            fast.shade_batch(&grads, &mut out);
+            fast.shade_batch_par(&grads, &mut par);
+            assert!(out == want && par == want, "{}", cfg.summary());
+            for (g, w) in grads.iter().zip(&want).step_by(97) {
+                assert_eq!(fast.shade(*g), *w as u32, "{g:?} {}", cfg.summary());
+            }
+        }
+    }
 }

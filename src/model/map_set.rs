@@ -90,6 +90,18 @@ pub fn map_file(cfg: &Config, buf: u32, axis: &str) -> String {
     cfg.prefixed(&format!("{map}_{axis}.hex"))
 }
 
+/// Characters of a bad entry a message quotes: a line of a file that is not a map may be
+/// megabytes long.
+const QUOTED_MAX: usize = 32;
+
+/// `t` quoted, cut after [`QUOTED_MAX`] characters (`...` and its length in bytes follow).
+fn quoted(t: &str) -> String {
+    match t.char_indices().nth(QUOTED_MAX) {
+        None => format!("{t:?}"),
+        Some((cut, _)) => format!("{:?}... ({} bytes)", &t[..cut], t.len()),
+    }
+}
+
 /// Reads the `$readmemh` files of buffer `buf`, [`map_file`] (logical address order): one
 /// per name of [`buffer_names`], the table too with `comp_table = ram`.
 pub fn read_maps(cfg: &Config, dir: &Path, buf: u32) -> Result<Maps> {
@@ -127,8 +139,9 @@ pub fn read_maps(cfg: &Config, dir: &Path, buf: u32) -> Result<Maps> {
             if t.is_empty() {
                 continue;
             }
-            let v = u32::from_str_radix(t, 16)
-                .with_context(|| format!("{}:{}: not a hex entry: {t:?}", p.display(), n + 1))?;
+            let v = u32::from_str_radix(t, 16).with_context(|| {
+                format!("{}:{}: not a hex entry: {}", p.display(), n + 1, quoted(t))
+            })?;
             if v > max {
                 let limit = if name == TABLE {
                     format!("past the largest position {max} (pos_max)")
@@ -152,5 +165,213 @@ pub fn read_maps(cfg: &Config, dir: &Path, buf: u32) -> Result<Maps> {
         Ok(maps)
     } else {
         maps.with_table(cfg, table)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::CompTable;
+    use crate::hexfile;
+
+    fn ram(prefix: &str) -> Config {
+        Config {
+            comp_table: CompTable::Ram,
+            prefix: prefix.into(),
+            ..Config::default()
+        }
+    }
+
+    /// Writes buffer `buf` of `maps` as the design's `$readmemh` files (header comments and
+    /// all), the table too when the maps carry one.
+    fn write_buffer(cfg: &Config, dir: &Path, buf: u32, maps: &Maps) {
+        for (k, name) in buffer_names(cfg).into_iter().enumerate() {
+            let (bits, entries) = if name == TABLE {
+                (cfg.pos_bits(), maps.table.clone().unwrap())
+            } else {
+                (cfg.map_bits, maps.axis(k as u32).to_vec())
+            };
+            let text = hexfile::format(cfg, name, bits, &entries);
+            std::fs::write(dir.join(map_file(cfg, buf, name)), text).unwrap();
+        }
+    }
+
+    #[test]
+    fn file_names_carry_the_buffer_the_axis_and_the_prefix() {
+        let rom = Config::default();
+        assert_eq!(map_file(&rom, 0, "x"), "map_x.hex");
+        assert_eq!(map_file(&rom, 1, "z"), "map2_z.hex");
+        assert_eq!(map_file(&ram("p_"), 1, TABLE), "p_map2_table.hex");
+        assert_eq!(map_file(&ram("p_"), 0, "*"), "p_map_*.hex");
+        assert_eq!(buffer_names(&rom), ["x", "y", "z"]);
+        assert_eq!(buffer_names(&ram("")), ["x", "y", "z", "table"]);
+    }
+
+    /// The second buffer holds the alternate scene, and with `comp_table = ram` the linear
+    /// index's positions as its table while the first holds the atan table.
+    #[test]
+    fn the_standard_set_is_two_scenes_and_two_tables() {
+        for cfg in [Config::default(), ram("")] {
+            let set = MapSet::standard(&cfg);
+            assert_eq!(set.scene.data, Scene::standard().maps(&cfg).data);
+            assert_eq!(set.second.data, Scene::alternate().maps(&cfg).data);
+            assert_ne!(set.scene.data, set.second.data);
+            assert_eq!(set.buffer(0), &set.scene);
+            assert_eq!(set.buffer(1), &set.second);
+            if cfg.comp_table.is_rom() {
+                assert_eq!((&set.scene.table, &set.second.table), (&None, &None));
+                continue;
+            }
+            let atan = crate::stages::atan_rom::model::contents(&cfg);
+            let linear: Vec<u32> = (0..cfg.atan_entries())
+                .map(|u| crate::model::linear_index::eval(&cfg, u))
+                .collect();
+            assert_ne!(atan, linear);
+            assert_eq!(set.scene.table.as_ref(), Some(&atan));
+            assert_eq!(set.second.table.as_ref(), Some(&linear));
+        }
+    }
+
+    /// What the design's files hold is read back whole, comments, blank lines and trailing
+    /// comments skipped, the prefix and the table with `comp_table = ram` included.
+    #[test]
+    fn a_design_directory_is_read_back_as_written() {
+        for cfg in [Config::default(), ram("p_")] {
+            let dir = tempfile::tempdir().unwrap();
+            let set = MapSet::standard(&cfg);
+            write_buffer(&cfg, dir.path(), 0, &set.scene);
+            write_buffer(&cfg, dir.path(), 1, &set.second);
+            assert_eq!(MapSet::from_dir(&cfg, dir.path()).unwrap(), set);
+            // A trailing comment and blank lines are not entries.
+            let p = dir.path().join(map_file(&cfg, 0, "y"));
+            let text = std::fs::read_to_string(&p).unwrap();
+            let mut lines: Vec<&str> = text.lines().collect();
+            let first = format!("{} // the first entry", lines[2]);
+            lines[2] = &first;
+            lines.splice(3..3, ["", "   ", "// a comment line"]);
+            std::fs::write(&p, lines.join("\n")).unwrap();
+            assert_eq!(read_maps(&cfg, dir.path(), 0).unwrap(), set.scene);
+        }
+    }
+
+    /// Each malformed file is refused with its name, its line and what is wrong.
+    #[test]
+    fn malformed_map_files_are_refused_by_line() {
+        let cfg = &ram("");
+        let set = MapSet::standard(cfg);
+        let err = |edit: &dyn Fn(&Path)| {
+            let dir = tempfile::tempdir().unwrap();
+            write_buffer(cfg, dir.path(), 0, &set.scene);
+            edit(dir.path());
+            let e = read_maps(cfg, dir.path(), 0).unwrap_err();
+            format!("{e:#}").replace(&format!("{}/", dir.path().display()), "")
+        };
+        // Lines 1 and 2 are the header; entry k is on line k + 3.
+        let entry = |name: &'static str, k: usize, v: &str| {
+            let v = v.to_string();
+            move |d: &Path| {
+                let p = d.join(map_file(cfg, 0, name));
+                let mut lines: Vec<String> = std::fs::read_to_string(&p)
+                    .unwrap()
+                    .lines()
+                    .map(String::from)
+                    .collect();
+                if v.is_empty() {
+                    lines.remove(k + 2);
+                } else if v == "+" {
+                    lines.push("00".into());
+                } else {
+                    lines[k + 2] = v.clone();
+                }
+                std::fs::write(&p, lines.join("\n") + "\n").unwrap();
+            }
+        };
+        assert_eq!(
+            err(&entry("y", 4, "0g")),
+            "map_y.hex:7: not a hex entry: \"0g\": invalid digit found in string"
+        );
+        assert_eq!(
+            err(&entry("z", 0, "100")),
+            "map_z.hex:3: entry 0x100 is wider than map_bits = 8"
+        );
+        // A table entry may be pos_max but no more; 255 is the widest map entry.
+        assert_eq!(
+            err(&entry(TABLE, 2, &format!("{:x}", cfg.pos_max() + 1))),
+            format!(
+                "map_table.hex:5: entry {:#x} is past the largest position {} (pos_max)",
+                cfg.pos_max() + 1,
+                cfg.pos_max()
+            )
+        );
+        let dir = tempfile::tempdir().unwrap();
+        write_buffer(cfg, dir.path(), 0, &set.scene);
+        entry(TABLE, 2, &format!("{:x}", cfg.pos_max()))(dir.path());
+        entry("z", 0, "ff")(dir.path());
+        let read = read_maps(cfg, dir.path(), 0).unwrap();
+        assert_eq!(
+            (read.table.as_ref().unwrap()[2], read.get(2, 0)),
+            (cfg.pos_max(), 255)
+        );
+        assert_eq!(
+            err(&entry("x", 7, "")),
+            "map_x.hex has 511 entries; the configuration needs 512"
+        );
+        assert_eq!(
+            err(&entry("x", 0, "+")),
+            "map_x.hex has 513 entries; the configuration needs 512"
+        );
+        assert_eq!(
+            err(&entry(TABLE, 0, "")),
+            format!(
+                "map_table.hex has {} entries; the configuration needs {}",
+                cfg.atan_entries() - 1,
+                cfg.atan_entries()
+            )
+        );
+        assert_eq!(
+            err(&|d: &Path| std::fs::remove_file(d.join("map_y.hex")).unwrap()),
+            "cannot read map map_y.hex: No such file or directory (os error 2)"
+        );
+        assert_eq!(
+            err(&|d: &Path| {
+                std::fs::remove_file(d.join("map_y.hex")).unwrap();
+                std::fs::create_dir(d.join("map_y.hex")).unwrap();
+            }),
+            "map map_y.hex is a directory, not a map file"
+        );
+        // A file past the limit is refused by its size, before it is read; at the limit it
+        // is read (and then refused for what it holds).
+        let sized = |len: u64| {
+            move |d: &Path| {
+                let f = std::fs::File::create(d.join("map_z.hex")).unwrap();
+                f.set_len(len).unwrap();
+            }
+        };
+        assert_eq!(
+            err(&sized(MAX_MAP_FILE_BYTES + 1)),
+            format!(
+                "map map_z.hex is {} bytes, more than the limit of {MAX_MAP_FILE_BYTES} for a map file",
+                MAX_MAP_FILE_BYTES + 1
+            )
+        );
+        assert_eq!(
+            err(&sized(MAX_MAP_FILE_BYTES)),
+            format!(
+                "map_z.hex:1: not a hex entry: {:?}... ({MAX_MAP_FILE_BYTES} bytes): invalid digit found in string",
+                "\0".repeat(QUOTED_MAX)
+            )
+        );
+        assert_eq!(
+            quoted(&"é".repeat(QUOTED_MAX)),
+            format!("{:?}", "é".repeat(QUOTED_MAX))
+        );
+        assert_eq!(
+            quoted(&"é".repeat(QUOTED_MAX + 1)),
+            format!(
+                "{:?}... ({} bytes)",
+                "é".repeat(QUOTED_MAX),
+                2 * QUOTED_MAX + 2
+            )
+        );
     }
 }

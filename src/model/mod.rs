@@ -164,3 +164,103 @@ impl Model {
         self.trace(maps, g, [0; 3]).out.intensity
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::CompTable;
+    use crate::rng::SplitMix64;
+
+    /// Gradients over the whole range, with the corners where the sort's rules act: zero,
+    /// one component, ties, the most negative value.
+    fn gradients(cfg: &Config, n: usize, seed: u64) -> Vec<[i32; 3]> {
+        let half = 1i32 << (cfg.grad_bits - 1);
+        let mut rng = SplitMix64::new(seed);
+        let mut v = vec![
+            [0, 0, 0],
+            [1, 0, 0],
+            [0, 1, 0],
+            [0, 0, 1],
+            [-1, 0, 0],
+            [0, 0, -1],
+            [-half, -half, -half],
+            [half - 1, -half, 3],
+            [5, 5, 5],
+            [-5, 5, -5],
+        ];
+        // Small gradients too: most of a face's states are reached only there.
+        v.extend((0..n).map(|k| {
+            let span = if k % 2 == 0 { 2 * half as u64 } else { 16 };
+            [0; 3].map(|_| (rng.next_u64() % span) as i32 - (span / 2) as i32)
+        }));
+        v
+    }
+
+    /// `state` is the zero flag, the max axis, the three signs and the two fraction codes,
+    /// packed where its documentation says; and samples of one state shade alike under any
+    /// maps and any compensation table (what the information bound of `fit` assumes).
+    #[test]
+    fn a_state_holds_what_decides_the_output() {
+        let configs = [
+            Config::default(),
+            Config {
+                comp_table: CompTable::Ram,
+                ..Config::default()
+            },
+            Config {
+                compensation: false,
+                interpolation: false,
+                interp_bits: 0,
+                ..Config::default()
+            },
+        ];
+        for cfg in configs {
+            let model = Model::new(&cfg);
+            let grads = gradients(&cfg, 20_000, 3);
+            let mut rng = SplitMix64::new(11);
+            let maps: Vec<Maps> = (0..3)
+                .map(|_| {
+                    let data = (0..3 * cfg.map_entries())
+                        .map(|_| (rng.next_u64() % (cfg.map_max() as u64 + 1)) as u32)
+                        .collect();
+                    let maps = Maps::from_data(&cfg, data);
+                    match maps.table {
+                        None => maps,
+                        Some(_) => {
+                            let table = (0..cfg.atan_entries())
+                                .map(|_| (rng.next_u64() % (cfg.pos_max() as u64 + 1)) as u32)
+                                .collect();
+                            maps.with_table(&cfg, table).unwrap()
+                        }
+                    }
+                })
+                .collect();
+            let mut seen = std::collections::HashMap::new();
+            for &g in &grads {
+                let t = model.trace(&maps[0], g, [0; 3]);
+                let s = model.state(g);
+                let fields = (
+                    s >> 53,
+                    (s >> 51) & 3,
+                    [(s >> 50) & 1, (s >> 49) & 1, (s >> 48) & 1],
+                    (s >> 24) & 0xff_ffff,
+                    s & 0xff_ffff,
+                );
+                let want = (
+                    t.zero as u64,
+                    t.sort.axis as u64,
+                    [t.sort.s_max, t.sort.s_u, t.sort.s_v].map(u64::from),
+                    t.norm.u as u64,
+                    t.norm.v as u64,
+                );
+                assert_eq!(fields, want, "{g:?} {}", cfg.summary());
+                let out: Vec<u32> = maps.iter().map(|m| model.intensity(m, g)).collect();
+                let first = seen.entry(s).or_insert((g, out.clone()));
+                assert_eq!(first.1, out, "{:?} and {g:?} share state {s:#x}", first.0);
+            }
+            // The sample covers many states, and states that several gradients share.
+            assert!(seen.len() > 5_000, "{} states", seen.len());
+            assert!(seen.len() < grads.len() - 1_000, "{} states", seen.len());
+        }
+    }
+}

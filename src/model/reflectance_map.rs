@@ -120,3 +120,155 @@ pub fn contents(cfg: &Config, shade: impl Fn(DVec3) -> f64) -> Maps {
     }
     Maps::from_data(cfg, data)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::CompTable;
+
+    /// Half up to `map_bits`, clamped, NaN as 0.
+    #[test]
+    fn quantise_rounds_half_up_and_clamps() {
+        let cfg = Config::default(); // map_bits 8
+        let q = |i: f64| quantise(&cfg, i);
+        assert_eq!(
+            [q(0.0), q(1.0), q(0.5), q(-0.1), q(1.5)],
+            [0, 255, 128, 0, 255]
+        );
+        assert_eq!(
+            [q(f64::NAN), q(f64::INFINITY), q(f64::NEG_INFINITY)],
+            [0, 255, 0]
+        );
+        // Exactly half a step rounds up; just below it, down.
+        assert_eq!(q(0.5 / 255.0), 1);
+        assert_eq!(q(0.499 / 255.0), 0);
+        assert_eq!(q(10.5 / 255.0), 11);
+        assert_eq!(q(10.499 / 255.0), 10);
+        let wide = Config {
+            map_bits: 12,
+            ..Config::default()
+        };
+        assert_eq!(quantise(&wide, 1.0), 4095);
+        assert_eq!(quantise(&wide, 0.25), 1024);
+    }
+
+    /// An entry's direction: the max axis, its sign, and the two tangents with their signs,
+    /// along the tangents of the entries (angles with compensation).
+    #[test]
+    fn an_entrys_direction_is_its_axis_signs_and_tangents() {
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let t = (std::f64::consts::FRAC_PI_4 / 7.0).tan(); // entry 1 of 8, compensated
+        for (cfg, t1) in [
+            (Config::default(), t),
+            (
+                Config {
+                    compensation: false,
+                    ..Config::default()
+                },
+                1.0 / 7.0,
+            ),
+        ] {
+            assert_eq!(entry_tangent(&cfg, 0), 0.0);
+            assert!((entry_tangent(&cfg, 1) - t1).abs() < 1e-15);
+            assert_eq!(entry_tangent(&cfg, 7), 1.0);
+            let d = |axis, s_max, s_u, i_u, s_v, i_v| {
+                entry_direction(&cfg, axis, s_max, s_u, i_u, s_v, i_v).to_array()
+            };
+            let near = |a: [f64; 3], b: [f64; 3]| (0..3).all(|k| (a[k] - b[k]).abs() < 1e-15);
+            assert_eq!(d(0, 0, 0, 0, 0, 0), [1.0, 0.0, 0.0]);
+            assert_eq!(d(0, 1, 0, 0, 0, 0), [-1.0, 0.0, 0.0]);
+            assert_eq!(d(1, 1, 1, 0, 1, 0), [0.0, -1.0, 0.0]);
+            assert_eq!(d(2, 0, 0, 0, 0, 0), [0.0, 0.0, 1.0]);
+            assert!(near(d(2, 1, 1, 7, 0, 0), [-h, 0.0, -h]));
+            assert!(near(d(1, 0, 0, 0, 1, 7), [0.0, h, -h]));
+            let n = (1.0 + t1 * t1).sqrt();
+            assert!(near(d(0, 0, 1, 1, 0, 0), [1.0 / n, -t1 / n, 0.0]));
+            assert!(near(d(1, 1, 0, 0, 0, 1), [0.0, -1.0 / n, t1 / n]));
+            let c = 1.0 / 3f64.sqrt();
+            assert!(near(d(2, 0, 1, 7, 1, 7), [-c, -c, c]));
+        }
+    }
+
+    /// Every entry of every axis holds the light model at that entry's direction, at the
+    /// address of its fields.
+    #[test]
+    fn each_entry_holds_the_light_model_at_its_direction() {
+        let cfg = Config {
+            index_bits: 2,
+            ..Config::default()
+        };
+        let light = |n: DVec3| 0.5 + 0.3 * n.x + 0.15 * n.y + 0.05 * n.z;
+        let maps = contents(&cfg, light);
+        let mut seen = std::collections::HashSet::new();
+        for axis in 0..3 {
+            assert_eq!(maps.axis(axis).len(), cfg.map_entries() as usize);
+            for a in 0..cfg.map_entries() {
+                let f = map_addr::MapAddr::decode(&cfg, a);
+                let d = entry_direction(&cfg, axis, f.s_max, f.s_u, f.i_u, f.s_v, f.i_v);
+                assert_eq!(
+                    maps.get(axis, a),
+                    quantise(&cfg, light(d)),
+                    "axis {axis} {f:?}"
+                );
+                assert_eq!(maps.axis(axis)[a as usize], maps.get(axis, a));
+                seen.insert(maps.get(axis, a));
+            }
+        }
+        assert!(seen.len() > 100, "{} distinct entries", seen.len());
+        assert_eq!(maps.table, None);
+    }
+
+    /// A RAM table design's maps carry the atan table out of reset; a table of another
+    /// length, one past the largest position, or any table for a ROM design, is refused.
+    #[test]
+    fn a_table_is_checked_before_it_is_taken() {
+        let cfg = Config {
+            comp_table: CompTable::Ram,
+            ..Config::default()
+        };
+        let data = vec![7; 3 * cfg.map_entries() as usize];
+        let maps = Maps::from_data(&cfg, data.clone());
+        let atan = crate::stages::atan_rom::model::contents(&cfg);
+        assert_eq!(maps.table.as_ref(), Some(&atan));
+        let n = cfg.atan_entries() as usize;
+        let mut table = vec![cfg.pos_max(); n];
+        table[0] = 0;
+        let taken = maps.clone().with_table(&cfg, table.clone()).unwrap();
+        assert_eq!((taken.table.as_ref(), &taken.data), (Some(&table), &data));
+        let e = |t: Vec<u32>| maps.clone().with_table(&cfg, t).unwrap_err().to_string();
+        assert_eq!(
+            e(vec![0; n + 1]),
+            format!(
+                "a compensation table of {} entries; the design has {n} (2^frac_bits)",
+                n + 1
+            )
+        );
+        assert!(e(vec![0; n - 1]).starts_with(&format!("a compensation table of {} ", n - 1)));
+        table[9] = cfg.pos_max() + 1;
+        assert_eq!(
+            e(table),
+            format!(
+                "compensation table entry 9 is {}, past the largest position {}",
+                cfg.pos_max() + 1,
+                cfg.pos_max()
+            )
+        );
+        let rom = Config::default();
+        let rom_maps = Maps::from_data(&rom, data);
+        assert_eq!(rom_maps.table, None);
+        assert_eq!(
+            rom_maps
+                .with_table(&rom, vec![0; n])
+                .unwrap_err()
+                .to_string(),
+            "a compensation table for a design whose table is a ROM (comp_table = rom)"
+        );
+    }
+
+    #[test]
+    #[should_panic(expected = "assertion `left == right` failed")]
+    fn maps_of_the_wrong_size_are_a_bug() {
+        let cfg = Config::default();
+        Maps::from_data(&cfg, vec![0; 3 * cfg.map_entries() as usize - 1]);
+    }
+}
