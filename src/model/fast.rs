@@ -229,10 +229,6 @@ impl FastShader {
         self.intensities = Intensities::new(&self.cfg, maps, samples);
     }
 
-    pub fn config(&self) -> &Config {
-        &self.cfg
-    }
-
     /// Whether each stage runs from a fused table: (positions, intensities).
     pub fn fused(&self) -> (bool, bool) {
         (
