@@ -94,6 +94,47 @@ struct Pair {
     mid: f64,
 }
 
+/// Which (max, component) pairs [`MinimaxFit::for_model`] runs through the model: every pair
+/// (max 1..=top, component 0..=max, top = 2^(G-1) - 1) while there are at most
+/// [`TRACE_BUDGET`] of them (G <= 12), else about sqrt(budget) maxes evenly spread up to top,
+/// and of each max about sqrt(budget) components evenly spread from 0 to the max itself.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct TracePlan {
+    pub(super) maxes: Vec<u64>,
+    /// The most components of one max (`u64::MAX`: all of them).
+    per_max: u64,
+}
+
+impl TracePlan {
+    pub(super) fn new(grad_bits: u32) -> TracePlan {
+        let top = (1u64 << (grad_bits - 1)) - 1;
+        let all: u64 = (top + 1) * (top + 2) / 2;
+        if all <= TRACE_BUDGET {
+            return TracePlan {
+                maxes: (1..=top).collect(),
+                per_max: u64::MAX,
+            };
+        }
+        let k = (TRACE_BUDGET as f64).sqrt() as u64;
+        TracePlan {
+            maxes: (1..=k).map(|i| (i * top).div_ceil(k)).collect(),
+            per_max: k,
+        }
+    }
+
+    /// The components traced at max `m`, ascending, 0 and `m` among them.
+    pub(super) fn components(&self, m: u64) -> impl Iterator<Item = u64> {
+        let count = (m + 1).min(self.per_max);
+        (0..count).map(move |i| {
+            if count == m + 1 {
+                i
+            } else {
+                (i * m) / (count - 1)
+            }
+        })
+    }
+}
+
 impl MinimaxFit {
     /// Finds every position's tangent range for `cfg`.
     pub fn new(cfg: &Config) -> MinimaxFit {
@@ -108,33 +149,17 @@ impl MinimaxFit {
         // atan table), so that the positions are `model`'s.
         let mut blank = Maps::from_data(cfg, vec![0; 3 * cfg.map_entries() as usize]);
         blank.table = None;
-        let top = (1u64 << (cfg.grad_bits - 1)) - 1;
-        let all: u64 = (top + 1) * (top + 2) / 2;
-        // Maxes and components: every pair, or about sqrt(budget) of each, evenly spread
-        // (always with the component equal to the max).
-        let (maxes, per_max): (Vec<u64>, u64) = if all <= TRACE_BUDGET {
-            ((1..=top).collect(), u64::MAX)
-        } else {
-            let k = (TRACE_BUDGET as f64).sqrt() as u64;
-            ((1..=k).map(|i| (i * top).div_ceil(k)).collect(), k)
-        };
+        let plan = TracePlan::new(cfg.grad_bits);
         let positions = cfg.pos_max() as usize + 1;
-        let ranges: Vec<Vec<Option<(f64, f64)>>> = maxes
+        let ranges: Vec<Vec<Option<(f64, f64)>>> = plan
+            .maxes
             .par_iter()
             .map(|&m| {
                 let mut r: Vec<Option<(f64, f64)>> = vec![None; positions];
-                let count = (m + 1).min(per_max);
-                for i in 0..count {
-                    let c = if count == m + 1 {
-                        i
-                    } else {
-                        (i * m) / (count - 1)
-                    };
+                for c in plan.components(m) {
                     let p = model.trace(&blank, [m as i32, c as i32, 0], [0; 3]).p_u as usize;
                     let t = c as f64 / m as f64;
-                    let e = r[p].get_or_insert((t, t));
-                    e.0 = e.0.min(t);
-                    e.1 = e.1.max(t);
+                    super::widen(&mut r[p], (t, t));
                 }
                 r
             })
@@ -142,10 +167,8 @@ impl MinimaxFit {
         let mut range: Vec<Option<(f64, f64)>> = vec![None; positions];
         for r in ranges {
             for (acc, x) in range.iter_mut().zip(r) {
-                if let Some((lo, hi)) = x {
-                    let e = acc.get_or_insert((lo, hi));
-                    e.0 = e.0.min(lo);
-                    e.1 = e.1.max(hi);
+                if let Some(x) = x {
+                    super::widen(acc, x);
                 }
             }
         }
@@ -735,5 +758,54 @@ mod tests {
             b_mm < b_lsq && b_mm < b_smp,
             "minimax {b_mm}, lsq {b_lsq}, sample {b_smp}"
         );
+    }
+
+    /// The trace plan: every (max, component) pair while they fit [`TRACE_BUDGET`] (G <= 12,
+    /// 2.1 M pairs at 12), else 2^11 maxes evenly spread up to the top magnitude and, of each,
+    /// up to 2^11 components evenly spread from 0 to the max itself; never over the budget.
+    #[test]
+    fn the_trace_plan_is_every_pair_up_to_the_budget_and_a_spread_beyond() {
+        let within = |gap: u64, span: u64, parts: u64, what: &str| {
+            assert!(
+                gap >= span / parts && gap <= span.div_ceil(parts),
+                "{what}: a gap of {gap} in {span} over {parts}"
+            );
+        };
+        for g in 8..=16u32 {
+            let top = (1u64 << (g - 1)) - 1;
+            let plan = TracePlan::new(g);
+            let pairs: u64 = plan
+                .maxes
+                .iter()
+                .map(|&m| plan.components(m).count() as u64)
+                .sum();
+            assert!(pairs <= TRACE_BUDGET, "G = {g}: {pairs} pairs");
+            if g <= 12 {
+                assert_eq!(plan.maxes, (1..=top).collect::<Vec<_>>(), "G = {g}");
+                assert!(plan.maxes.iter().all(|&m| plan.components(m).eq(0..=m)));
+                assert_eq!(pairs, top * (top + 3) / 2, "G = {g}");
+                continue;
+            }
+            let k = 1u64 << 11;
+            assert_eq!(plan.maxes.len() as u64, k, "G = {g}");
+            assert_eq!(plan.maxes[0], top.div_ceil(k), "G = {g}");
+            assert_eq!(*plan.maxes.last().unwrap(), top, "G = {g}");
+            for w in plan.maxes.windows(2) {
+                within(w[1] - w[0], top, k, &format!("G = {g}, maxes"));
+            }
+            for &m in &plan.maxes {
+                let c: Vec<u64> = plan.components(m).collect();
+                assert_eq!(c.len() as u64, (m + 1).min(k), "G = {g}, max {m}");
+                assert_eq!((c[0], *c.last().unwrap()), (0, m), "G = {g}, max {m}");
+                for w in c.windows(2) {
+                    within(
+                        w[1] - w[0],
+                        m,
+                        c.len() as u64 - 1,
+                        &format!("G = {g}, max {m}"),
+                    );
+                }
+            }
+        }
     }
 }

@@ -403,6 +403,13 @@ fn quadrant(q: u32) -> (u32, u32, u32, u32) {
     (q >> 3, (q >> 2) & 1, (q >> 1) & 1, q & 1)
 }
 
+/// Widens a range of tangents `acc` (None: empty) to hold `lo..=hi`.
+fn widen(acc: &mut Option<(f64, f64)>, (lo, hi): (f64, f64)) {
+    let e = acc.get_or_insert((lo, hi));
+    e.0 = e.0.min(lo);
+    e.1 = e.1.max(hi);
+}
+
 /// The maps holding the entries of the 24 quadrants (entry i_u * N + i_v of each).
 fn pack(cfg: &Config, quadrants: &[Vec<u32>]) -> Maps {
     let n = cfg.entries();

@@ -22,8 +22,8 @@
 //! (table, maps) by the minimax bound is kept, so the fit is never worse than the atan
 //! table's minimax maps.
 
-use super::minimax::{FitReport, MinimaxFit};
-use super::{quadrant, unpack};
+use super::minimax::{FitReport, MinimaxFit, TracePlan};
+use super::{quadrant, unpack, widen};
 use crate::config::Config;
 use crate::model::{Maps, Model};
 use crate::stages::interpolate::model as interpolate;
@@ -69,8 +69,8 @@ struct Quadrant {
 }
 
 impl TableFit {
-    /// The code ranges of `cfg` (compensation on), every (max, component) pair traced (the
-    /// code does not depend on the table).
+    /// The code ranges of `cfg` (compensation on), from the (max, component) pairs the
+    /// minimax fit traces (every pair up to G = 12; the code does not depend on the table).
     pub fn new(cfg: &Config) -> TableFit {
         assert!(
             cfg.compensation,
@@ -78,13 +78,14 @@ impl TableFit {
         );
         let model = Model::new(cfg);
         let blank = Maps::from_data(cfg, vec![0; 3 * cfg.map_entries() as usize]);
-        let top = (1u64 << (cfg.grad_bits - 1)) - 1;
         let n = cfg.frac_max() as usize + 1;
-        let parts: Vec<Vec<Option<(f64, f64)>>> = (1..=top)
-            .into_par_iter()
-            .map(|m| {
+        let plan = TracePlan::new(cfg.grad_bits);
+        let parts: Vec<Vec<Option<(f64, f64)>>> = plan
+            .maxes
+            .par_iter()
+            .map(|&m| {
                 let mut r = vec![None; n];
-                for c in 0..=m {
+                for c in plan.components(m) {
                     let u = model.trace(&blank, [m as i32, c as i32, 0], [0; 3]).norm.u;
                     let t = c as f64 / m as f64;
                     widen(&mut r[u as usize], (t, t));
@@ -277,12 +278,6 @@ impl TableFit {
         }
         moved
     }
-}
-
-fn widen(acc: &mut Option<(f64, f64)>, (lo, hi): (f64, f64)) {
-    let e = acc.get_or_insert((lo, hi));
-    e.0 = e.0.min(lo);
-    e.1 = e.1.max(hi);
 }
 
 fn error(v: u32, lo: f64, hi: f64) -> f64 {
