@@ -49,6 +49,9 @@ pub const TIE_BREAK: f64 = 1e-5;
 pub const CUT_ROUNDS: usize = 12;
 /// A pair whose error exceeds the subset's bound by more than this (LSB) is added to it.
 pub const CUT_TOLERANCE: f64 = 1e-4;
+/// The most iterations of the interior-point solver for one program: beyond them the program
+/// counts as not solved.
+pub const SOLVER_ITERATIONS: u32 = 200;
 /// The most ±1 moves of the integer polish per quadrant, per entry.
 pub const POLISH_MOVES_PER_ENTRY: usize = 8;
 /// How close to the quadrant's bound the RMS polish may bring a pair's largest error (LSB):
@@ -71,6 +74,8 @@ pub struct MinimaxFit {
     lsq: super::LsqFit,
     /// The RMS polish's slack ([`RMS_SLACK`] unless [`Self::rms_slack`] says otherwise).
     rms_slack: f64,
+    /// The solver's iterations for one program ([`SOLVER_ITERATIONS`]).
+    solver_iterations: u32,
 }
 
 /// What one frame's fit did.
@@ -178,6 +183,7 @@ impl MinimaxFit {
             range,
             lsq: super::LsqFit::new(cfg),
             rms_slack: RMS_SLACK,
+            solver_iterations: SOLVER_ITERATIONS,
         }
     }
 
@@ -191,6 +197,7 @@ impl MinimaxFit {
             range,
             lsq: super::LsqFit::new(cfg),
             rms_slack: RMS_SLACK,
+            solver_iterations: SOLVER_ITERATIONS,
         }
     }
 
@@ -432,7 +439,7 @@ impl MinimaxFit {
         q[t] = 1.0;
         let settings = DefaultSettingsBuilder::default()
             .verbose(false)
-            .max_iter(200)
+            .max_iter(self.solver_iterations)
             .build()
             .ok()?;
         let cones = [NonnegativeConeT(row)];
@@ -807,5 +814,27 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A quadrant whose program the solver does not solve (here: allowed one iteration)
+    /// keeps the least-squares entries, polished on the hardware as a solved one's are, and
+    /// the report counts it; the bound is still the one measured on the maps.
+    #[test]
+    fn an_unsolved_quadrant_keeps_the_least_squares_entries_and_is_counted() {
+        let cfg = small();
+        let mut scene = Scene::standard();
+        scene.material.shininess = 120.0;
+        let p = scene.prepared();
+        let shade = |n: DVec3| p.shade(n);
+        let mut f = MinimaxFit::new(&cfg);
+        f.solver_iterations = 1;
+        let (maps, r) = f.fit_report(shade);
+        assert_eq!(r.unsolved, 24);
+        for q in 0..24 {
+            let pairs = f.pairs(q, &shade);
+            let (e, _) = f.polish(&pairs, &f.lsq.fit_quadrant(q, &shade));
+            assert_eq!(super::super::unpack(&cfg, &maps, q), e, "quadrant {q}");
+        }
+        assert_eq!(f.bound(&maps, shade), r.bound);
     }
 }
