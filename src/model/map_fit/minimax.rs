@@ -837,4 +837,62 @@ mod tests {
         }
         assert_eq!(f.bound(&maps, shade), r.bound);
     }
+
+    /// A quadrant's pairs: one per pair of reached positions, in order, each with the
+    /// hardware's base entries and weights of its positions, and the light model's mean over
+    /// its directions (what the RMS polish aims at) within its range.
+    #[test]
+    fn a_pair_holds_its_positions_entries_and_the_light_models_range_and_mean() {
+        let cfg = small();
+        let f = MinimaxFit::new(&cfg);
+        let mut scene = Scene::standard();
+        scene.material.shininess = 120.0;
+        let p = scene.prepared();
+        let shade = |n: DVec3| p.shade(n);
+        let positions = cfg.pos_max() + 1;
+        let top = cfg.map_max() as f64;
+        let mut spread = 0;
+        for q in 0..24 {
+            let pairs = f.pairs(q, &shade);
+            assert_eq!(pairs.len() as u32, positions * positions, "quadrant {q}");
+            for (k, pr) in pairs.iter().enumerate() {
+                let (pu, pv) = (k as u32 / positions, k as u32 % positions);
+                let ((bu, wu), (bv, wv)) = (split(&cfg, pu), split(&cfg, pv));
+                assert_eq!((pr.base, pr.w), ((bu as usize, bv as usize), (wu, wv)));
+                assert!(
+                    0.0 <= pr.lo && pr.lo <= pr.mid && pr.mid <= pr.hi && pr.hi <= top,
+                    "quadrant {q}, pair {k}: {} <= {} <= {}",
+                    pr.lo,
+                    pr.mid,
+                    pr.hi
+                );
+            }
+            spread += pairs
+                .iter()
+                .filter(|pr| pr.lo < pr.mid && pr.mid < pr.hi)
+                .count();
+        }
+        assert!(spread > 0, "no pair's light model varies");
+    }
+
+    /// The bound the fit reports holds against the float light model: on every pixel of a
+    /// sphere the model with the minimax maps is within it (plus 1 LSB: the bound samples
+    /// each pair's rectangle of directions at 3 x 3 points).
+    #[test]
+    fn the_reported_bound_holds_on_a_sphere() {
+        let cfg = small();
+        let mut scene = Scene::standard();
+        scene.material.shininess = 120.0;
+        let p = scene.prepared();
+        let (maps, r) = MinimaxFit::new(&cfg).fit_report(|n| p.shade(n));
+        let model = crate::model::Model::new(&cfg);
+        let reference = crate::reference::Reference::new(&cfg, &scene);
+        let mut worst = 0.0f64;
+        for (_, _, g) in crate::render::sphere_gradients(&cfg, 128, 0) {
+            let m = model.intensity(&maps, g) as f64;
+            let exact = reference.exact(g).unwrap().clamp(0.0, 1.0) * cfg.map_max() as f64;
+            worst = worst.max((m - exact).abs());
+        }
+        assert!(worst <= r.bound + 1.0, "{worst} over the bound {}", r.bound);
+    }
 }
