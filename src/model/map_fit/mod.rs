@@ -265,22 +265,12 @@ impl LsqFit {
     /// The unrounded entries of quadrant q = axis << 3 | s_max << 2 | s_u << 1 | s_v.
     fn fit_quadrant(&self, q: u32, shade: &impl Fn(DVec3) -> f64) -> Vec<f64> {
         let (n, k) = (self.n, self.tangent.len());
-        let top = self.cfg.map_max() as f64;
-        let (axis, s_max, s_u, s_v) = quadrant(q);
-        let sg = |s: u32, t: f64| if s == 1 { -t } else { t };
-        // Light-model values on the dense grid, in output LSBs, clamped as the reference
-        // clamps them.
+        // Light-model values on the dense grid.
+        let light = light(&self.cfg, q, shade);
         let mut f = vec![0.0; k * k];
         for (ju, &tu) in self.tangent.iter().enumerate() {
             for (jv, &tv) in self.tangent.iter().enumerate() {
-                let [x, y, z] =
-                    crate::geometry::place(axis, sg(s_max, 1.0), sg(s_u, tu), sg(s_v, tv));
-                let i = shade(crate::geometry::sym_normalize(DVec3::new(x, y, z)));
-                f[ju * k + jv] = if i.is_nan() {
-                    0.0
-                } else {
-                    i.clamp(0.0, 1.0) * top
-                };
+                f[ju * k + jv] = light(tu, tv);
             }
         }
         let mut e = vec![0.0; n * n];
@@ -401,6 +391,59 @@ impl LsqFit {
 /// | s_v (24 in all).
 fn quadrant(q: u32) -> (u32, u32, u32, u32) {
     (q >> 3, (q >> 2) & 1, (q >> 1) & 1, q & 1)
+}
+
+/// The largest tangent spacing between the points at which [`light_over`] samples the light
+/// model over a position's range of tangents. An interpolating design's positions are narrower
+/// than two spacings and are sampled at their ends and middle; a wide one (nearest entry, few
+/// index bits) at more points, so that a highlight inside it is not missed.
+pub const LIGHT_SPACING: f64 = 1.0 / 64.0;
+
+/// The light model of quadrant q at tangents (t_u, t_v), in output LSBs, clamped as the
+/// reference clamps it (a NaN, a direction the light model does not define, is 0).
+fn light<'a>(
+    cfg: &Config,
+    q: u32,
+    shade: &'a impl Fn(DVec3) -> f64,
+) -> impl Fn(f64, f64) -> f64 + 'a {
+    let top = cfg.map_max() as f64;
+    let (axis, s_max, s_u, s_v) = quadrant(q);
+    let sg = |s: u32, t: f64| if s == 1 { -t } else { t };
+    move |tu, tv| {
+        let [x, y, z] = crate::geometry::place(axis, sg(s_max, 1.0), sg(s_u, tu), sg(s_v, tv));
+        let i = shade(crate::geometry::sym_normalize(DVec3::new(x, y, z)));
+        if i.is_nan() {
+            0.0
+        } else {
+            i.clamp(0.0, 1.0) * top
+        }
+    }
+}
+
+/// The points at which the light model is sampled over tangents `lo..=hi`: both ends, evenly
+/// spread, at most [`LIGHT_SPACING`] apart, and at least the middle between them.
+fn light_points(lo: f64, hi: f64) -> impl Iterator<Item = f64> {
+    let gaps = (((hi - lo) / LIGHT_SPACING).ceil() as usize).max(2);
+    (0..=gaps).map(move |i| {
+        let s = i as f64 / gaps as f64;
+        lo * (1.0 - s) + hi * s
+    })
+}
+
+/// The light model's smallest value, largest value and mean over the rectangle of tangents
+/// `u` x `v` ([`light_points`] of each).
+fn light_over(light: &impl Fn(f64, f64) -> f64, u: (f64, f64), v: (f64, f64)) -> (f64, f64, f64) {
+    let (mut lo, mut hi, mut sum, mut count) = (f64::INFINITY, f64::NEG_INFINITY, 0.0, 0);
+    for tu in light_points(u.0, u.1) {
+        for tv in light_points(v.0, v.1) {
+            let i = light(tu, tv);
+            lo = lo.min(i);
+            hi = hi.max(i);
+            sum += i;
+            count += 1;
+        }
+    }
+    (lo, hi, sum / count as f64)
 }
 
 /// Widens a range of tangents `acc` (None: empty) to hold `lo..=hi`.

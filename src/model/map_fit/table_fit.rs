@@ -11,8 +11,8 @@
 //! every position stands for one contiguous range of tangents and the minimax fit's ranges
 //! stay exact. The state of a sample is its quadrant and its code pair (c_u, c_v); the
 //! pipeline shades it `interpolate(maps, t(c_u), t(c_v))`, and the light model over the
-//! rectangle of tangents the pair stands for lies in [lo, hi] (3 x 3 points of it, as in
-//! [`super::minimax`]). Its error is max(v - lo, hi - v).
+//! rectangle of tangents the pair stands for lies in [lo, hi] (sampled as in
+//! [`super::minimax`], [`super::light_over`]). Its error is max(v - lo, hi - v).
 //!
 //! **How.** Rounds of two steps, starting from the atan table: (1) the maps by
 //! [`MinimaxFit`] for the current table (position ranges from the code ranges, no tracing);
@@ -23,7 +23,7 @@
 //! table's minimax maps.
 
 use super::minimax::{FitReport, MinimaxFit, TracePlan};
-use super::{quadrant, unpack, widen};
+use super::{light, light_over, unpack, widen};
 use crate::config::Config;
 use crate::model::{Maps, Model};
 use crate::stages::interpolate::model as interpolate;
@@ -173,36 +173,17 @@ impl TableFit {
     /// The light model's range over every (quadrant, code pair) state.
     fn states(&self, shade: &(impl Fn(DVec3) -> f64 + Sync)) -> Vec<Quadrant> {
         let n = self.range.len();
-        let top = self.cfg.map_max() as f64;
         (0..24u32)
             .into_par_iter()
             .map(|q| {
-                let (axis, s_max, s_u, s_v) = quadrant(q);
-                let sg = |s: u32, t: f64| if s == 1 { -t } else { t };
-                let light = |tu: f64, tv: f64| {
-                    let [x, y, z] =
-                        crate::geometry::place(axis, sg(s_max, 1.0), sg(s_u, tu), sg(s_v, tv));
-                    let i = shade(crate::geometry::sym_normalize(DVec3::new(x, y, z)));
-                    if i.is_nan() {
-                        0.0
-                    } else {
-                        i.clamp(0.0, 1.0) * top
-                    }
-                };
+                let light = light(&self.cfg, q, shade);
                 let mut lo = vec![f64::NAN; n * n];
                 let mut hi = vec![f64::NAN; n * n];
                 for &cu in &self.codes {
-                    let (u0, u1) = self.range[cu].expect("reachable");
+                    let u = self.range[cu].expect("reachable");
                     for &cv in &self.codes {
-                        let (v0, v1) = self.range[cv].expect("reachable");
-                        let (mut l, mut h) = (f64::INFINITY, f64::NEG_INFINITY);
-                        for tu in [u0, (u0 + u1) / 2.0, u1] {
-                            for tv in [v0, (v0 + v1) / 2.0, v1] {
-                                let i = light(tu, tv);
-                                l = l.min(i);
-                                h = h.max(i);
-                            }
-                        }
+                        let v = self.range[cv].expect("reachable");
+                        let (l, h, _) = light_over(&light, u, v);
                         lo[cu * n + cv] = l;
                         hi[cu * n + cv] = h;
                     }
@@ -294,7 +275,7 @@ mod tests {
     /// positions, never worse than the atan table by the minimax bound and, on this sharp
     /// enough scene, better; and the model with the table and maps shades within that bound
     /// of the light model on every sphere pixel (plus 1 LSB: the bound samples each state's
-    /// rectangle of directions at 3 x 3 points).
+    /// rectangle of directions, [`super::super::light_over`]).
     #[test]
     fn the_fitted_table_is_monotone_and_lowers_the_bound() {
         let cfg = Config {
