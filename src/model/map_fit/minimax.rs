@@ -11,7 +11,7 @@
 //! spread samples of them beyond). A position pair then stands for a rectangle of tangents,
 //! and the light model over it lies in [lo, hi] (its values at a grid of the rectangle:
 //! corners, edges and inside, at most [`super::LIGHT_SPACING`] apart and at least 3 x 3,
-//! [`super::light_over`]). The error of value v there is max(v - lo, hi - v);
+//! `light_over`). The error of value v there is max(v - lo, hi - v);
 //! the fit minimises the largest such error over all position pairs of the quadrant.
 //!
 //! **How.** Each quadrant (24 per frame, independent) is a linear program in its N^2 entries
@@ -859,7 +859,7 @@ mod tests {
 
     /// The bound the fit reports holds against the float light model: on every pixel of a
     /// sphere the model with the minimax maps is within it (plus 1 LSB: the bound samples
-    /// each pair's rectangle of directions, [`super::super::light_over`]), with interpolation
+    /// each pair's rectangle of directions, `light_over`), with interpolation
     /// and without (nearest entry, whose wide rectangles are sampled at up to 17 x 17 points:
     /// at 3 x 3 the fit missed the highlight inside one, its bound was 30.7 LSB and the
     /// sphere's largest error 32.6), and it is the bound measured on the maps.

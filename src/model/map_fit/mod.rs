@@ -393,7 +393,7 @@ fn quadrant(q: u32) -> (u32, u32, u32, u32) {
     (q >> 3, (q >> 2) & 1, (q >> 1) & 1, q & 1)
 }
 
-/// The largest tangent spacing between the points at which [`light_over`] samples the light
+/// The largest tangent spacing between the points at which `light_over` samples the light
 /// model over a position's range of tangents. An interpolating design's positions are narrower
 /// than two spacings and are sampled at their ends and middle; a wide one (nearest entry, few
 /// index bits) at more points, so that a highlight inside it is not missed.
@@ -668,5 +668,38 @@ mod tests {
             let want = reflectance_map::quantise(&cfg, 0.4);
             assert!(maps.data.iter().all(|&e| e == want), "{}", cfg.summary());
         }
+    }
+
+    /// The light model's points over a range of tangents: both ends, evenly spread, at most
+    /// `LIGHT_SPACING` apart; at least the ends and their exact middle, which is all a range of
+    /// up to two spacings gets; and over a rectangle, the smallest, largest and mean value.
+    #[test]
+    fn a_range_is_sampled_at_its_ends_and_at_most_a_spacing_apart() {
+        for (lo, hi) in [
+            (0.0, 0.0),
+            (0.25, 0.25 + LIGHT_SPACING),
+            (0.1, 0.1 + 2.0 * LIGHT_SPACING),
+            (0.5, 0.5 + 2.5 * LIGHT_SPACING),
+            (0.0, 1.0),
+            (0.3, 0.55),
+        ] {
+            let p: Vec<f64> = light_points(lo, hi).collect();
+            let gaps = ((hi - lo) / LIGHT_SPACING).ceil().max(2.0) as usize;
+            assert_eq!(p.len(), gaps + 1, "{lo}..{hi}");
+            assert_eq!((p[0], p[gaps]), (lo, hi));
+            if gaps == 2 {
+                assert_eq!(p[1], (lo + hi) / 2.0);
+            }
+            for w in p.windows(2) {
+                assert!(
+                    w[0] <= w[1] && w[1] - w[0] <= LIGHT_SPACING + 1e-15,
+                    "{lo}..{hi}: {w:?}"
+                );
+                assert!((w[1] - w[0] - (hi - lo) / gaps as f64).abs() < 1e-12);
+            }
+        }
+        let (lo, hi, mean) = light_over(&|u, v| u + 10.0 * v, (0.0, 1.0), (0.5, 0.75));
+        assert_eq!((lo, hi), (5.0, 8.5));
+        assert!((mean - (0.5 + 10.0 * 0.625)).abs() < 1e-12, "{mean}");
     }
 }

@@ -12,7 +12,7 @@
 //! stay exact. The state of a sample is its quadrant and its code pair (c_u, c_v); the
 //! pipeline shades it `interpolate(maps, t(c_u), t(c_v))`, and the light model over the
 //! rectangle of tangents the pair stands for lies in [lo, hi] (sampled as in
-//! [`super::minimax`], [`super::light_over`]). Its error is max(v - lo, hi - v).
+//! [`super::minimax`], `light_over`). Its error is max(v - lo, hi - v).
 //!
 //! **How.** Rounds of two steps, starting from the atan table: (1) the maps by
 //! [`MinimaxFit`] for the current table (position ranges from the code ranges, no tracing);
@@ -275,7 +275,7 @@ mod tests {
     /// positions, never worse than the atan table by the minimax bound and, on this sharp
     /// enough scene, better; and the model with the table and maps shades within that bound
     /// of the light model on every sphere pixel (plus 1 LSB: the bound samples each state's
-    /// rectangle of directions, [`super::super::light_over`]).
+    /// rectangle of directions, `light_over`).
     #[test]
     fn the_fitted_table_is_monotone_and_lowers_the_bound() {
         let cfg = Config {
