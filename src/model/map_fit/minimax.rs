@@ -437,9 +437,36 @@ impl MinimaxFit {
         (ok && x.iter().all(|v| v.is_finite())).then(|| (x[..nn].to_vec(), x[t]))
     }
 
-    /// Integer entries from the real ones, polished on the hardware's interpolation: returns
-    /// them and the quadrant's largest error.
+    /// Integer entries from the real ones, polished on the hardware's interpolation, first for
+    /// the largest error and then for the RMS error: returns them and the quadrant's largest
+    /// error.
     fn polish(&self, pairs: &[Pair], real: &[f64]) -> (Vec<u32>, f64) {
+        let readers = self.readers(pairs);
+        let (mut e, bound) = self.bound_polish(pairs, &readers, real);
+        self.rms_polish(pairs, &readers, &mut e, bound);
+        (e, bound)
+    }
+
+    /// The pairs that read each entry of a quadrant.
+    fn readers(&self, pairs: &[Pair]) -> Vec<Vec<usize>> {
+        let mut readers: Vec<Vec<usize>> = vec![Vec::new(); self.n * self.n];
+        for (k, p) in pairs.iter().enumerate() {
+            for (j, _) in self.taps(p) {
+                readers[j].push(k);
+            }
+        }
+        readers
+    }
+
+    /// Integer entries from the real ones, rounded and then moved by ±1 while a move lowers
+    /// the quadrant's largest error or keeps it and lowers how many pairs reach it: returns
+    /// them and the largest error.
+    fn bound_polish(
+        &self,
+        pairs: &[Pair],
+        readers: &[Vec<usize>],
+        real: &[f64],
+    ) -> (Vec<u32>, f64) {
         let top = self.cfg.map_max();
         let mut e: Vec<u32> = real
             .iter()
@@ -451,13 +478,6 @@ impl MinimaxFit {
                 }
             })
             .collect();
-        // The pairs that read each entry.
-        let mut readers: Vec<Vec<usize>> = vec![Vec::new(); e.len()];
-        for (k, p) in pairs.iter().enumerate() {
-            for (j, _) in self.taps(p) {
-                readers[j].push(k);
-            }
-        }
         let mut err: Vec<f64> = pairs.iter().map(|p| error(p, self.value(p, &e))).collect();
         // The score: the largest error, then how many pairs reach it.
         let score = |err: &[f64]| -> (f64, usize) {
@@ -535,7 +555,6 @@ impl MinimaxFit {
             }
         }
         debug_assert_eq!(best, score(&err));
-        self.rms_polish(pairs, &readers, &mut e, best.0);
         (e, best.0)
     }
 }
@@ -649,12 +668,7 @@ mod tests {
                 let anchor = f.lsq.fit_quadrant(q, &shade);
                 let (real, _) = f.solve(&pairs, &anchor).unwrap();
                 let mut e: Vec<u32> = real.iter().map(|&v| (v + 0.5).floor() as u32).collect();
-                let mut readers: Vec<Vec<usize>> = vec![Vec::new(); e.len()];
-                for (k, pr) in pairs.iter().enumerate() {
-                    for (j, _) in f.taps(pr) {
-                        readers[j].push(k);
-                    }
-                }
+                let readers = f.readers(&pairs);
                 let errs = |e: &[u32]| -> Vec<f64> {
                     pairs.iter().map(|pr| error(pr, f.value(pr, e))).collect()
                 };
@@ -905,5 +919,65 @@ mod tests {
                 r.bound
             );
         }
+    }
+
+    /// The bound polish ends at a local optimum of the integer entries on the hardware's
+    /// interpolation: no entry moved by ±1 (within 0..=map_max) lowers the quadrant's largest
+    /// error, or keeps it and lowers how many pairs reach it. It is never worse than plain
+    /// rounding, the bound it returns is its entries' largest error, and the RMS polish after
+    /// it keeps that bound.
+    #[test]
+    fn the_polish_ends_where_no_single_move_lowers_the_bound() {
+        let cfg = small();
+        let f = MinimaxFit::new(&cfg);
+        let mut scene = Scene::standard();
+        scene.material.shininess = 120.0;
+        let p = scene.prepared();
+        let shade = |n: DVec3| p.shade(n);
+        let top = cfg.map_max();
+        let mut moved = 0;
+        for q in [0, 5, 13, 22] {
+            let pairs = f.pairs(q, &shade);
+            let readers = f.readers(&pairs);
+            let (real, _) = f.solve(&pairs, &f.lsq.fit_quadrant(q, &shade)).unwrap();
+            // The largest error and how many pairs reach it.
+            let score = |e: &[u32]| -> (f64, usize) {
+                let errs: Vec<f64> = pairs.iter().map(|pr| error(pr, f.value(pr, e))).collect();
+                let m = errs.iter().copied().fold(0.0, f64::max);
+                (m, errs.iter().filter(|&&x| x >= m - 1e-9).count())
+            };
+            let better = |a: (f64, usize), b: (f64, usize)| {
+                a.0 < b.0 - 1e-9 || (a.0 <= b.0 + 1e-9 && a.1 < b.1)
+            };
+            let rounded: Vec<u32> = real
+                .iter()
+                .map(|&v| (v + 0.5).floor().clamp(0.0, top as f64) as u32)
+                .collect();
+            let (mut e, bound) = f.bound_polish(&pairs, &readers, &real);
+            let s = score(&e);
+            assert_eq!(s.0, bound, "quadrant {q}");
+            assert!(
+                !better(score(&rounded), s),
+                "quadrant {q}: worse than rounding"
+            );
+            moved += e.iter().zip(&rounded).filter(|(a, b)| a != b).count();
+            for j in 0..e.len() {
+                for v in [e[j].wrapping_sub(1), e[j] + 1] {
+                    if v > top {
+                        continue;
+                    }
+                    let old = std::mem::replace(&mut e[j], v);
+                    let t = score(&e);
+                    assert!(
+                        !better(t, s),
+                        "quadrant {q}: entry {j} {old} -> {v}: {s:?} -> {t:?}"
+                    );
+                    e[j] = old;
+                }
+            }
+            f.rms_polish(&pairs, &readers, &mut e, bound);
+            assert!(score(&e).0 <= bound + 1e-9, "quadrant {q}");
+        }
+        assert!(moved > 0, "the polish moved no entry");
     }
 }
