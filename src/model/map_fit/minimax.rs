@@ -442,7 +442,7 @@ impl MinimaxFit {
     /// error.
     fn polish(&self, pairs: &[Pair], real: &[f64]) -> (Vec<u32>, f64) {
         let readers = self.readers(pairs);
-        let (mut e, bound) = self.bound_polish(pairs, &readers, real);
+        let (mut e, bound, _) = self.bound_polish(pairs, &readers, real);
         self.rms_polish(pairs, &readers, &mut e, bound);
         (e, bound)
     }
@@ -459,14 +459,15 @@ impl MinimaxFit {
     }
 
     /// Integer entries from the real ones, rounded and then moved by ±1 while a move lowers
-    /// the quadrant's largest error or keeps it and lowers how many pairs reach it: returns
-    /// them and the largest error.
+    /// the quadrant's largest error or keeps it and lowers how many pairs reach it (at most
+    /// [`POLISH_MOVES_PER_ENTRY`] moves an entry): returns them, the largest error and the
+    /// moves made.
     fn bound_polish(
         &self,
         pairs: &[Pair],
         readers: &[Vec<usize>],
         real: &[f64],
-    ) -> (Vec<u32>, f64) {
+    ) -> (Vec<u32>, f64, usize) {
         let top = self.cfg.map_max();
         let mut e: Vec<u32> = real
             .iter()
@@ -491,7 +492,8 @@ impl MinimaxFit {
         let mut trial: Vec<f64> = Vec::new();
         let mut stamp = vec![0usize; pairs.len()];
         let mut tries = 0usize;
-        for _ in 0..POLISH_MOVES_PER_ENTRY * e.len() {
+        let mut moves = 0;
+        while moves < POLISH_MOVES_PER_ENTRY * e.len() {
             // The entries the pairs at the max read, each once, in order.
             let mut seen = vec![false; e.len()];
             let mut entries = Vec::new();
@@ -553,9 +555,10 @@ impl MinimaxFit {
             if !moved {
                 break;
             }
+            moves += 1;
         }
         debug_assert_eq!(best, score(&err));
-        (e, best.0)
+        (e, best.0, moves)
     }
 }
 
@@ -923,8 +926,8 @@ mod tests {
 
     /// The bound polish ends at a local optimum of the integer entries on the hardware's
     /// interpolation: no entry moved by ±1 (within 0..=map_max) lowers the quadrant's largest
-    /// error, or keeps it and lowers how many pairs reach it. It is never worse than plain
-    /// rounding, the bound it returns is its entries' largest error, and the RMS polish after
+    /// error, or keeps it and lowers how many pairs reach it, and it got there before its cap
+    /// of moves (all 24 quadrants). It is never worse than plain rounding, the bound it returns is its entries' largest error, and the RMS polish after
     /// it keeps that bound.
     #[test]
     fn the_polish_ends_where_no_single_move_lowers_the_bound() {
@@ -936,7 +939,7 @@ mod tests {
         let shade = |n: DVec3| p.shade(n);
         let top = cfg.map_max();
         let mut moved = 0;
-        for q in [0, 5, 13, 22] {
+        for q in 0..24 {
             let pairs = f.pairs(q, &shade);
             let readers = f.readers(&pairs);
             let (real, _) = f.solve(&pairs, &f.lsq.fit_quadrant(q, &shade)).unwrap();
@@ -953,7 +956,12 @@ mod tests {
                 .iter()
                 .map(|&v| (v + 0.5).floor().clamp(0.0, top as f64) as u32)
                 .collect();
-            let (mut e, bound) = f.bound_polish(&pairs, &readers, &real);
+            let (mut e, bound, moves) = f.bound_polish(&pairs, &readers, &real);
+            // It ended where no move helps, not at its cap.
+            assert!(
+                moves < POLISH_MOVES_PER_ENTRY * e.len(),
+                "quadrant {q}: {moves} moves"
+            );
             let s = score(&e);
             assert_eq!(s.0, bound, "quadrant {q}");
             assert!(
@@ -979,5 +987,36 @@ mod tests {
             assert!(score(&e).0 <= bound + 1e-9, "quadrant {q}");
         }
         assert!(moved > 0, "the polish moved no entry");
+    }
+
+    /// A move that changes no pair's error (here an entry of weight 1/8, whose ±1 the
+    /// interpolator's rounding absorbs) is not taken: the polish would step back and forth
+    /// to its cap.
+    #[test]
+    fn the_polish_takes_no_move_that_changes_nothing() {
+        let cfg = small();
+        let f = MinimaxFit::new(&cfg);
+        let pair = Pair {
+            base: (0, 0),
+            w: (1, 0),
+            lo: 100.4,
+            hi: 100.4,
+            mid: 100.4,
+        };
+        let e = vec![100; f.n * f.n];
+        assert_eq!(f.value(&pair, &e), 100);
+        let mut up = e.clone();
+        up[f.n] += 1;
+        assert_eq!(
+            f.value(&pair, &up),
+            100,
+            "the entry of weight 1/8 is absorbed"
+        );
+        let pairs = [pair];
+        let readers = f.readers(&pairs);
+        let real = vec![100.0; f.n * f.n];
+        let (polished, bound, moves) = f.bound_polish(&pairs, &readers, &real);
+        assert_eq!((polished, moves), (e, 0));
+        assert!((bound - 0.4).abs() < 1e-9, "{bound}");
     }
 }
