@@ -1019,4 +1019,36 @@ mod tests {
         assert_eq!((polished, moves), (e, 0));
         assert!((bound - 0.4).abs() < 1e-9, "{bound}");
     }
+
+    /// Among the entries that reach the bound, the program takes those closest to its anchor
+    /// (the least-squares entries): one pair reading one entry pins that entry and the bound,
+    /// and every other entry, free within 0..=map_max, is the anchor's, within half an LSB (the
+    /// solver stops within its tolerance of an objective this flat: 0.2 LSB at an anchor of 0).
+    #[test]
+    fn the_program_takes_the_entries_closest_to_the_anchor() {
+        let cfg = small();
+        let f = MinimaxFit::new(&cfg);
+        let nn = f.n * f.n;
+        let pairs = [Pair {
+            base: (2, 3),
+            w: (0, 0),
+            lo: 50.0,
+            hi: 51.0,
+            mid: 50.5,
+        }];
+        let pinned = 2 * f.n + 3;
+        let anchor: Vec<f64> = (0..nn).map(|j| (j * 37 % 256) as f64).collect();
+        let taps: Vec<Vec<(usize, f64)>> = pairs.iter().map(|p| f.taps(p)).collect();
+        assert_eq!(taps, [vec![(pinned, 1.0)]]);
+        let (x, t) = f.solve_rows(&pairs, &taps, &[0], &anchor).unwrap();
+        assert!(
+            (t - 0.5).abs() < 1e-3 && (x[pinned] - 50.5).abs() < 1e-3,
+            "{t}, {x:?}"
+        );
+        for (j, (&v, &a)) in x.iter().zip(&anchor).enumerate() {
+            if j != pinned {
+                assert!((v - a).abs() < 0.5, "entry {j}: {v}, anchor {a}");
+            }
+        }
+    }
 }
