@@ -292,7 +292,28 @@ mod tests {
         assert!(table.windows(2).all(|w| w[0] <= w[1]), "{table:?}");
         assert!(table.iter().all(|&t| t <= cfg.pos_max()));
         assert!(r.bound < r.atan_bound - 1.0, "{r:?}");
+        let atan = crate::model::atan_rom::contents(&cfg);
+        assert_eq!(
+            r.changed,
+            table.iter().zip(&atan).filter(|(a, b)| a != b).count()
+        );
         assert!(r.changed > 0);
+        // The report is of the table and maps returned: the maps are the minimax maps of the
+        // table, with that bound, and the atan bound is the atan table's.
+        let (again, ra) = fit.maps(&table, &|n| p.shade(n));
+        assert_eq!((again.data, ra.bound), (maps.data.clone(), r.bound));
+        assert_eq!(fit.maps(&atan, &|n| p.shade(n)).1.bound, r.atan_bound);
+        // A code no gradient reaches holds the position of the code below it (0 at code 0).
+        let unreached: Vec<usize> = (0..table.len())
+            .filter(|&c| fit.range[c].is_none())
+            .collect();
+        assert!(
+            !unreached.is_empty() && unreached.len() < table.len() / 2,
+            "{unreached:?}"
+        );
+        for c in unreached {
+            assert_eq!(table[c], if c == 0 { 0 } else { table[c - 1] }, "code {c}");
+        }
         let mut model = Model::new(&cfg);
         model.atan = Some(table);
         let px = crate::render::sphere_gradients(&cfg, 128, 0);
