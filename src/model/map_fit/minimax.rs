@@ -1051,4 +1051,60 @@ mod tests {
             }
         }
     }
+
+    /// A pair's value and taps are the pipeline's: for gradients all over the range, with
+    /// random maps, the value at the pair of the gradient's positions, read from its
+    /// quadrant's entries, is the model's interpolated intensity, and the exact bilinear
+    /// weights of the taps give it to within the interpolator's rounding; with interpolation
+    /// and without.
+    #[test]
+    fn a_pairs_value_and_taps_are_the_pipelines() {
+        let nearest = Config {
+            interpolation: false,
+            interp_bits: 0,
+            ..small()
+        };
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        for cfg in [small(), nearest] {
+            let f = MinimaxFit::new(&cfg);
+            let model = crate::model::Model::new(&cfg);
+            let data = (0..3 * cfg.map_entries())
+                .map(|_| (next() % 256) as u32)
+                .collect();
+            let maps = Maps::from_data(&cfg, data);
+            let span = 1u64 << cfg.grad_bits;
+            let half = (span / 2) as i64;
+            for _ in 0..20_000 {
+                let g = [0, 1, 2].map(|_| ((next() % span) as i64 - half) as i32);
+                let t = model.trace(&maps, g, [0; 3]);
+                if t.zero {
+                    continue;
+                }
+                let s = t.sort;
+                let q = s.axis << 3 | s.s_max << 2 | s.s_u << 1 | s.s_v;
+                let e = super::super::unpack(&cfg, &maps, q);
+                let ((bu, wu), (bv, wv)) = (split(&cfg, t.p_u), split(&cfg, t.p_v));
+                let pair = Pair {
+                    base: (bu as usize, bv as usize),
+                    w: (wu, wv),
+                    lo: 0.0,
+                    hi: 0.0,
+                    mid: 0.0,
+                };
+                assert_eq!(f.value(&pair, &e), t.interp, "{g:?}");
+                let exact: f64 = f.taps(&pair).iter().map(|&(j, w)| w * e[j] as f64).sum();
+                assert!(
+                    (exact - t.interp as f64).abs() <= 1.0,
+                    "{g:?}: {exact} {}",
+                    t.interp
+                );
+            }
+        }
+    }
 }
