@@ -1107,4 +1107,31 @@ mod tests {
             }
         }
     }
+
+    /// On a constant light model the bound polish walks entries a few LSB off the constant
+    /// onto it, at both ends of the range as in the middle: from 3 below 100 (at least 192
+    /// moves, past a cap of 8 + 64; it takes 412 here), from 1 above 0 and from 1 below the
+    /// top (no entry leaves 0..=map_max).
+    #[test]
+    fn the_polish_walks_entries_onto_a_constant_at_either_end_of_the_range() {
+        let cfg = small();
+        let f = MinimaxFit::new(&cfg);
+        let nn = f.n * f.n;
+        let top = cfg.map_max() as f64;
+        for (level, start) in [(100.0, 97.0), (0.0, 1.0), (top, top - 1.0)] {
+            let mut pairs = f.pairs(0, &|_| 0.5);
+            for p in &mut pairs {
+                (p.lo, p.hi, p.mid) = (level, level, level);
+            }
+            let readers = f.readers(&pairs);
+            let (e, bound, moves) = f.bound_polish(&pairs, &readers, &vec![start; nn]);
+            let what = format!("from {start} to {level}: {moves} moves");
+            assert_eq!((e, bound), (vec![level as u32; nn], 0.0), "{what}");
+            let least = (level - start).abs() as usize * nn;
+            assert!(
+                least <= moves && moves < POLISH_MOVES_PER_ENTRY * nn,
+                "{what}"
+            );
+        }
+    }
 }
