@@ -1111,7 +1111,7 @@ mod tests {
     /// On a constant light model the bound polish walks entries a few LSB off the constant
     /// onto it, at both ends of the range as in the middle: from 3 below 100 (at least 192
     /// moves, past a cap of 8 + 64; it takes 412 here), from 1 above 0 and from 1 below the
-    /// top (no entry leaves 0..=map_max).
+    /// top (no entry leaves 0..=map_max); and from 200 below it stops at its cap.
     #[test]
     fn the_polish_walks_entries_onto_a_constant_at_either_end_of_the_range() {
         let cfg = small();
@@ -1133,5 +1133,13 @@ mod tests {
                 "{what}"
             );
         }
+        // From 200 below it takes at least 12,800 moves: the polish stops at its cap, short.
+        let mut pairs = f.pairs(0, &|_| 0.5);
+        for p in &mut pairs {
+            (p.lo, p.hi, p.mid) = (200.0, 200.0, 200.0);
+        }
+        let (_, bound, moves) = f.bound_polish(&pairs, &f.readers(&pairs), &vec![0.0; nn]);
+        assert_eq!(moves, POLISH_MOVES_PER_ENTRY * nn);
+        assert!(bound > 100.0, "{bound}");
     }
 }
