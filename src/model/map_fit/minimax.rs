@@ -1142,4 +1142,25 @@ mod tests {
         assert_eq!(moves, POLISH_MOVES_PER_ENTRY * nn);
         assert!(bound > 100.0, "{bound}");
     }
+
+    /// The RMS polish, given room under a bound, walks entries a few LSB off a constant light
+    /// model onto it, down to 0, up to the top and in the middle, within its rounds.
+    #[test]
+    fn the_rms_polish_walks_entries_onto_a_constant_at_either_end_of_the_range() {
+        let cfg = small();
+        let f = MinimaxFit::new(&cfg);
+        let nn = f.n * f.n;
+        let top = cfg.map_max();
+        for (level, start) in [(0, 2), (top, top - 2), (100, 97)] {
+            let mut pairs = f.pairs(0, &|_| 0.5);
+            for p in &mut pairs {
+                let l = level as f64;
+                (p.lo, p.hi, p.mid) = (l, l, l);
+            }
+            let readers = f.readers(&pairs);
+            let mut e = vec![start; nn];
+            f.rms_polish(&pairs, &readers, &mut e, 10.0);
+            assert_eq!(e, vec![level; nn], "from {start} to {level}");
+        }
+    }
 }
