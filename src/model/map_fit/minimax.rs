@@ -1163,4 +1163,37 @@ mod tests {
             assert_eq!(e, vec![level; nn], "from {start} to {level}");
         }
     }
+
+    /// No polish moves an entry past the top, even where that would help: a pair reading an
+    /// entry at the top at weight 7/8 and one at 0 at weight 1/8 shades 223 under a light
+    /// model of 250; one step up of the top entry would give 224.
+    #[test]
+    fn no_polish_moves_an_entry_past_the_top() {
+        let cfg = small();
+        let f = MinimaxFit::new(&cfg);
+        let nn = f.n * f.n;
+        let top = cfg.map_max();
+        let pairs = [Pair {
+            base: (0, 0),
+            w: (1, 0),
+            lo: 250.0,
+            hi: 250.0,
+            mid: 250.0,
+        }];
+        assert_eq!(f.taps(&pairs[0]), [(0, 0.875), (f.n, 0.125)]);
+        let readers = f.readers(&pairs);
+        let mut e = vec![0; nn];
+        e[0] = top;
+        assert_eq!(f.value(&pairs[0], &e), 223);
+        e[0] = top + 1;
+        assert_eq!(f.value(&pairs[0], &e), 224);
+        let real: Vec<f64> = (0..nn)
+            .map(|j| if j == 0 { top as f64 } else { 0.0 })
+            .collect();
+        let (e, _, _) = f.bound_polish(&pairs, &readers, &real);
+        assert_eq!(e[0], top, "the bound polish");
+        let mut e: Vec<u32> = real.iter().map(|&v| v as u32).collect();
+        f.rms_polish(&pairs, &readers, &mut e, 100.0);
+        assert_eq!(e[0], top, "the RMS polish");
+    }
 }
