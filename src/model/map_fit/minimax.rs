@@ -1196,4 +1196,36 @@ mod tests {
         f.rms_polish(&pairs, &readers, &mut e, 100.0);
         assert_eq!(e[0], top, "the RMS polish");
     }
+
+    /// The RMS polish lets a pair's error rise to its limit exactly (the bound less the slack:
+    /// 9.5 here), not past it, and takes no move that leaves the squares as they were (an
+    /// entry of weight 1/8, whose ±1 the interpolator's rounding absorbs).
+    #[test]
+    fn the_rms_polish_reaches_a_pairs_limit_and_takes_no_move_that_changes_nothing() {
+        let cfg = small();
+        let f = MinimaxFit::new(&cfg);
+        let nn = f.n * f.n;
+        let one = |w: u32, level: f64, mid: f64| {
+            [Pair {
+                base: (0, 0),
+                w: (w, 0),
+                lo: level,
+                hi: level,
+                mid,
+            }]
+        };
+        // From 92 (error 8.5) towards a mean of 80: 91 has error 9.5, the limit; 90 is past it.
+        let pairs = one(0, 100.5, 80.0);
+        let mut e = vec![92; nn];
+        f.rms_polish(&pairs, &f.readers(&pairs), &mut e, 10.0);
+        assert_eq!(e[0], 91);
+        // Entry n has weight 1/8: its steps leave the value, so the squares, unchanged.
+        let pairs = one(1, 100.4, 100.4);
+        let mut e = vec![100; nn];
+        let mut up = e.clone();
+        up[f.n] += 1;
+        assert_eq!(f.value(&pairs[0], &up), f.value(&pairs[0], &e));
+        f.rms_polish(&pairs, &f.readers(&pairs), &mut e, 10.0);
+        assert_eq!(e, vec![100; nn]);
+    }
 }
