@@ -916,6 +916,13 @@ mod tests {
                 worst = worst.max((m - exact).abs());
             }
             let what = format!("interpolation {}", cfg.interpolation);
+            // The fitted bits, recorded (a change to what the fit makes must be deliberate).
+            let golden = if cfg.interpolation {
+                "eeb3340c0a9fe26296304ddffef2943e1623d435258a69e8fffe50c60b5bd64b"
+            } else {
+                "1d20f5a68b2d85c66b2692d9435a07b4b5ba47990e52c40b0ae03677e359cbe4"
+            };
+            assert_eq!(super::super::bits_digest(&[&maps.data]), golden, "{what}");
             assert!(
                 worst <= r.bound + 1.0,
                 "{what}: {worst} over the bound {}",

@@ -571,6 +571,20 @@ fn invert_spd(a: &[f64], n: usize) -> Vec<f64> {
     inv
 }
 
+/// The SHA-256 of lists of entries (each entry as 4 little-endian bytes, each list
+/// prefixed by its length): the fitted bits that the tests record, so that a change to what
+/// a fit makes is deliberate.
+#[cfg(test)]
+fn bits_digest(parts: &[&[u32]]) -> String {
+    use sha2::{Digest, Sha256};
+    let mut h = Sha256::new();
+    for p in parts {
+        h.update((p.len() as u64).to_le_bytes());
+        p.iter().for_each(|v| h.update(v.to_le_bytes()));
+    }
+    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

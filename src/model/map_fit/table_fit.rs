@@ -298,6 +298,11 @@ mod tests {
             table.iter().zip(&atan).filter(|(a, b)| a != b).count()
         );
         assert!(r.changed > 0);
+        // The fitted bits, recorded (a change to what the fit makes must be deliberate).
+        assert_eq!(
+            super::super::bits_digest(&[&table, &maps.data]),
+            "6393e865dddec996fd9ee9fbb877c3c7fe9456e570babdc269dd001132aef529"
+        );
         // The report is of the table and maps returned: the maps are the minimax maps of the
         // table, with that bound, and the atan bound is the atan table's.
         let (again, ra) = fit.maps(&table, &|n| p.shade(n));
