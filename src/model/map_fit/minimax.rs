@@ -308,18 +308,7 @@ impl MinimaxFit {
 
     /// The hardware's value at a pair for integer entries `e` of a quadrant.
     fn value(&self, p: &Pair, e: &[u32]) -> u32 {
-        let n = self.n;
-        let (bu, bv) = p.base;
-        if !self.cfg.interpolation {
-            return e[bu * n + bv];
-        }
-        let at = |du: usize, dv: usize| e[(bu + du) * n + bv + dv];
-        interpolate::eval(
-            &self.cfg,
-            [at(0, 0), at(1, 0), at(0, 1), at(1, 1)],
-            p.w.0,
-            p.w.1,
-        )
+        entries_value(&self.cfg, e, p.base, p.w)
     }
 
     /// The linear program of a quadrant, solved: its real entries, or None if the solver
@@ -615,6 +604,23 @@ impl MinimaxFit {
             }
         }
     }
+}
+
+/// The hardware's value from a quadrant's entries `e` (entry i_u * N + i_v) at base entries
+/// (b_u, b_v) and interpolation weights (w_u, w_v): the four neighbours interpolated, or the
+/// base entry alone without interpolation.
+pub(super) fn entries_value(
+    cfg: &Config,
+    e: &[u32],
+    (bu, bv): (usize, usize),
+    (wu, wv): (u32, u32),
+) -> u32 {
+    let n = cfg.entries() as usize;
+    if !cfg.interpolation {
+        return e[bu * n + bv];
+    }
+    let at = |du: usize, dv: usize| e[(bu + du) * n + bv + dv];
+    interpolate::eval(cfg, [at(0, 0), at(1, 0), at(0, 1), at(1, 1)], wu, wv)
 }
 
 /// The largest error of value `v` over a pair's directions.

@@ -22,11 +22,10 @@
 //! (table, maps) by the minimax bound is kept, so the fit is never worse than the atan
 //! table's minimax maps.
 
-use super::minimax::{FitReport, MinimaxFit, TracePlan};
+use super::minimax::{entries_value, FitReport, MinimaxFit, TracePlan};
 use super::{light, light_over, unpack, widen};
 use crate::config::Config;
 use crate::model::{Maps, Model};
-use crate::stages::interpolate::model as interpolate;
 use crate::stages::map_lookup::model::split;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -195,16 +194,8 @@ impl TableFit {
 
     /// The hardware's value of quadrant entries `e` at positions (p_u, p_v).
     fn value(&self, e: &[u32], pu: u32, pv: u32) -> u32 {
-        let cfg = &self.cfg;
-        let n = cfg.entries() as usize;
-        let (bu, wu) = split(cfg, pu);
-        let (bv, wv) = split(cfg, pv);
-        let (bu, bv) = (bu as usize, bv as usize);
-        if !cfg.interpolation {
-            return e[bu * n + bv];
-        }
-        let at = |du: usize, dv: usize| e[(bu + du) * n + bv + dv];
-        interpolate::eval(cfg, [at(0, 0), at(1, 0), at(0, 1), at(1, 1)], wu, wv)
+        let ((bu, wu), (bv, wv)) = (split(&self.cfg, pu), split(&self.cfg, pv));
+        entries_value(&self.cfg, e, (bu as usize, bv as usize), (wu, wv))
     }
 
     /// One sweep of coordinate descent over the table, maps fixed; returns the entries moved.
