@@ -394,9 +394,10 @@ fn quadrant(q: u32) -> (u32, u32, u32, u32) {
 }
 
 /// The largest tangent spacing between the points at which `light_over` samples the light
-/// model over a position's range of tangents. An interpolating design's positions are narrower
-/// than two spacings and are sampled at their ends and middle; a wide one (nearest entry, few
-/// index bits) at more points, so that a highlight inside it is not missed.
+/// model over a position's range of tangents. Most of an interpolating design's positions are
+/// narrower than two spacings and are sampled at their ends and middle (the default shape's
+/// widest, 2.5 spacings, at 4 points); a wide one (nearest entry, few index bits) at more
+/// points, so that a highlight inside it is not missed.
 pub const LIGHT_SPACING: f64 = 1.0 / 64.0;
 
 /// The light model of quadrant q at tangents (t_u, t_v), in output LSBs, clamped as the
