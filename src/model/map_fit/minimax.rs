@@ -635,6 +635,13 @@ mod tests {
     use super::*;
     use crate::scene::Scene;
 
+    /// The standard scene with a sharp highlight (shininess 120).
+    fn sharp() -> Scene {
+        let mut scene = Scene::standard();
+        scene.material.shininess = 120.0;
+        scene
+    }
+
     fn small() -> Config {
         let c = Config {
             grad_bits: 8,
@@ -665,8 +672,7 @@ mod tests {
     #[test]
     fn the_rms_polish_lowers_the_squares_within_each_pairs_limit() {
         let cfg = small();
-        let mut scene = Scene::standard();
-        scene.material.shininess = 120.0;
+        let scene = sharp();
         let p = scene.prepared();
         let shade = |n: DVec3| p.shade(n);
         for slack in [0.0, RMS_SLACK] {
@@ -712,8 +718,7 @@ mod tests {
     fn cutting_planes_reach_the_whole_programs_optimum() {
         let cfg = small();
         let f = MinimaxFit::new(&cfg);
-        let mut scene = Scene::standard();
-        scene.material.shininess = 120.0;
+        let scene = sharp();
         let p = scene.prepared();
         let shade = |n: DVec3| p.shade(n);
         for q in [0, 5, 13, 22] {
@@ -764,8 +769,7 @@ mod tests {
         );
         assert!(maps.data.iter().all(|&v| v == 127 || v == 128));
 
-        let mut scene = Scene::standard();
-        scene.material.shininess = 120.0;
+        let scene = sharp();
         let p = scene.prepared();
         let shade = |n: DVec3| p.shade(n);
         let (mm, r) = f.fit_report(shade);
@@ -839,8 +843,7 @@ mod tests {
     #[test]
     fn an_unsolved_quadrant_keeps_the_least_squares_entries_and_is_counted() {
         let cfg = small();
-        let mut scene = Scene::standard();
-        scene.material.shininess = 120.0;
+        let scene = sharp();
         let p = scene.prepared();
         let shade = |n: DVec3| p.shade(n);
         let mut f = MinimaxFit::new(&cfg);
@@ -862,8 +865,7 @@ mod tests {
     fn a_pair_holds_its_positions_entries_and_the_light_models_range_and_mean() {
         let cfg = small();
         let f = MinimaxFit::new(&cfg);
-        let mut scene = Scene::standard();
-        scene.material.shininess = 120.0;
+        let scene = sharp();
         let p = scene.prepared();
         let shade = |n: DVec3| p.shade(n);
         let positions = cfg.pos_max() + 1;
@@ -906,8 +908,7 @@ mod tests {
             ..small()
         };
         nearest.validate().unwrap();
-        let mut scene = Scene::standard();
-        scene.material.shininess = 120.0;
+        let scene = sharp();
         let p = scene.prepared();
         for cfg in [small(), nearest] {
             let f = MinimaxFit::new(&cfg);
@@ -940,14 +941,13 @@ mod tests {
     /// The bound polish ends at a local optimum of the integer entries on the hardware's
     /// interpolation: no entry moved by ±1 (within 0..=map_max) lowers the quadrant's largest
     /// error, or keeps it and lowers how many pairs reach it, and it got there before its cap
-    /// of moves (all 24 quadrants). It is never worse than plain rounding, the bound it returns is its entries' largest error, and the RMS polish after
-    /// it keeps that bound.
+    /// of moves (all 24 quadrants). It is never worse than plain rounding, the bound it
+    /// returns is its entries' largest error, and the RMS polish after it keeps that bound.
     #[test]
     fn the_polish_ends_where_no_single_move_lowers_the_bound() {
         let cfg = small();
         let f = MinimaxFit::new(&cfg);
-        let mut scene = Scene::standard();
-        scene.material.shininess = 120.0;
+        let scene = sharp();
         let p = scene.prepared();
         let shade = |n: DVec3| p.shade(n);
         let top = cfg.map_max();
