@@ -642,6 +642,15 @@ mod tests {
         scene
     }
 
+    /// The pairs of a quadrant under a light model of `level` LSB everywhere.
+    fn constant(f: &MinimaxFit, level: f64) -> Vec<Pair> {
+        let mut pairs = f.pairs(0, &|_| 0.5);
+        for p in &mut pairs {
+            (p.lo, p.hi, p.mid) = (level, level, level);
+        }
+        pairs
+    }
+
     fn small() -> Config {
         let c = Config {
             grad_bits: 8,
@@ -1132,10 +1141,7 @@ mod tests {
         let nn = f.n * f.n;
         let top = cfg.map_max() as f64;
         for (level, start) in [(100.0, 97.0), (0.0, 1.0), (top, top - 1.0)] {
-            let mut pairs = f.pairs(0, &|_| 0.5);
-            for p in &mut pairs {
-                (p.lo, p.hi, p.mid) = (level, level, level);
-            }
+            let pairs = constant(&f, level);
             let readers = f.readers(&pairs);
             let (e, bound, moves) = f.bound_polish(&pairs, &readers, &vec![start; nn]);
             let what = format!("from {start} to {level}: {moves} moves");
@@ -1147,10 +1153,7 @@ mod tests {
             );
         }
         // From 200 below it takes at least 12,800 moves: the polish stops at its cap, short.
-        let mut pairs = f.pairs(0, &|_| 0.5);
-        for p in &mut pairs {
-            (p.lo, p.hi, p.mid) = (200.0, 200.0, 200.0);
-        }
+        let pairs = constant(&f, 200.0);
         let (_, bound, moves) = f.bound_polish(&pairs, &f.readers(&pairs), &vec![0.0; nn]);
         assert_eq!(moves, POLISH_MOVES_PER_ENTRY * nn);
         assert!(bound > 100.0, "{bound}");
@@ -1165,11 +1168,7 @@ mod tests {
         let nn = f.n * f.n;
         let top = cfg.map_max();
         for (level, start) in [(0, 2), (top, top - 2), (100, 97)] {
-            let mut pairs = f.pairs(0, &|_| 0.5);
-            for p in &mut pairs {
-                let l = level as f64;
-                (p.lo, p.hi, p.mid) = (l, l, l);
-            }
+            let pairs = constant(&f, level as f64);
             let readers = f.readers(&pairs);
             let mut e = vec![start; nn];
             f.rms_polish(&pairs, &readers, &mut e, 10.0);
