@@ -262,6 +262,17 @@ mod tests {
     use super::*;
     use crate::scene::Scene;
 
+    /// A G = 8 design (R = 6): every (max, component) pair traced in milliseconds.
+    fn small() -> Config {
+        let cfg = Config {
+            grad_bits: 8,
+            red_bits: 6,
+            ..Config::default()
+        };
+        cfg.validate().unwrap();
+        cfg
+    }
+
     /// On a G = 8 design and the standard scene: the fitted table is monotone, within the
     /// positions, never worse than the atan table by the minimax bound and, on this sharp
     /// enough scene, better; and the model with the table and maps shades within that bound
@@ -269,12 +280,7 @@ mod tests {
     /// rectangle of directions, `light_over`).
     #[test]
     fn the_fitted_table_is_monotone_and_lowers_the_bound() {
-        let cfg = Config {
-            grad_bits: 8,
-            red_bits: 6,
-            ..Config::default()
-        };
-        cfg.validate().unwrap();
+        let cfg = small();
         let scene = Scene::standard();
         let p = scene.prepared();
         let fit = TableFit::new(&cfg);
@@ -324,5 +330,34 @@ mod tests {
                 r.bound
             );
         }
+    }
+
+    /// One sweep of the descent moves each reachable code's position by at most
+    /// `RADIUS_STEPS` interpolation steps, keeps the table monotone, and counts what it moved
+    /// (here at most 3 positions: the neighbours bound a move before the radius of 8 does).
+    #[test]
+    fn a_sweep_moves_each_position_at_most_the_radius_and_keeps_the_order() {
+        let cfg = small();
+        let mut scene = Scene::standard();
+        scene.material.shininess = 120.0;
+        let p = scene.prepared();
+        let shade = |n: DVec3| p.shade(n);
+        let fit = TableFit::new(&cfg);
+        let atan = crate::model::atan_rom::contents(&cfg);
+        let (maps, first) = fit.maps(&atan, &shade);
+        let ents: Vec<Vec<u32>> = (0..24).map(|q| unpack(&cfg, &maps, q)).collect();
+        let mut table = atan.clone();
+        let moved = fit.sweep(&fit.states(&shade), &mut table, &ents, first.bound.max(1.0));
+        let radius = RADIUS_STEPS * cfg.step();
+        let steps: Vec<u32> = fit
+            .codes
+            .iter()
+            .map(|&c| table[c].abs_diff(atan[c]))
+            .collect();
+        assert_eq!(moved, steps.iter().filter(|&&d| d > 0).count());
+        assert!(steps.iter().all(|&d| d <= radius), "{steps:?}");
+        assert!(steps.iter().any(|&d| d > 1), "{steps:?}");
+        let reached: Vec<u32> = fit.codes.iter().map(|&c| table[c]).collect();
+        assert!(reached.windows(2).all(|w| w[0] <= w[1]), "{reached:?}");
     }
 }
