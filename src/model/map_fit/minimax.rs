@@ -924,13 +924,7 @@ mod tests {
             let (maps, r) = f.fit_report(|n| p.shade(n));
             assert_eq!((f.bound(&maps, |n| p.shade(n)), r.unsolved), (r.bound, 0));
             let model = crate::model::Model::new(&cfg);
-            let reference = crate::reference::Reference::new(&cfg, &scene);
-            let mut worst = 0.0f64;
-            for (_, _, g) in crate::render::sphere_gradients(&cfg, 128, 0) {
-                let m = model.intensity(&maps, g) as f64;
-                let exact = reference.exact(g).unwrap().clamp(0.0, 1.0) * cfg.map_max() as f64;
-                worst = worst.max((m - exact).abs());
-            }
+            let (worst, at) = super::super::sphere_error(&model, &maps, &scene);
             let what = format!("interpolation {}", cfg.interpolation);
             // The fitted bits, recorded (a change to what the fit makes must be deliberate).
             let golden = if cfg.interpolation {
@@ -941,7 +935,7 @@ mod tests {
             assert_eq!(super::super::bits_digest(&[&maps.data]), golden, "{what}");
             assert!(
                 worst <= r.bound + 1.0,
-                "{what}: {worst} over the bound {}",
+                "{what}: {worst} at {at:?} over the bound {}",
                 r.bound
             );
         }

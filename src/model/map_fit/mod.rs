@@ -591,6 +591,28 @@ fn bits_digest(parts: &[&[u32]]) -> String {
     h.finalize().iter().map(|b| format!("{b:02x}")).collect()
 }
 
+/// The model's largest difference, in output LSBs, from the float light model of `scene`
+/// (clamped as the reference clamps it) over the pixels of a 128-pixel sphere, and the
+/// gradient where it is: what a fit's reported bound is checked against.
+#[cfg(test)]
+fn sphere_error(
+    model: &crate::model::Model,
+    maps: &Maps,
+    scene: &crate::scene::Scene,
+) -> (f64, [i32; 3]) {
+    let cfg = &model.cfg;
+    let reference = crate::reference::Reference::new(cfg, scene);
+    let mut worst = (0.0, [0; 3]);
+    for (_, _, g) in crate::render::sphere_gradients(cfg, 128, 0) {
+        let m = model.intensity(maps, g) as f64;
+        let exact = reference.exact(g).unwrap().clamp(0.0, 1.0) * cfg.map_max() as f64;
+        if (m - exact).abs() > worst.0 {
+            worst = ((m - exact).abs(), g);
+        }
+    }
+    worst
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

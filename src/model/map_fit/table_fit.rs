@@ -318,18 +318,12 @@ mod tests {
         }
         let mut model = Model::new(&cfg);
         model.atan = Some(table);
-        let px = crate::render::sphere_gradients(&cfg, 128, 0);
-        let reference = crate::reference::Reference::new(&cfg, &scene);
-        for (_, _, g) in px {
-            let m = model.intensity(&maps, g);
-            let exact = reference.exact(g).unwrap().clamp(0.0, 1.0) * cfg.map_max() as f64;
-            let e = (m as f64 - exact).abs();
-            assert!(
-                e <= r.bound + 1.0,
-                "{g:?}: model {m}, light {exact}, bound {}",
-                r.bound
-            );
-        }
+        let (worst, at) = super::super::sphere_error(&model, &maps, &scene);
+        assert!(
+            worst <= r.bound + 1.0,
+            "{at:?}: the model is {worst} from the light model, over the bound {}",
+            r.bound
+        );
     }
 
     /// One sweep of the descent moves each reachable code's position by at most
