@@ -980,4 +980,42 @@ mod tests {
             }
         }
     }
+
+    /// The fitted bits on the sharp scene, recorded (a change to what a fit makes must be
+    /// deliberate): the least-squares fit with and without its refinement at the default shape
+    /// (where the one quadrant that misses gives its refinement up) and at four entries a side
+    /// (where eight keep it), and without interpolation.
+    #[test]
+    fn the_fitted_bits_are_recorded() {
+        let scene = sharp();
+        let p = scene.prepared();
+        let four = Config {
+            index_bits: 2,
+            ..Config::default()
+        };
+        let nearest = Config {
+            interpolation: false,
+            interp_bits: 0,
+            ..Config::default()
+        };
+        let mut digests = Vec::new();
+        for cfg in [Config::default(), four, nearest] {
+            for fit in [MapFit::Lsq, MapFit::LsqPlain] {
+                let maps = contents(&cfg, fit, |d| p.shade(d));
+                digests.push(bits_digest(&[&maps.data])[..16].to_string());
+            }
+        }
+        // The first 64 bits of each SHA-256: lsq and lsq-plain, at each shape.
+        assert_eq!(
+            digests,
+            [
+                "2acf5e9740d44e63",
+                "2acf5e9740d44e63",
+                "8c2ff2ef8f439774",
+                "a5158b67e9dd82ef",
+                "cc920325d70f279c",
+                "cc920325d70f279c"
+            ]
+        );
+    }
 }
