@@ -14,6 +14,7 @@
 //!   `{axis, address, data}` row per write.
 
 use crate::config::Config;
+use crate::hexfile::quoted;
 use crate::model::Maps;
 use crate::scene::Scene;
 use crate::stages;
@@ -237,7 +238,7 @@ pub fn decode_hex(text: &str) -> Result<Vec<Write>> {
             .split(' ')
             .map(|x| u32::from_str_radix(x, 16))
             .collect::<Result<_, _>>()
-            .with_context(|| format!("line {}: not hex: {t:?}", n + 1))?;
+            .with_context(|| format!("line {}: not hex: {}", n + 1, quoted(t)))?;
         let [axis, addr, data] = f[..] else {
             bail!("line {}: {} fields, not 3", n + 1, f.len());
         };
@@ -277,9 +278,9 @@ pub fn decode_c(text: &str) -> Result<Vec<Write>> {
             .split(',')
             .map(|x| u32::from_str_radix(x.trim().trim_start_matches("0x"), 16))
             .collect::<Result<_, _>>()
-            .with_context(|| format!("not a row of three hex numbers: {{{row}}}"))?;
+            .with_context(|| format!("not a row of three hex numbers: {}", quoted(row)))?;
         let [axis, addr, data] = f[..] else {
-            bail!("{{{row}}}: {} fields, not 3", f.len());
+            bail!("{}: {} fields, not 3", quoted(row), f.len());
         };
         v.push(Write { axis, addr, data });
     }
@@ -457,7 +458,32 @@ mod tests {
         assert!(to_maps(&cfg, &ws).is_err());
         ws.pop();
         assert!(to_maps(&cfg, &writes(&cfg, &maps)[1..]).is_err());
-        assert!(decode_hex("0 000\n").is_err());
         assert!(decode_bin(&[0; 7]).is_err());
+        // A bad line is named and quoted, at most 32 characters of it (a stream that is not
+        // one may be a single line of megabytes).
+        let msg = |r: Result<Vec<Write>>| format!("{:#}", r.unwrap_err());
+        assert_eq!(
+            msg(decode_hex("// writes\n0 000\n")),
+            "line 2: 2 fields, not 3"
+        );
+        let long = "x".repeat(1 << 20);
+        assert_eq!(
+            msg(decode_hex(&format!("0 0 0\n{long}\n"))),
+            format!(
+                "line 2: not hex: \"{}\"... (1048576 bytes): invalid digit found in string",
+                "x".repeat(32)
+            )
+        );
+        assert_eq!(
+            msg(decode_c(&format!("x[3] = {{{{0, 1, 2}}, {{{long}}}}};"))),
+            format!(
+                "not a row of three hex numbers: \"{}\"... (1048576 bytes): invalid digit found in string",
+                "x".repeat(32)
+            )
+        );
+        assert_eq!(
+            msg(decode_c("x[3] = {{0, 1}};")),
+            "\"0, 1\": 2 fields, not 3"
+        );
     }
 }

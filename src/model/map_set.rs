@@ -90,18 +90,6 @@ pub fn map_file(cfg: &Config, buf: u32, axis: &str) -> String {
     cfg.prefixed(&format!("{map}_{axis}.hex"))
 }
 
-/// Characters of a bad entry a message quotes: a line of a file that is not a map may be
-/// megabytes long.
-const QUOTED_MAX: usize = 32;
-
-/// `t` quoted, cut after [`QUOTED_MAX`] characters (`...` and its length in bytes follow).
-fn quoted(t: &str) -> String {
-    match t.char_indices().nth(QUOTED_MAX) {
-        None => format!("{t:?}"),
-        Some((cut, _)) => format!("{:?}... ({} bytes)", &t[..cut], t.len()),
-    }
-}
-
 /// Reads the `$readmemh` files of buffer `buf`, [`map_file`] (logical address order): one
 /// per name of [`buffer_names`], the table too with `comp_table = ram`.
 pub fn read_maps(cfg: &Config, dir: &Path, buf: u32) -> Result<Maps> {
@@ -140,7 +128,12 @@ pub fn read_maps(cfg: &Config, dir: &Path, buf: u32) -> Result<Maps> {
                 continue;
             }
             let v = u32::from_str_radix(t, 16).with_context(|| {
-                format!("{}:{}: not a hex entry: {}", p.display(), n + 1, quoted(t))
+                format!(
+                    "{}:{}: not a hex entry: {}",
+                    p.display(),
+                    n + 1,
+                    crate::hexfile::quoted(t)
+                )
             })?;
             if v > max {
                 let limit = if name == TABLE {
@@ -172,7 +165,7 @@ pub fn read_maps(cfg: &Config, dir: &Path, buf: u32) -> Result<Maps> {
 mod tests {
     use super::*;
     use crate::config::CompTable;
-    use crate::hexfile;
+    use crate::hexfile::{self, quoted, QUOTED_MAX};
 
     fn ram(prefix: &str) -> Config {
         Config {
