@@ -756,6 +756,20 @@ mod tests {
         }
     }
 
+    /// The residuals are the largest and the root-mean-square difference over the dense grid.
+    #[test]
+    fn the_residuals_are_the_largest_and_the_rms_difference() {
+        let fit = LsqFit::new(&Config::default());
+        let k = fit.tangent.len();
+        let e = vec![0.0; fit.n * fit.n];
+        let mut f = vec![3.0; k * k];
+        f[k + 2] = -7.0;
+        let (max, rms) = fit.residuals(&f, &e);
+        let want = ((9.0 * (k * k - 1) as f64 + 49.0) / (k * k) as f64).sqrt();
+        assert_eq!(max, 7.0);
+        assert!((rms - want).abs() < 1e-12, "{rms} {want}");
+    }
+
     /// The light model's points over a range of tangents: both ends, evenly spread, at most
     /// `LIGHT_SPACING` apart; at least the ends and their exact middle, which is all a range of
     /// up to two spacings gets; and over a rectangle, the smallest, largest and mean value.
