@@ -6,19 +6,6 @@ use crate::model::map_set::{map_file, AXES, TABLE};
 use crate::model::{Maps, Model};
 use crate::stages;
 
-/// Characters of a bad line a message quotes: a line of a file that is not hex text may be
-/// megabytes long.
-pub const QUOTED_MAX: usize = 32;
-
-/// A bad line of hex text (a map file's, a map stream's), quoted for a one-line message: cut
-/// after [`QUOTED_MAX`] characters (`...` and its length in bytes follow).
-pub fn quoted(t: &str) -> String {
-    match t.char_indices().nth(QUOTED_MAX) {
-        None => format!("{t:?}"),
-        Some((cut, _)) => format!("{:?}... ({} bytes)", &t[..cut], t.len()),
-    }
-}
-
 /// Hex digits of a `bits`-wide value.
 pub fn digits(bits: u32) -> usize {
     bits.div_ceil(4) as usize

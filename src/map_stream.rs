@@ -14,10 +14,10 @@
 //!   `{axis, address, data}` row per write.
 
 use crate::config::Config;
-use crate::hexfile::quoted;
 use crate::model::Maps;
 use crate::scene::Scene;
 use crate::stages;
+use crate::toml_input::quoted;
 use anyhow::{bail, Context, Result};
 
 /// The first characters of a hex or C stream rmapgen wrote (after `//` or `/*`).

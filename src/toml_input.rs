@@ -1,7 +1,8 @@
 //! Loading TOML input files (scenes and configurations) with errors a user can act on: one
 //! line naming the file, the line and column, and the key path (`light[9999].direction`),
 //! for a syntax error, a value of the wrong type or shape, and a value refused by validation
-//! after parsing.
+//! after parsing. Also the quoting of a bad line that the messages about other inputs (map
+//! files, map streams) share, [`quoted`].
 
 use anyhow::{bail, Result};
 use serde::de::DeserializeOwned;
@@ -53,6 +54,19 @@ pub fn one_line(s: &str) -> String {
         .map(|c| if c.is_control() { ' ' } else { c })
         .collect();
     s
+}
+
+/// Characters of a bad line a message quotes: a line of a file that is not what it should be
+/// may be megabytes long.
+pub const QUOTED_MAX: usize = 32;
+
+/// A bad line of an input (a map file's, a map stream's), quoted for a one-line message: cut
+/// after [`QUOTED_MAX`] characters (`...` and its length in bytes follow).
+pub fn quoted(t: &str) -> String {
+    match t.char_indices().nth(QUOTED_MAX) {
+        None => format!("{t:?}"),
+        Some((cut, _)) => format!("{:?}... ({} bytes)", &t[..cut], t.len()),
+    }
 }
 
 /// `what:line:col: ` (or `what: ` without a position).

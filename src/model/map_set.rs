@@ -132,7 +132,7 @@ pub fn read_maps(cfg: &Config, dir: &Path, buf: u32) -> Result<Maps> {
                     "{}:{}: not a hex entry: {}",
                     p.display(),
                     n + 1,
-                    crate::hexfile::quoted(t)
+                    crate::toml_input::quoted(t)
                 )
             })?;
             if v > max {
@@ -165,7 +165,8 @@ pub fn read_maps(cfg: &Config, dir: &Path, buf: u32) -> Result<Maps> {
 mod tests {
     use super::*;
     use crate::config::CompTable;
-    use crate::hexfile::{self, quoted, QUOTED_MAX};
+    use crate::hexfile;
+    use crate::toml_input::{quoted, QUOTED_MAX};
 
     fn ram(prefix: &str) -> Config {
         Config {
