@@ -632,15 +632,9 @@ fn error(p: &Pair, v: u32) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::super::super::reflectance_map;
+    use super::super::sharp;
     use super::*;
     use crate::scene::Scene;
-
-    /// The standard scene with a sharp highlight (shininess 120).
-    fn sharp() -> Scene {
-        let mut scene = Scene::standard();
-        scene.material.shininess = 120.0;
-        scene
-    }
 
     /// The pairs of a quadrant under a light model of `level` LSB everywhere.
     fn constant(f: &MinimaxFit, level: f64) -> Vec<Pair> {

@@ -586,6 +586,15 @@ fn bits_digest(parts: &[&[u32]]) -> String {
     h.finalize().iter().map(|b| format!("{b:02x}")).collect()
 }
 
+/// The standard scene with a sharp highlight (shininess 120): the scene the fits' tests use,
+/// which the uniform fit misses by far more than `REFINE_TAU` at the default shape.
+#[cfg(test)]
+fn sharp() -> crate::scene::Scene {
+    let mut scene = crate::scene::Scene::standard();
+    scene.material.shininess = 120.0;
+    scene
+}
+
 /// The model's largest difference, in output LSBs, from the float light model of `scene`
 /// (clamped as the reference clamps it) over the pixels of a 128-pixel sphere, and the
 /// gradient where it is: what a fit's reported bound is checked against.
@@ -894,14 +903,6 @@ mod tests {
                 }
             }
         }
-    }
-
-    /// The standard scene with a sharp highlight (shininess 120), which the uniform fit misses
-    /// by far more than `REFINE_TAU` at the default shape.
-    fn sharp() -> crate::scene::Scene {
-        let mut scene = crate::scene::Scene::standard();
-        scene.material.shininess = 120.0;
-        scene
     }
 
     /// The uniform fit of every quadrant: (q, light model on the dense grid, entries).

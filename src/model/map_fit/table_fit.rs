@@ -332,8 +332,7 @@ mod tests {
     #[test]
     fn a_sweep_moves_each_position_at_most_the_radius_and_keeps_the_order() {
         let cfg = small();
-        let mut scene = Scene::standard();
-        scene.material.shininess = 120.0;
+        let scene = super::super::sharp();
         let p = scene.prepared();
         let shade = |n: DVec3| p.shade(n);
         let fit = TableFit::new(&cfg);
