@@ -353,4 +353,39 @@ mod tests {
         let reached: Vec<u32> = fit.codes.iter().map(|&c| table[c]).collect();
         assert!(reached.windows(2).all(|w| w[0] <= w[1]), "{reached:?}");
     }
+
+    /// The radius binds: from the atan table shifted four interpolation steps up (clamped at
+    /// the last position), one sweep moves the reachable codes back down, each by at most the
+    /// radius, and most of them (the lowest first: their neighbours below moved first) by
+    /// exactly the radius; near the top, where the shift was clamped, by less.
+    #[test]
+    fn a_sweep_from_a_shifted_table_moves_by_the_radius_and_no_more() {
+        let cfg = small();
+        let scene = super::super::sharp();
+        let p = scene.prepared();
+        let shade = |n: DVec3| p.shade(n);
+        let fit = TableFit::new(&cfg);
+        let atan = crate::model::atan_rom::contents(&cfg);
+        let (maps, first) = fit.maps(&atan, &shade);
+        let ents: Vec<Vec<u32>> = (0..24).map(|q| unpack(&cfg, &maps, q)).collect();
+        let radius = RADIUS_STEPS * cfg.step();
+        let shifted: Vec<u32> = atan
+            .iter()
+            .map(|&t| (t + 4 * radius).min(cfg.pos_max()))
+            .collect();
+        let mut table = shifted.clone();
+        fit.sweep(&fit.states(&shade), &mut table, &ents, first.bound.max(1.0));
+        let down: Vec<i64> = fit
+            .codes
+            .iter()
+            .map(|&c| shifted[c] as i64 - table[c] as i64)
+            .collect();
+        assert!(
+            down.iter().all(|&d| (0..=radius as i64).contains(&d)),
+            "{down:?}"
+        );
+        assert!(down[..4].iter().all(|&d| d == radius as i64), "{down:?}");
+        let whole = down.iter().filter(|&&d| d == radius as i64).count();
+        assert!(2 * whole > down.len(), "{down:?}");
+    }
 }
