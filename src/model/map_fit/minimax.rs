@@ -450,7 +450,8 @@ impl MinimaxFit {
     /// Integer entries from the real ones, rounded and then moved by ±1 while a move lowers
     /// the quadrant's largest error or keeps it and lowers how many pairs reach it (at most
     /// [`POLISH_MOVES_PER_ENTRY`] moves an entry): returns them, the largest error and the
-    /// moves made.
+    /// moves made. Each move is the first that improves, over the entries the pairs at the
+    /// largest error read (in the pairs' order), +1 tried before -1.
     fn bound_polish(
         &self,
         pairs: &[Pair],
@@ -1049,6 +1050,45 @@ mod tests {
         let (polished, bound, moves) = f.bound_polish(&pairs, &readers, &real);
         assert_eq!((polished, moves), (e, 0));
         assert!((bound - 0.4).abs() < 1e-9, "{bound}");
+    }
+
+    /// Where a step either way improves (each step lowers one of the two pairs at the largest
+    /// error and leaves the other on its rounding plateau), the bound polish takes the step
+    /// up: it tries +1 before -1, so that the fitted bits do not depend on chance. Entry n
+    /// (position (1, 0)) is read at 1/2 by A, between entries 0 and n, and by B, between n and
+    /// 2n; A = round((100 + x) / 2) wants to rise, B = round((x + 101) / 2) to fall.
+    #[test]
+    fn where_both_steps_improve_the_bound_polish_raises_the_entry() {
+        let cfg = small();
+        let f = MinimaxFit::new(&cfg);
+        let (nn, n) = (f.n * f.n, f.n);
+        let pair = |bu: usize, level: f64| Pair {
+            base: (bu, 0),
+            w: (cfg.step() / 2, 0),
+            lo: level,
+            hi: level,
+            mid: level,
+        };
+        let (b, a) = (pair(1, 98.0), pair(0, 103.0));
+        let mut e = vec![0; nn];
+        (e[0], e[n], e[2 * n]) = (100, 100, 101);
+        let at = |x: u32| {
+            let mut e = e.clone();
+            e[n] = x;
+            (f.value(&a, &e), f.value(&b, &e))
+        };
+        // Errors 3 and 3; up: 2 and 3; down: 3 and 2.
+        assert_eq!(
+            [at(99), at(100), at(101)],
+            [(100, 100), (100, 101), (101, 101)]
+        );
+        let pairs = [b, a];
+        let readers = f.readers(&pairs);
+        let real: Vec<f64> = e.iter().map(|&v| v as f64).collect();
+        let (polished, bound, moves) = f.bound_polish(&pairs, &readers, &real);
+        let mut raised = e.clone();
+        raised[n] = 101;
+        assert_eq!((polished, bound, moves), (raised, 3.0, 1));
     }
 
     /// Among the entries that reach the bound, the program takes those closest to its anchor
