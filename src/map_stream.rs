@@ -249,7 +249,7 @@ pub fn decode_hex(text: &str) -> Result<Vec<Write>> {
 
 /// Reads a binary stream back.
 pub fn decode_bin(bytes: &[u8]) -> Result<Vec<Write>> {
-    if bytes.len() % RECORD_BYTES != 0 {
+    if !bytes.len().is_multiple_of(RECORD_BYTES) {
         bail!(
             "{} bytes is not a whole number of {RECORD_BYTES}-byte records",
             bytes.len()

@@ -102,7 +102,7 @@ fn best(
                 let e = ctx.measure(c, lim);
                 if e.complete {
                     let mut bd = bound.lock().expect("bound");
-                    if bd.map_or(true, |o| better(&e, &o)) {
+                    if bd.is_none_or(|o| better(&e, &o)) {
                         *bd = Some(e);
                     }
                 }

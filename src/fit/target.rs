@@ -17,8 +17,8 @@ pub struct Target {
 impl Target {
     pub fn met_by(&self, e: &Errors) -> bool {
         e.complete
-            && self.max_error.map_or(true, |m| e.max_any() <= m)
-            && self.rmse.map_or(true, |r| e.rmse <= r)
+            && self.max_error.is_none_or(|m| e.max_any() <= m)
+            && self.rmse.is_none_or(|r| e.rmse <= r)
     }
 
     pub(super) fn limits(&self, pixels: usize) -> Limits {

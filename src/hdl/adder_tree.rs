@@ -501,7 +501,7 @@ pub fn registered_at(depth: u32, anchor: u32, k: u32) -> bool {
     }
     match depth {
         0 => k == anchor,
-        1 => (anchor - k) % 2 == 0,
+        1 => (anchor - k).is_multiple_of(2),
         _ => true,
     }
 }

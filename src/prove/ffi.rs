@@ -95,7 +95,9 @@ impl Front {
     /// `lanes` per clock; `zero` and `ss` receive each module's outputs in order.
     pub fn run(&mut self, g: &[u16], zero: &mut [u8], ss: &mut [u64]) -> Result<()> {
         let n = g.len() / 3;
-        assert!(zero.len() >= n && ss.len() >= n && g.len() == 3 * n && n % self.lanes == 0);
+        assert!(
+            zero.len() >= n && ss.len() >= n && g.len() == 3 * n && n.is_multiple_of(self.lanes)
+        );
         // SAFETY: the buffers hold n samples each, as rp_front_run reads and writes.
         let r = unsafe {
             (self.run)(

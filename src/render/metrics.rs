@@ -71,7 +71,7 @@ impl Accumulator {
             self.hist.resize(ae as usize + 1, 0);
         }
         self.hist[ae as usize] += 1;
-        if self.worst.map_or(true, |(_, w)| ae > w) {
+        if self.worst.is_none_or(|(_, w)| ae > w) {
             self.worst = Some((self.n, ae));
         }
         self.n += 1;

@@ -234,7 +234,7 @@ impl ClassAcc {
     pub fn angle(&mut self, deg: f64, key: u64, g: [i32; 3]) {
         if self
             .angle
-            .map_or(true, |(d, k, _)| deg > d || (deg == d && key < k))
+            .is_none_or(|(d, k, _)| deg > d || (deg == d && key < k))
         {
             self.angle = Some((deg, key, g));
         }
@@ -243,7 +243,7 @@ impl ClassAcc {
     pub fn error(&mut self, w: WorstError, key: u64) {
         if self
             .error
-            .map_or(true, |(a, k, _)| w.abs() > a || (w.abs() == a && key < k))
+            .is_none_or(|(a, k, _)| w.abs() > a || (w.abs() == a && key < k))
         {
             self.error = Some((w.abs(), key, w));
         }
@@ -282,7 +282,7 @@ impl Acc {
 
     pub fn mismatch(&mut self, key: u64, g: [i32; 3]) {
         self.mismatches += 1;
-        if self.first_mismatch.map_or(true, |(k, _)| key < k) {
+        if self.first_mismatch.is_none_or(|(k, _)| key < k) {
             self.first_mismatch = Some((key, g));
         }
     }
@@ -296,7 +296,7 @@ impl Acc {
             .collect();
         self.mismatches += o.mismatches;
         if let Some((k, g)) = o.first_mismatch {
-            if self.first_mismatch.map_or(true, |(kk, _)| k < kk) {
+            if self.first_mismatch.is_none_or(|(kk, _)| k < kk) {
                 self.first_mismatch = Some((k, g));
             }
         }
@@ -329,7 +329,7 @@ impl Acc {
                 .iter()
                 .filter_map(|c| c.worst_angle)
                 .fold(None, |b: Option<WorstAngle>, w| {
-                    if b.map_or(true, |b| w.degrees > b.degrees) {
+                    if b.is_none_or(|b| w.degrees > b.degrees) {
                         Some(w)
                     } else {
                         b
@@ -340,7 +340,7 @@ impl Acc {
                 .iter()
                 .filter_map(|c| c.worst_error)
                 .fold(None, |b: Option<WorstError>, w| {
-                    if b.map_or(true, |b| w.abs() > b.abs()) {
+                    if b.is_none_or(|b| w.abs() > b.abs()) {
                         Some(w)
                     } else {
                         b

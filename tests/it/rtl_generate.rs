@@ -256,7 +256,10 @@ fn manifest_agrees_with_the_files_and_the_latency_function() {
         if cfg.axis {
             assert_eq!(listed[..2], ["rmap_axis", "rmap_top"], "{name}");
             assert!(
-                m["axis"]["s_tdata"]["bits"].as_u64().unwrap() % 8 == 0,
+                m["axis"]["s_tdata"]["bits"]
+                    .as_u64()
+                    .unwrap()
+                    .is_multiple_of(8),
                 "{name}"
             );
         } else if cfg.lanes > 1 {

@@ -14,7 +14,7 @@ fn s(p: &Path) -> &str {
 /// Runs rmapgen with its standard output the write end of a pipe whose read end is already
 /// closed: its first write fails with EPIPE, deterministically.
 fn to_closed_pipe(args: &[&str]) -> Output {
-    let (reader, writer) = rustix::pipe::pipe().expect("a pipe");
+    let (reader, writer) = std::io::pipe().expect("a pipe");
     drop(reader);
     helpers::rmapgen()
         .args(args)

@@ -128,7 +128,7 @@ pub(super) fn search(
                 stats.cells_evaluated += 1;
                 stats.reference_evaluations += n;
                 if let Some(w) = w {
-                    if best.map_or(true, |b| w.abs() > b.abs()) {
+                    if best.is_none_or(|b| w.abs() > b.abs()) {
                         best = Some(w);
                     }
                 }
@@ -220,7 +220,7 @@ fn evaluate_cell(
                 n += 1;
                 let reference = setup.reference.intensity(g);
                 let error = c.out as i64 - reference as i64;
-                if error.abs() > floor && worst.map_or(true, |w| error.unsigned_abs() > w.abs()) {
+                if error.abs() > floor && worst.is_none_or(|w| error.unsigned_abs() > w.abs()) {
                     let exact = setup.reference.exact(g).expect("not the zero gradient");
                     debug_assert_eq!(setup.fast.shade(g), c.out, "{g:?}");
                     worst = Some(WorstError {

@@ -134,7 +134,7 @@ pub fn run(setup: &Setup, progress: &(dyn Fn(u64) + Sync)) -> Result<Report> {
                         .enumerate()
                         .fold((0, &-1.0), |b, x| if x.1 > b.1 { x } else { b });
                 let best = &mut angles[shift as usize];
-                if best.map_or(true, |(b, _)| s > b) {
+                if best.is_none_or(|(b, _)| s > b) {
                     *best = Some((s, [max, c_u, c_v as u32]));
                 }
                 for axis in 0..3u32 {

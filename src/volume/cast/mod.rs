@@ -419,7 +419,10 @@ mod tests {
         let (n, m) = (8, 8);
         let mut d = Vec::new();
         for z in 0..m {
-            d.extend(std::iter::repeat(if z <= 3 { 1000.0 } else { 0.0 }).take(n * n));
+            d.extend(std::iter::repeat_n(
+                if z <= 3 { 1000.0 } else { 0.0 },
+                n * n,
+            ));
         }
         let vol = Volume::new(
             [n, n, m],
