@@ -354,10 +354,12 @@ mod tests {
         assert!(reached.windows(2).all(|w| w[0] <= w[1]), "{reached:?}");
     }
 
-    /// The radius binds: from the atan table shifted four interpolation steps up (clamped at
-    /// the last position), one sweep moves the reachable codes back down, each by at most the
-    /// radius, and most of them (the lowest first: their neighbours below moved first) by
-    /// exactly the radius; near the top, where the shift was clamped, by less.
+    /// The radius binds, down and up. From the atan table shifted four interpolation steps up
+    /// (clamped at the last position), one sweep moves the reachable codes back down, each by
+    /// at most the radius, and most of them (the lowest first: their neighbours below moved
+    /// first) by exactly the radius; near the top, where the shift was clamped, by less. From
+    /// the atan table with its lower half of codes collapsed to position 0, the highest of
+    /// them moves up by exactly the radius (the next code holds each of the others at 0).
     #[test]
     fn a_sweep_from_a_shifted_table_moves_by_the_radius_and_no_more() {
         let cfg = small();
@@ -387,5 +389,18 @@ mod tests {
         assert!(down[..4].iter().all(|&d| d == radius as i64), "{down:?}");
         let whole = down.iter().filter(|&&d| d == radius as i64).count();
         assert!(2 * whole > down.len(), "{down:?}");
+
+        let half = fit.codes.len() / 2;
+        let mut collapsed = atan.clone();
+        for &c in &fit.codes[..half] {
+            collapsed[c] = 0;
+        }
+        let mut table = collapsed.clone();
+        fit.sweep(&fit.states(&shade), &mut table, &ents, first.bound.max(1.0));
+        let up: Vec<u32> = fit.codes[..half].iter().map(|&c| table[c]).collect();
+        let mut expected = vec![0; half];
+        expected[half - 1] = radius;
+        assert_eq!(up, expected);
+        assert!(atan[fit.codes[half - 1]] > 2 * radius);
     }
 }
