@@ -326,31 +326,66 @@ mod tests {
         );
     }
 
+    /// One sweep of the descent on a G = 8 design under the sharp scene, with the maps fixed at
+    /// the atan table's minimax maps: what the sweep tests start from.
+    struct Descent {
+        cfg: Config,
+        fit: TableFit,
+        atan: Vec<u32>,
+        states: Vec<Quadrant>,
+        ents: Vec<Vec<u32>>,
+        scale: f64,
+    }
+
+    impl Descent {
+        fn new() -> Self {
+            let cfg = small();
+            let p = super::super::sharp().prepared();
+            let shade = |n: DVec3| p.shade(n);
+            let fit = TableFit::new(&cfg);
+            let atan = crate::model::atan_rom::contents(&cfg);
+            let (maps, first) = fit.maps(&atan, &shade);
+            let ents = (0..24).map(|q| unpack(&cfg, &maps, q)).collect();
+            let states = fit.states(&shade);
+            let scale = first.bound.max(1.0);
+            Descent {
+                cfg,
+                fit,
+                atan,
+                states,
+                ents,
+                scale,
+            }
+        }
+
+        /// One sweep from `table`: the table it leaves and the entries it moved.
+        fn sweep(&self, table: &[u32]) -> (Vec<u32>, usize) {
+            let mut table = table.to_vec();
+            let moved = self
+                .fit
+                .sweep(&self.states, &mut table, &self.ents, self.scale);
+            (table, moved)
+        }
+    }
+
     /// One sweep of the descent moves each reachable code's position by at most
     /// `RADIUS_STEPS` interpolation steps, keeps the table monotone, and counts what it moved
     /// (here at most 3 positions: the neighbours bound a move before the radius of 8 does).
     #[test]
     fn a_sweep_moves_each_position_at_most_the_radius_and_keeps_the_order() {
-        let cfg = small();
-        let scene = super::super::sharp();
-        let p = scene.prepared();
-        let shade = |n: DVec3| p.shade(n);
-        let fit = TableFit::new(&cfg);
-        let atan = crate::model::atan_rom::contents(&cfg);
-        let (maps, first) = fit.maps(&atan, &shade);
-        let ents: Vec<Vec<u32>> = (0..24).map(|q| unpack(&cfg, &maps, q)).collect();
-        let mut table = atan.clone();
-        let moved = fit.sweep(&fit.states(&shade), &mut table, &ents, first.bound.max(1.0));
-        let radius = RADIUS_STEPS * cfg.step();
-        let steps: Vec<u32> = fit
+        let d = Descent::new();
+        let (table, moved) = d.sweep(&d.atan);
+        let radius = RADIUS_STEPS * d.cfg.step();
+        let steps: Vec<u32> = d
+            .fit
             .codes
             .iter()
-            .map(|&c| table[c].abs_diff(atan[c]))
+            .map(|&c| table[c].abs_diff(d.atan[c]))
             .collect();
         assert_eq!(moved, steps.iter().filter(|&&d| d > 0).count());
         assert!(steps.iter().all(|&d| d <= radius), "{steps:?}");
         assert!(steps.iter().any(|&d| d > 1), "{steps:?}");
-        let reached: Vec<u32> = fit.codes.iter().map(|&c| table[c]).collect();
+        let reached: Vec<u32> = d.fit.codes.iter().map(|&c| table[c]).collect();
         assert!(reached.windows(2).all(|w| w[0] <= w[1]), "{reached:?}");
     }
 
@@ -362,23 +397,15 @@ mod tests {
     /// them moves up by exactly the radius (the next code holds each of the others at 0).
     #[test]
     fn a_sweep_from_a_shifted_table_moves_by_the_radius_and_no_more() {
-        let cfg = small();
-        let scene = super::super::sharp();
-        let p = scene.prepared();
-        let shade = |n: DVec3| p.shade(n);
-        let fit = TableFit::new(&cfg);
-        let atan = crate::model::atan_rom::contents(&cfg);
-        let (maps, first) = fit.maps(&atan, &shade);
-        let ents: Vec<Vec<u32>> = (0..24).map(|q| unpack(&cfg, &maps, q)).collect();
-        let radius = RADIUS_STEPS * cfg.step();
+        let d = Descent::new();
+        let (codes, atan) = (&d.fit.codes, &d.atan);
+        let radius = RADIUS_STEPS * d.cfg.step();
         let shifted: Vec<u32> = atan
             .iter()
-            .map(|&t| (t + 4 * radius).min(cfg.pos_max()))
+            .map(|&t| (t + 4 * radius).min(d.cfg.pos_max()))
             .collect();
-        let mut table = shifted.clone();
-        fit.sweep(&fit.states(&shade), &mut table, &ents, first.bound.max(1.0));
-        let down: Vec<i64> = fit
-            .codes
+        let (table, _) = d.sweep(&shifted);
+        let down: Vec<i64> = codes
             .iter()
             .map(|&c| shifted[c] as i64 - table[c] as i64)
             .collect();
@@ -390,17 +417,16 @@ mod tests {
         let whole = down.iter().filter(|&&d| d == radius as i64).count();
         assert!(2 * whole > down.len(), "{down:?}");
 
-        let half = fit.codes.len() / 2;
+        let half = codes.len() / 2;
         let mut collapsed = atan.clone();
-        for &c in &fit.codes[..half] {
+        for &c in &codes[..half] {
             collapsed[c] = 0;
         }
-        let mut table = collapsed.clone();
-        fit.sweep(&fit.states(&shade), &mut table, &ents, first.bound.max(1.0));
-        let up: Vec<u32> = fit.codes[..half].iter().map(|&c| table[c]).collect();
+        let (table, _) = d.sweep(&collapsed);
+        let up: Vec<u32> = codes[..half].iter().map(|&c| table[c]).collect();
         let mut expected = vec![0; half];
         expected[half - 1] = radius;
         assert_eq!(up, expected);
-        assert!(atan[fit.codes[half - 1]] > 2 * radius);
+        assert!(atan[codes[half - 1]] > 2 * radius);
     }
 }
