@@ -522,4 +522,82 @@ mod tests {
         assert!(decode("+1 X").is_none());
         assert!(decode("+1 X 7").is_none());
     }
+
+    /// A process group in its own group, as the tools rmapgen starts are.
+    fn in_own_group(args: &[&str]) -> std::process::Child {
+        use std::os::unix::process::CommandExt;
+        std::process::Command::new(args[0])
+            .args(&args[1..])
+            .stdout(std::process::Stdio::piped())
+            .process_group(0)
+            .spawn()
+            .unwrap()
+    }
+
+    /// What the guardian waits on after it kills a tool's group: a group whose leader is
+    /// gone but whose member still runs is running (the group, not the leader's pid, is
+    /// asked, and the member is found by its group in /proc); a group left with a zombie
+    /// alone is not.
+    #[test]
+    fn a_group_runs_while_a_member_does_and_not_as_a_zombie() {
+        use std::io::BufRead;
+        // The leader starts a member and exits; once the leader is reaped its pid is free,
+        // and only the member holds the group.
+        let mut leader = in_own_group(&["sh", "-c", "sleep 30 & echo $!"]);
+        let pgid = leader.id();
+        let mut line = String::new();
+        std::io::BufReader::new(leader.stdout.take().unwrap())
+            .read_line(&mut line)
+            .unwrap();
+        let member: i32 = line.trim().parse().unwrap();
+        leader.wait().unwrap();
+        let running = group_running(pgid);
+        // SAFETY: kill(2) on the member this test started.
+        unsafe { libc::kill(member, libc::SIGKILL) };
+        assert!(
+            running,
+            "a group whose member runs ({member}) was seen as gone"
+        );
+
+        let mut z = in_own_group(&["sleep", "30"]);
+        let pgid = z.id();
+        assert!(group_running(pgid), "a running leader was seen as gone");
+        z.kill().unwrap();
+        // Wait for its end without reaping it (WNOWAIT): a zombie, which the kernel still
+        // counts in the group.
+        // SAFETY: waitid(2) on the child this test started; `info` is written by the call.
+        let mut info: libc::siginfo_t = unsafe { std::mem::zeroed() };
+        let r =
+            unsafe { libc::waitid(libc::P_PID, pgid, &mut info, libc::WEXITED | libc::WNOWAIT) };
+        assert_eq!(r, 0, "waitid");
+        // SAFETY: kill(2) with signal 0 only checks that the group exists.
+        assert_eq!(
+            unsafe { libc::kill(-(pgid as i32), 0) },
+            0,
+            "the zombie's group"
+        );
+        assert!(
+            !group_running(pgid),
+            "a group of one zombie was seen as running"
+        );
+        z.wait().unwrap();
+        assert!(!group_running(pgid), "a reaped group was seen as running");
+    }
+
+    /// The guardian's wait ends when the group's last process does (here a half-second
+    /// sleep): not before, and not at the end of the settling time either.
+    #[test]
+    fn the_wait_for_a_group_lasts_until_it_is_gone() {
+        let mut c = in_own_group(&["sleep", "0.5"]);
+        let start = Instant::now();
+        wait_group_gone(c.id());
+        let gone = !group_running(c.id());
+        let waited = start.elapsed();
+        c.wait().unwrap();
+        assert!(gone, "returned after {waited:?} with the group running");
+        assert!(
+            waited < SETTLE,
+            "waited the whole settling time, {waited:?}"
+        );
+    }
 }

@@ -168,7 +168,8 @@ fn a_small_design_is_proven_in_two_shards_and_every_part_catches_a_planted_fault
         &["direct (buffer 0 as loaded): sample", "gradient ["],
     );
     // ... and in a --direct shard, which drives its own share only: the last quarter of the
-    // samples, the pass on buffer 1 as written.
+    // samples, the pass on buffer 1 as written, where the fault is found on a gradient driven
+    // (not only reported as never driven: "samples .. were never driven").
     let o = prove(
         &d,
         &build,
@@ -178,7 +179,8 @@ fn a_small_design_is_proven_in_two_shards_and_every_part_catches_a_planted_fault
         &o,
         "direct",
         &[
-            "direct (buffer 1 written): sample",
+            "direct (buffer 1 written): sample ",
+            "gradient [",
             " 16777216 of ",
             " 67108864 inputs [50331648..67108864) ",
         ],
@@ -751,6 +753,60 @@ fn shards_reuse_one_build_of_the_same_files_and_nothing_else() {
         &prove(&dir, &shards, &["--reuse", s(&built)]),
         "states",
         &["states (buffer 0 as loaded): sample "],
+    );
+}
+
+/// A build holds the models its run needs, and says which: `--direct` builds the top alone,
+/// `--part front` the front alone. A shard reusing it runs with the models it has and is
+/// refused, in one line, a model it lacks.
+#[test]
+fn a_build_serves_the_runs_it_has_the_models_for_and_no_other() {
+    if !tools() {
+        return;
+    }
+    let tmp = helpers::tempdir();
+    let dir = tmp.path().join("d");
+    hdl::generate(&dir, &["--grad-bits", "8", "--red-bits", "6"], 0);
+    let build = tmp.path().join("build");
+    let built = build.join("d-build");
+    let shards = tmp.path().join("shards");
+    // Exit 0, with a line that starts with `says` (a build's line, or a part's that passed).
+    let ok = |o: Output, says: &str| {
+        let t = text(&o);
+        assert_eq!(o.status.code(), Some(0), "{t}");
+        assert!(
+            t.lines()
+                .any(|l| l.trim_start().starts_with(says) && !l.contains("FAILED")),
+            "{t}"
+        );
+    };
+
+    ok(
+        prove(&dir, &build, &["--direct", "--build-only"]),
+        &format!("built the Verilated top for {}", s(&dir)),
+    );
+    let shard = ["--shard", "64/64", "--reuse", s(&built)];
+    ok(
+        prove(&dir, &shards, &[&["--direct"][..], &shard].concat()),
+        "direct ",
+    );
+    helpers::assert_error(
+        &prove(&dir, &shards, &[&["--part", "front"][..], &shard].concat()),
+        "built for front engine none, not gates",
+    );
+
+    let front = ["--part", "front", "--front-engine", "verilator"];
+    ok(
+        prove(&dir, &build, &[&front[..], &["--build-only"]].concat()),
+        &format!("built the front (verilator) for {}", s(&dir)),
+    );
+    ok(
+        prove(&dir, &shards, &[&front[..], &shard].concat()),
+        "front (verilator) ",
+    );
+    helpers::assert_error(
+        &prove(&dir, &shards, &[&["--part", "states"][..], &shard].concat()),
+        "the build has no Verilated top",
     );
 }
 
