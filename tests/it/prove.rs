@@ -11,7 +11,7 @@ use crate::hdl::{self, require};
 use crate::helpers;
 use rmapgen::config::Config;
 use rmapgen::grid;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Output;
 
 fn text(o: &Output) -> String {
@@ -80,6 +80,15 @@ fn corrupt_entry(dir: &Path, file: &str, entry: usize) {
         })
         .collect();
     std::fs::write(&p, lines.join("\n") + "\n").unwrap();
+}
+
+/// The design of issue 31's reproduction (G = 8, R = 6), generated into `d` of a fresh
+/// temporary directory.
+fn issue_design() -> (tempfile::TempDir, PathBuf) {
+    let tmp = helpers::tempdir();
+    let dir = tmp.path().join("d");
+    hdl::generate(&dir, &["--grad-bits", "8", "--red-bits", "6"], 0);
+    (tmp, dir)
 }
 
 /// The front's engines (`--front-engine`); each must catch the front's planted faults.
@@ -637,9 +646,7 @@ fn a_flipped_rom_bit_fails_the_factored_proof_and_the_edited_file_is_named() {
     if !tools() {
         return;
     }
-    let tmp = helpers::tempdir();
-    let dir = tmp.path().join("d");
-    hdl::generate(&dir, &["--grad-bits", "8", "--red-bits", "6"], 0);
+    let (tmp, dir) = issue_design();
     let p = dir.join("recip_rom.hex");
     let text = std::fs::read_to_string(&p).unwrap();
     let flipped: Vec<String> = text
@@ -689,9 +696,7 @@ fn shards_reuse_one_build_of_the_same_files_and_nothing_else() {
     if !tools() {
         return;
     }
-    let tmp = helpers::tempdir();
-    let dir = tmp.path().join("d");
-    hdl::generate(&dir, &["--grad-bits", "8", "--red-bits", "6"], 0);
+    let (tmp, dir) = issue_design();
     let build = tmp.path().join("build");
     let o = prove(&dir, &build, &["--build-only"]);
     let t = text(&o);
@@ -764,9 +769,7 @@ fn a_build_serves_the_runs_it_has_the_models_for_and_no_other() {
     if !tools() {
         return;
     }
-    let tmp = helpers::tempdir();
-    let dir = tmp.path().join("d");
-    hdl::generate(&dir, &["--grad-bits", "8", "--red-bits", "6"], 0);
+    let (tmp, dir) = issue_design();
     let build = tmp.path().join("build");
     let built = build.join("d-build");
     let shards = tmp.path().join("shards");
@@ -818,9 +821,7 @@ fn a_single_changed_entry_of_every_memory_class_fails_the_states() {
     if !tools() {
         return;
     }
-    let tmp = helpers::tempdir();
-    let dir = tmp.path().join("d");
-    hdl::generate(&dir, &["--grad-bits", "8", "--red-bits", "6"], 0);
+    let (tmp, dir) = issue_design();
     let build = tmp.path().join("build");
     // (file, entry, the pass that must see it). A bank holds 1,024 entries: address
     // {buf, axis, s_max, s_u, i_u >> 1, s_v, i_v >> 1}, 512 a buffer; entry 100 is axis 0.
