@@ -523,7 +523,7 @@ mod tests {
         assert!(decode("+1 X 7").is_none());
     }
 
-    /// A process group in its own group, as the tools rmapgen starts are.
+    /// A child in a process group of its own, as every tool rmapgen starts is.
     fn in_own_group(args: &[&str]) -> std::process::Child {
         use std::os::unix::process::CommandExt;
         std::process::Command::new(args[0])
