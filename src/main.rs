@@ -111,6 +111,8 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         .map_err(|e| anyhow::anyhow!("cannot install the signal handler: {e}"))?;
     // ... and, with every child process, when rmapgen is killed outright (SIGKILL).
     rmapgen::output::signals::install_guardian();
+    // The progress lines' period, checked before any work (src/cmd/progress.rs).
+    cmd::progress::every()?;
     // Commands that check a design exit 1 when the design fails the check; the others have
     // only success and bad input.
     let done = |r: anyhow::Result<()>| r.map(|()| ExitCode::SUCCESS);

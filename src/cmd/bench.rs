@@ -5,7 +5,6 @@ use crate::bench::{self, Options};
 use crate::output::StagedDir;
 use anyhow::Result;
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 
 /// Smallest sphere image side of the error figures (`--size`); the largest is
@@ -117,17 +116,12 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         scenes,
         fits: a.map.map_fit.map_or(bench::FITS.to_vec(), |f| vec![f]),
     };
-    let bar = ProgressBar::new(opts.steps() as u64);
-    bar.set_style(
-        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} {msg}")
-            .expect("valid template")
-            .progress_chars("=> "),
-    );
+    let bar = super::progress::Progress::total("bench", opts.steps() as u64, "steps");
     let rows = bench::run(&opts, &|msg| {
-        bar.set_message(msg.to_string());
+        bar.step(msg);
         bar.inc(1);
     });
-    bar.finish_and_clear();
+    drop(bar);
     let rows = rows?;
     bench::write(&rows, &out)?;
     let p = out.commit()?;

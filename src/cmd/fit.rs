@@ -10,10 +10,7 @@ use crate::fit::target::Target;
 use crate::fit::{self, CostKind, Options};
 use anyhow::Result;
 use clap::Args;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::PathBuf;
-use std::sync::Mutex;
-use std::time::{Duration, Instant};
 
 /// Smallest sphere image side `fit` measures on (`--size`): below it too few pixels fall in
 /// each map cell for the error to mean much. The largest is [`crate::render::MAX_SIZE`].
@@ -187,28 +184,12 @@ pub fn run(a: &FitArgs) -> Result<()> {
             compensation: a.compensation.as_deref().map(|c| c == "on"),
         },
     };
-    // A progress bar, shown once the search has run for a second (on a terminal).
-    let bar = ProgressBar::with_draw_target(Some(0), ProgressDrawTarget::hidden());
-    bar.set_style(
-        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} {msg}")
-            .expect("valid template")
-            .progress_chars("=> "),
-    );
-    let start = Instant::now();
-    let shown = Mutex::new(false);
+    // A progress bar, shown on a terminal once the search has run for a second.
+    let bar = super::progress::Progress::tasks("fit", 1);
     let outcome = fit::search(&scene, &opts, &|done, total, msg| {
-        bar.set_length(total as u64);
-        bar.set_position(done as u64);
-        bar.set_message(msg.to_string());
-        let mut s = shown.lock().expect("progress");
-        if !*s && start.elapsed() > Duration::from_secs(1) {
-            *s = true;
-            bar.set_draw_target(ProgressDrawTarget::stderr());
-            // The clock moves while one candidate is synthesised or measured for long.
-            bar.enable_steady_tick(Duration::from_millis(250));
-        }
+        bar.task(done as u64, total as u64, msg)
     });
-    bar.finish_and_clear();
+    drop(bar);
     let d = match outcome? {
         Outcome::Found(d) => d,
         Outcome::Unreachable(u) => anyhow::bail!(u.message(&scene_file.to_string())),

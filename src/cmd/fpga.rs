@@ -148,7 +148,7 @@ fn flow(
 ) -> Result<fpga::FpgaReport> {
     let logs = opts.logs.as_deref().expect("a log directory");
     // The steps on a terminal: synthesis takes seconds, place and route up to a minute.
-    let steps = super::progress::Steps::new();
+    let steps = super::progress::Progress::steps("fpga");
     let step = |what: &str| steps.step(what);
     let (what, report) = match (&a.dir, cfg) {
         (Some(d), _) => (d.display().to_string(), fpga::run_dir_with(d, opts, &step)?),

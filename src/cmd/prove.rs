@@ -11,7 +11,6 @@ use crate::output::{absolute, StagedDir, StagedFile};
 use crate::prove::{self, report, FrontEngine, Options, Shard};
 use anyhow::{Context, Result};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -145,13 +144,9 @@ pub fn run(a: &ProveArgs) -> Result<ExitCode> {
     ));
     let staged = StagedDir::new(&target, &policy)?;
     let build = absolute(staged.path());
-    let bar = ProgressBar::new_spinner();
-    bar.set_style(
-        ProgressStyle::with_template("{elapsed_precise} {human_pos} inputs ({per_sec})")
-            .expect("valid template"),
-    );
+    let bar = super::progress::Progress::count("prove", "inputs");
     let result = prove::run(&design, &build, &opts, &|n| bar.inc(n));
-    bar.finish_and_clear();
+    drop(bar);
     let (_, r) = staged.commit_with(result)?;
     crate::out!("{}", r.summary())?;
     if let Some(f) = out {
@@ -183,7 +178,7 @@ fn slurm(a: &ProveArgs, design: &DesignDir, policy: &crate::output::Policy) -> R
     let layout = prove::slurm::Layout {
         root: absolute(&root),
     };
-    let steps = super::progress::Steps::new();
+    let steps = super::progress::Progress::steps("prove");
     let outcome = prove::slurm::run(
         design,
         &layout,

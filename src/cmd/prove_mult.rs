@@ -79,7 +79,7 @@ pub fn run(a: &ProveMultArgs) -> Result<ExitCode> {
         known_trees(&jobs, &a.tree)?;
         engines(&jobs, a.engine)?;
         need_yosys()?;
-        let steps = super::progress::Steps::new();
+        let steps = super::progress::Progress::steps("prove-mult");
         steps.step(&format!(
             "proving {} multiplier{} of {}",
             jobs.len(),
@@ -126,7 +126,7 @@ fn matrix(a: &ProveMultArgs, rows: &[GridRow]) -> Result<bool> {
     let out: Mutex<Vec<Option<Result<Proof>>>> =
         Mutex::new((0..rows.len()).map(|_| None).collect());
     let start = Instant::now();
-    let steps = super::progress::Steps::new();
+    let steps = super::progress::Progress::steps("prove-mult");
     steps.step(&format!("proving the multipliers of {} rows", rows.len()));
     std::thread::scope(|s| {
         for _ in 0..workers {

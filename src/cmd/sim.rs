@@ -175,7 +175,7 @@ fn simulate(design: &DesignDir, a: &SimArgs, opts: &Options) -> Result<Outcome> 
     )?;
     // The first line that cannot be printed stops nothing of the run, but is its error.
     let mut report = Lines {
-        steps: super::progress::Steps::new(),
+        steps: super::progress::Progress::steps("sim"),
         printed: Ok(()),
     };
     let result = sim::run(design, &build, &absolute(&target), opts, &mut report);
@@ -189,7 +189,7 @@ fn simulate(design: &DesignDir, a: &SimArgs, opts: &Options) -> Result<Outcome> 
 
 /// The run's lines on stdout, and the step under way on a terminal's stderr.
 struct Lines {
-    steps: super::progress::Steps,
+    steps: super::progress::Progress,
     printed: Result<()>,
 }
 

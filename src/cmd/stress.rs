@@ -7,7 +7,6 @@ use crate::output::StagedFile;
 use crate::stress::{self, exhaustive, Report, Setup};
 use anyhow::Result;
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 
 #[derive(Args, Debug)]
@@ -50,28 +49,18 @@ pub fn run(a: &StressArgs) -> Result<()> {
     };
     let setup = Setup::new(&cfg, &scene, scene.maps(&cfg));
     let report = if a.exhaustive {
-        let bar = ProgressBar::new(1u64 << (3 * cfg.grad_bits.min(exhaustive::MAX_GRAD_BITS)));
-        bar.set_style(
-            ProgressStyle::with_template(
-                "{elapsed_precise} [{bar:40}] {percent}% {human_pos}/{human_len} inputs, eta {eta}",
-            )
-            .expect("valid template")
-            .progress_chars("=> "),
+        let bar = super::progress::Progress::total(
+            "stress",
+            1u64 << (3 * cfg.grad_bits.min(exhaustive::MAX_GRAD_BITS)),
+            "inputs",
         );
         let r = exhaustive::run(&setup, &|n| bar.inc(n));
-        bar.finish_and_clear();
+        drop(bar);
         r?
     } else {
-        let bar = ProgressBar::new(a.samples);
-        bar.set_style(
-            ProgressStyle::with_template(
-                "{elapsed_precise} [{bar:40}] {percent}% {human_pos}/{human_len} samples, eta {eta}",
-            )
-            .expect("valid template")
-            .progress_chars("=> "),
-        );
+        let bar = super::progress::Progress::total("stress", a.samples, "samples");
         let r = stress::sampled_with_progress(&setup, a.samples, a.seed, &|n| bar.inc(n));
-        bar.finish_and_clear();
+        drop(bar);
         r
     };
     crate::out!("{}", summary(&report))?;

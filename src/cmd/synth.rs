@@ -44,7 +44,7 @@ pub fn run(a: &SynthArgs) -> Result<ExitCode> {
     };
     let staged = StagedDir::new(&a.logs, &a.force.policy(&[Some(design.path())]))?;
     let logs = absolute(staged.path());
-    let steps = super::progress::Steps::new();
+    let steps = super::progress::Progress::steps("synth");
     steps.step(&format!(
         "synthesising {} with Yosys {}",
         design.top,

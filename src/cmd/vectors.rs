@@ -9,7 +9,6 @@ use crate::scene::Scene;
 use crate::vectors::{self, MapSet};
 use anyhow::Result;
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
@@ -67,19 +66,16 @@ pub fn run(a: &VectorsArgs) -> Result<()> {
         need,
         &format!("--count {}: {}", a.count, a.out.display()),
     )?;
-    let bar = ProgressBar::new(vectors::top_stream_lines(&cfg, a.count as u64));
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{elapsed_precise} [{bar:40}] {percent}% {human_pos}/{human_len} vectors, eta {eta}",
-        )
-        .expect("valid template")
-        .progress_chars("=> "),
+    let bar = super::progress::Progress::total(
+        "vectors",
+        vectors::top_stream_lines(&cfg, a.count as u64),
+        "vectors",
     );
     let written =
         vectors::write_top_stream_with_progress(&cfg, &maps, out.path(), a.count, a.seed, &|k| {
             bar.inc(k)
         });
-    bar.finish_and_clear();
+    drop(bar);
     let n = written.map_err(|e| out.name_target(e))?;
     out.commit()?;
     crate::errln!(

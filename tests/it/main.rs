@@ -32,6 +32,7 @@ mod mult_proof;
 mod nothing_left;
 mod output_safety;
 mod prefix;
+mod progress;
 mod prove;
 mod readme;
 mod render;
