@@ -633,6 +633,24 @@ fpga-throughput: build venv
 	@WITH_FPGA=1 scripts/install-tools.sh
 	YOSYS=$(YOSYS) $(ECP5_ENV) $(GOWIN_ENV) $(RMAPGEN) bench --throughput --lanes $(TP_LANES) --family $(TP_FAMILIES) --mult $(TP_MULTS) --seeds $(TP_SEEDS) --out $(TP_DIR) --force
 
+# ---- The README's hardware table (src/bench/datasheet.rs): the throughput sweeps behind it run
+# again into $(HW_BUILD), their tables copied into docs/bench/hardware/<sweep>/ (one-lane: the
+# default design on each family's default part, the design `rmapgen fpga --family F` places;
+# eight-lanes: the ECP5's throughput row, every ROM read replicated, out of context), then the
+# README's table rendered from them. A benchmark, not in make test (about an hour on 2 cores:
+# eight ECP5 lanes take minutes a seed); the cargo tests check that the README's table is the
+# rendering of the committed sweeps, and that they measured the current design's memories.
+HW_BUILD ?= build/hardware
+HW_SEEDS ?= 5
+HW_SWEEPS = one-lane eight-lanes
+.PHONY: readme-hardware
+readme-hardware: build venv
+	@WITH_FPGA=1 scripts/install-tools.sh
+	YOSYS=$(YOSYS) $(ECP5_ENV) $(GOWIN_ENV) $(RMAPGEN) bench --throughput --layout family --lanes 1 --family ice40,ecp5,gowin --mult tree --seeds $(HW_SEEDS) --out $(HW_BUILD)/one-lane --force
+	$(ECP5_ENV) $(RMAPGEN) bench --throughput --layout replicated --lanes 8 --family ecp5 --mult tree --seeds $(HW_SEEDS) --out $(HW_BUILD)/eight-lanes --force
+	for d in $(HW_SWEEPS); do mkdir -p docs/bench/hardware/$$d && for f in json md csv; do cp $(HW_BUILD)/$$d/throughput.$$f docs/bench/hardware/$$d/ || exit 1; done; done
+	RMAPGEN_WRITE_README=1 $(CARGO) test --release --test it readme::the_readme_hardware_table
+
 # ---- Gate-level sign-off (rmapgen sim --gate): the default design for the iCE40 (--target
 # ice40, what fpga places) generated into $(GATE_OUT), its top synthesised with Yosys
 # synth_ice40 (the flow of fpga, its netlist written with write_verilog -noattr) and simulated

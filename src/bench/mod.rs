@@ -11,6 +11,7 @@
 //! on a scene's Pareto front when no other row of that scene is at least as good in both error
 //! (RMSE) and cost (bits), or in both error and one-thread speed.
 
+pub mod datasheet;
 pub mod fpga;
 pub mod octahedral;
 pub mod pareto;

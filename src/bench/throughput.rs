@@ -1,7 +1,8 @@
 //! `rmapgen bench --throughput` (`make fpga-throughput`): shaded samples per second on real
 //! parts. For every lane count × family × multiplier style, the design (the default
-//! configuration with `lanes` set, generated with `--target ice40`, as `rmapgen fpga` builds
-//! it) is synthesised once and placed and routed once per seed; the row gives the median
+//! configuration with `lanes` set, generated with every ROM read replicated, or with
+//! `--layout family` for the family's own `--target`, as `rmapgen fpga` builds it) is
+//! synthesised once and placed and routed once per seed; the row gives the median
 //! post-route Fmax over the seeds, samples/s = lanes × that median, logic cells, LUT4s,
 //! flip-flops, block RAMs and DSP blocks, and the critical path of the median seed. A design
 //! that needs more of the part than it has is a row saying so ("does not fit"), not an error.
@@ -28,6 +29,47 @@ use anyhow::{Context, Result};
 use serde::Serialize;
 use std::path::Path;
 
+/// Which design a row places.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum Layout {
+    /// Every ROM read with a copy of its own, on every family ([`replicated`]): each family's
+    /// rows place the same design.
+    #[default]
+    Replicated,
+    /// Each family's own design (`--target <family>`), the one `rmapgen fpga --family F`
+    /// places: its block RAM's read ports shared where it has two.
+    Family,
+}
+
+impl Layout {
+    /// As `--layout` spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Layout::Replicated => "replicated",
+            Layout::Family => "family",
+        }
+    }
+
+    /// The target a row of `family` is generated for.
+    pub fn target(self, family: Family) -> Target {
+        match self {
+            Layout::Replicated => replicated(),
+            Layout::Family => Target::Family(family),
+        }
+    }
+}
+
 /// What to sweep.
 #[derive(Clone, Debug)]
 pub struct Sweep {
@@ -39,6 +81,8 @@ pub struct Sweep {
     pub seeds: Vec<u64>,
     /// The clock the placer aims at, MHz.
     pub freq_mhz: f64,
+    /// The design each row places.
+    pub layout: Layout,
 }
 
 /// The lane counts of the full sweep.
@@ -62,21 +106,25 @@ impl Default for Sweep {
             mults: MULTS.to_vec(),
             seeds: (1..=SEEDS).collect(),
             freq_mhz: FREQ_MHZ,
+            layout: Layout::default(),
         }
     }
 }
 
 /// One placed seed.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct Seed {
     pub seed: u64,
     pub fmax_mhz: f64,
 }
 
 /// One configuration of the sweep.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct Row {
     pub family: Family,
+    /// The design it places (absent in tables written before 2026-12-07: replicated).
+    #[serde(default)]
+    pub layout: Layout,
     pub device: String,
     pub package: String,
     pub out_of_context: bool,
@@ -144,7 +192,7 @@ pub fn run(sweep: &Sweep, out: &StagedDir, progress: &dyn Fn(&str)) -> Result<Ve
                     mult,
                     ..Config::default()
                 }
-                .for_target(replicated());
+                .for_target(sweep.layout.target(family));
                 cfg.validate()?;
                 let name = format!("{}-l{lanes}-{}", family.name(), mult.name());
                 let logs = out.path().join(&name);
@@ -180,6 +228,7 @@ fn configuration(
     opts.logs = Some(logs.to_path_buf());
     let mut row = Row {
         family,
+        layout: sweep.layout,
         device: opts.device.clone(),
         package: opts.package.clone(),
         out_of_context: opts.out_of_context,
@@ -287,8 +336,8 @@ pub fn best(rows: &[Row]) -> Option<&Row> {
 }
 
 /// The header of the Markdown table.
-const HEADER: &str = "| family | part | placed | lanes | mult | Fmax median (MHz) | Fmax per seed (MHz) | samples/s | logic cells | LUT4 | flip-flops | block RAMs | DSP | memory bits per lane |\n\
-     |---|---|---|---:|---|---:|---|---:|---:|---:|---:|---:|---:|---:|\n";
+const HEADER: &str = "| family | part | placed | lanes | mult | design | Fmax median (MHz) | Fmax per seed (MHz) | samples/s | logic cells | LUT4 | flip-flops | block RAMs | DSP | memory bits per lane |\n\
+     |---|---|---|---:|---|---|---:|---|---:|---:|---:|---:|---:|---:|---:|\n";
 
 /// How a row was placed, as its column says it.
 fn placed(r: &Row) -> &'static str {
@@ -302,13 +351,14 @@ fn placed(r: &Row) -> &'static str {
 /// One row of the Markdown table, with its line end.
 pub fn line(r: &Row) -> String {
     let head = format!(
-        "| {} | {} {} | {} | {} | {} |",
+        "| {} | {} {} | {} | {} | {} | {} |",
         r.family.title(),
         r.device,
         r.package,
         placed(r),
         r.lanes,
-        r.mult.name()
+        r.mult.name(),
+        r.layout.name()
     );
     match (&r.report, r.fmax_mhz, r.samples_per_s) {
         (Some(p), Some(f), Some(sps)) => {
@@ -372,7 +422,7 @@ pub fn markdown(rows: &[Row]) -> String {
 
 /// The rows as CSV with a header line.
 pub fn csv(rows: &[Row]) -> String {
-    let mut s = String::from("family,device,package,out_of_context,lanes,mult,fits,fmax_mhz_median,fmax_mhz_seeds,samples_per_s,logic_cells,luts,flip_flops,block_rams,dsps,memory_bits,memory_bits_per_lane\n");
+    let mut s = String::from("family,device,package,out_of_context,lanes,mult,layout,fits,fmax_mhz_median,fmax_mhz_seeds,samples_per_s,logic_cells,luts,flip_flops,block_rams,dsps,memory_bits,memory_bits_per_lane\n");
     for r in rows {
         let p = r.report.as_ref();
         let seeds: Vec<String> = r
@@ -382,13 +432,14 @@ pub fn csv(rows: &[Row]) -> String {
             .collect();
         let n = |f: fn(&FpgaReport) -> u32| p.map_or(String::new(), |p| f(p).to_string());
         s += &format!(
-            "{},{},{},{},{},{},{},{},\"{}\",{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},\"{}\",{},{},{},{},{},{},{},{}\n",
             r.family.name(),
             r.device,
             r.package,
             r.out_of_context,
             r.lanes,
             r.mult.name(),
+            r.layout.name(),
             r.does_not_fit.is_none(),
             r.fmax_mhz.map_or(String::new(), |f| format!("{f:.2}")),
             seeds.join(" "),
@@ -420,6 +471,7 @@ mod tests {
     fn row(family: Family, lanes: u32, mult: Mult, out_of_context: bool) -> Row {
         Row {
             family,
+            layout: Layout::Replicated,
             device: "85k".into(),
             package: "CABGA381".into(),
             out_of_context,
@@ -441,11 +493,11 @@ mod tests {
         r.does_not_fit = Some("no BELs".into());
         let l = line(&r);
         assert!(
-            l.starts_with("| ECP5 | 85k CABGA381 | out of context (more port bits than pins) | 8 | infer | does not fit |"),
+            l.starts_with("| ECP5 | 85k CABGA381 | out of context (more port bits than pins) | 8 | infer | replicated | does not fit |"),
             "{l}"
         );
         let l = line(&row(Family::Ecp5, 1, Mult::Tree, false));
-        assert!(l.contains("| in context | 1 | tree |"), "{l}");
+        assert!(l.contains("| in context | 1 | tree | replicated |"), "{l}");
         // Every line has the header's columns.
         let md = markdown(&[r.clone(), row(Family::Ice40, 2, Mult::Tree, false)]);
         let bars: Vec<usize> = md.lines().take(4).map(|x| x.matches('|').count()).collect();
@@ -459,7 +511,7 @@ mod tests {
             c.lines()
                 .nth(1)
                 .unwrap()
-                .starts_with("ecp5,85k,CABGA381,true,8,infer,false,"),
+                .starts_with("ecp5,85k,CABGA381,true,8,infer,replicated,false,"),
             "{c}"
         );
     }

@@ -66,6 +66,11 @@ pub struct BenchArgs {
     /// Placer seeds of the throughput sweep, 1..=N [default: 5].
     #[arg(long, value_name = "N", requires = "throughput", value_parser = super::parse::whole::<u64>(1, MAX_SEEDS))]
     pub seeds: Option<u64>,
+    /// The design each row of the throughput sweep places: every ROM read with a copy of its
+    /// own on every family (replicated), or the family's own `--target` design, the one
+    /// `rmapgen fpga --family F` places (family) [default: replicated].
+    #[arg(long, value_enum, requires = "throughput")]
+    pub layout: Option<crate::bench::throughput::Layout>,
 }
 
 pub fn run(a: &BenchArgs) -> Result<()> {
@@ -155,6 +160,7 @@ fn throughput(a: &BenchArgs) -> Result<()> {
         },
         seeds: a.seeds.map_or(d.seeds, |n| (1..=n).collect()),
         freq_mhz: d.freq_mhz,
+        layout: a.layout.unwrap_or(d.layout),
     };
     // A value named twice would be a row measured twice into the same log directory.
     fn once<T: PartialEq + std::fmt::Debug>(flag: &str, v: &[T]) -> Result<()> {

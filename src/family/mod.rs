@@ -16,7 +16,18 @@ mod ice40;
 
 /// An FPGA family, as `--family` and the `target` of a design spell it. What it is comes from
 /// its [`Descriptor`] ([`Family::get`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, clap::ValueEnum)]
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    Hash,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Family {
     /// Lattice iCE40 (HX8K in ct256 by default): Debian's yosys `synth_ice40` and

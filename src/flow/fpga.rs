@@ -77,7 +77,7 @@ impl Options {
 }
 
 /// One memory of the manifest and the block RAMs that hold it.
-#[derive(Clone, Debug, Serialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize, PartialEq)]
 pub struct MemoryPlacement {
     pub instance: String,
     pub bits: u64,
@@ -87,7 +87,7 @@ pub struct MemoryPlacement {
 }
 
 /// The slowest register-to-register path after routing.
-#[derive(Clone, Debug, Serialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize, PartialEq)]
 pub struct CriticalPath {
     /// The signal (net or register) the path starts from and the one it ends at.
     pub from: String,
@@ -98,8 +98,9 @@ pub struct CriticalPath {
     pub routing_ns: f64,
 }
 
-/// What the flow measured.
-#[derive(Clone, Debug, Serialize, PartialEq)]
+/// What the flow measured (read back from a benchmark's committed table by the README's
+/// hardware table, bench::datasheet).
+#[derive(Clone, Debug, Serialize, serde::Deserialize, PartialEq)]
 pub struct FpgaReport {
     pub family: Family,
     pub device: String,

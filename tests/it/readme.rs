@@ -81,3 +81,47 @@ fn the_readme_scene_is_the_standard_scene() {
     let file = Scene::from_toml_file(&helpers::root().join("scenes/standard.toml")).unwrap();
     assert_eq!(shown.named(""), file.named(""));
 }
+
+/// The README's hardware table is the rendering of the committed sweeps that measured it
+/// (docs/bench/hardware, issue 60: no figure typed), and they measured the current design:
+/// each row's memory bits are those of the configuration it names. `make readme-hardware` runs
+/// the sweeps again and writes the table (RMAPGEN_WRITE_README=1 makes this test write it).
+#[test]
+fn the_readme_hardware_table_is_the_committed_sweeps() {
+    use rmapgen::bench::datasheet;
+    use rmapgen::config::Config;
+    let root = helpers::root();
+    let rows = datasheet::load(&root.join(datasheet::DIR)).unwrap();
+    assert!(!rows.is_empty(), "no sweep in {}", datasheet::DIR);
+    for r in &rows {
+        let cfg = Config {
+            lanes: r.lanes,
+            mult: r.mult,
+            ..Config::default()
+        }
+        .for_target(r.layout.target(r.family));
+        let bits: u64 = rmapgen::emit::manifest::memories(&cfg)
+            .iter()
+            .map(|m| m.bits)
+            .sum();
+        assert_eq!(
+            r.memory_bits,
+            bits,
+            "the {} row ({} lanes) measured another design: run make readme-hardware",
+            r.family.title(),
+            r.lanes
+        );
+    }
+    let path = root.join("README.md");
+    let readme = std::fs::read_to_string(&path).unwrap();
+    let want = datasheet::with_table(&readme, &datasheet::table(&rows)).unwrap();
+    if std::env::var_os("RMAPGEN_WRITE_README").is_some() {
+        std::fs::write(&path, &want).unwrap();
+        return;
+    }
+    assert!(
+        readme == want,
+        "README.md's hardware table is not the committed sweeps' (make readme-hardware writes it):\n{}",
+        datasheet::table(&rows)
+    );
+}
