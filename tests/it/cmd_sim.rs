@@ -621,7 +621,16 @@ fn sim_shows_its_steps_on_a_terminal_only() {
     assert!(tty.contains("icarus zero_detect_tb (compile)"), "{tty}");
     assert!(tty.contains("00:00:0"), "{tty}");
     assert!(tty.contains("ok:   icarus zero_detect_tb: "), "{tty}");
-    let o = helpers::run(&[
+    // In a script: no spinner. (Its plain lines, every RMAPGEN_PROGRESS seconds, are
+    // tests/it/progress.rs's; off here, so that a slow machine does not print one.)
+    let quiet = |args: &[&str]| {
+        helpers::rmapgen()
+            .args(args)
+            .env("RMAPGEN_PROGRESS", "0")
+            .output()
+            .expect("rmapgen runs")
+    };
+    let o = quiet(&[
         "sim",
         "--icarus",
         "--only",
@@ -646,7 +655,7 @@ fn sim_shows_its_steps_on_a_terminal_only() {
             tty.contains("synthesising rmap_top with Yosys synth_ice40"),
             "{tty}"
         );
-        let o = helpers::run(&["synth", "--logs", s(&logs), "--force", s(&dir)]);
+        let o = quiet(&["synth", "--logs", s(&logs), "--force", s(&dir)]);
         assert!(o.status.success());
         assert_eq!(text(&o).1, "");
     }
