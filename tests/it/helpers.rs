@@ -4,9 +4,14 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-/// The built `rmapgen` binary.
+/// The built `rmapgen` binary, with its plain progress lines off (`RMAPGEN_PROGRESS=0`): on a
+/// slow machine a long command would otherwise print one every 10 s, and the tests that count
+/// the lines of an error or compare a command's output would depend on the machine's speed.
+/// The tests of progress itself set the variable again.
 pub fn rmapgen() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_rmapgen"))
+    let mut c = Command::new(env!("CARGO_BIN_EXE_rmapgen"));
+    c.env("RMAPGEN_PROGRESS", "0");
+    c
 }
 
 /// Runs rmapgen with arguments and returns its output.
