@@ -27,6 +27,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import urllib.error
 import urllib.request
 import zlib
 from pathlib import Path
@@ -202,22 +203,34 @@ def main() -> int:
             g = ", ".join(str(c) for c in m["worst"]["gradient"])
             if f"gradient ({g})" not in head:
                 errors.append(f"the trace is of another gradient: {head!r}, want ({g})")
-            # The configuration the page saves: what generate --config reads.
+            # The configuration the page saves: what generate --config reads. The API answers
+            # the page's token and nothing else.
             rid = page.evaluate("() => document.body.dataset.renderId")
-            saved = urllib.request.urlopen(f"{url}api/config.toml?id={rid}").read().decode()
+            token = page.eval_on_selector('meta[name="rmapgen-token"]', "e => e.content")
+            get = lambda path: urllib.request.urlopen(urllib.request.Request(
+                f"{url}{path}", headers={"X-Rmapgen-Token": token})).read()
+            try:
+                urllib.request.urlopen(f"{url}api/config.toml?id={rid}")
+                errors.append("the API answered a request without the token")
+            except urllib.error.HTTPError as e:
+                if e.code != 403:
+                    errors.append(f"without the token the API answered {e.code}, not 403")
+            saved = get(f"api/config.toml?id={rid}").decode()
             if f"index_bits = {ib + 1}" not in saved.splitlines():
                 errors.append(f"the saved config.toml has not index_bits = {ib + 1}:\n{saved}")
             with page.expect_download() as dl:
                 page.click("#save-config")
             if dl.value.suggested_filename != "config.toml":
                 errors.append(f"the save button saves {dl.value.suggested_filename}")
+            elif Path(dl.value.path()).read_text() != saved:
+                errors.append("the save button's config.toml is not the API's")
             # The volume: the engine block, as `rmapgen volume --synthetic` renders it from the
             # configuration and scene the page saves.
             page.select_option("#object", "volume")
             third = wait_render(page, rid)
             cfg_file, scene_file = tmp / "v-config.toml", tmp / "v-scene.toml"
             for f, what in ((cfg_file, "config"), (scene_file, "scene")):
-                f.write_bytes(urllib.request.urlopen(f"{url}api/{what}.toml?id={third}").read())
+                f.write_bytes(get(f"api/{what}.toml?id={third}"))
             vol = tmp / "volume"
             subprocess.run([a.rmapgen, "volume", "--synthetic", "--config", str(cfg_file),
                             "--scene", str(scene_file), "--size", str(size), "--out", str(vol),
