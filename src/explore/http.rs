@@ -128,27 +128,32 @@ impl Reply {
     }
 }
 
-/// The reason phrase of every status the explorer sends.
+/// Every status the explorer sends, with its reason phrase (docs/EXPLORE.md's status table
+/// is checked against this list).
+pub const STATUSES: &[(u16, &str)] = &[
+    (200, "OK"),
+    (204, "No Content"),
+    (400, "Bad Request"),
+    (403, "Forbidden"),
+    (404, "Not Found"),
+    (405, "Method Not Allowed"),
+    (408, "Request Timeout"),
+    (411, "Length Required"),
+    (413, "Content Too Large"),
+    (415, "Unsupported Media Type"),
+    (421, "Misdirected Request"),
+    (431, "Request Header Fields Too Large"),
+    (500, "Internal Server Error"),
+    (501, "Not Implemented"),
+    (503, "Service Unavailable"),
+];
+
+/// The reason phrase of `status` (one of [`STATUSES`]).
 fn reason(status: u16) -> &'static str {
-    match status {
-        200 => "OK",
-        204 => "No Content",
-        400 => "Bad Request",
-        403 => "Forbidden",
-        404 => "Not Found",
-        405 => "Method Not Allowed",
-        408 => "Request Timeout",
-        411 => "Length Required",
-        413 => "Content Too Large",
-        415 => "Unsupported Media Type",
-        421 => "Misdirected Request",
-        431 => "Request Header Fields Too Large",
-        500 => "Internal Server Error",
-        501 => "Not Implemented",
-        503 => "Service Unavailable",
-        505 => "HTTP Version Not Supported",
-        _ => "Status",
-    }
+    STATUSES
+        .iter()
+        .find(|s| s.0 == status)
+        .map_or("Unknown", |s| s.1)
 }
 
 /// What the server asks of the application.
