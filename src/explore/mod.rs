@@ -103,8 +103,8 @@ enum Object {
 
 /// A finished render of either object.
 enum Shown {
-    Sphere(Render),
-    Volume(VolumeRender, Arc<Prepared<'static>>),
+    Sphere(Box<Render>),
+    Volume(Box<VolumeRender>, Arc<Prepared<'static>>),
 }
 
 impl Shown {
@@ -407,7 +407,13 @@ impl Explorer {
                 }
                 let (summary, metrics) = (render.summary(), serde_json::to_value(&render.metrics)?);
                 let worst = serde_json::to_value(render.worst())?;
-                (Shown::Sphere(render), maps, summary, metrics, worst)
+                (
+                    Shown::Sphere(Box::new(render)),
+                    maps,
+                    summary,
+                    metrics,
+                    worst,
+                )
             }
             Object::Volume => {
                 let opts = CastOptions {
@@ -427,7 +433,13 @@ impl Explorer {
                 let maps = p.vol.shading_scene(&scene).maps(&cfg);
                 let (summary, metrics) = (render.summary(), serde_json::to_value(&render.metrics)?);
                 let worst = serde_json::to_value(render.worst())?;
-                (Shown::Volume(render, p), maps, summary, metrics, worst)
+                (
+                    Shown::Volume(Box::new(render), p),
+                    maps,
+                    summary,
+                    metrics,
+                    worst,
+                )
             }
         };
         let addr = |name: &str| format!("/img/{id}/{name}");

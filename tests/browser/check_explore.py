@@ -18,7 +18,8 @@ for the new render. It checks:
   scene it saves (pixels and bytes), and a click on its worst pixel lists the samples of that
   pixel's ray and traces the heaviest: i_o equal to that sample's intensity in the list.
 Before that it shows that the check can fail: against the render of the configuration before
-the slider moved, the image must be refused. Exit 0 when all pass, 1 when not, 2 for bad input.
+the slider moved, the image must be refused. Last, a slow render (the fitted table) is stopped
+with the page's button, and the page must say it was. Exit 0 when all pass, 1 when not, 2 for bad input.
 """
 
 import argparse
@@ -250,6 +251,21 @@ def main() -> int:
             if f"model {vm['worst']['model']}," not in head:
                 errors.append(f"volume: the trace is not of the worst pixel (model {vm['worst']['model']}): {head!r}")
             errors += [f"the page logged an error: {e}" for e in logged]
+            # A slow render (the fitted table) stopped with the page's button: the page says
+            # why (the 503 it answers is logged by the browser, and expected).
+            page.select_option("#comp_table", "ram")
+            wait_render(page, page.evaluate("() => document.body.dataset.renderId"))
+            page.select_option("#map_fit", "table")
+            stopped = None
+            for _ in range(600):
+                if page.is_visible("#stop"):
+                    page.click("#stop")
+                stopped = page.evaluate("() => document.body.dataset.error || null")
+                if stopped:
+                    break
+                page.wait_for_timeout(100)
+            if stopped != "cancelled: stopped by a request to /api/cancel":
+                errors.append(f"the stop button: the page says {stopped!r}")
             browser.close()
             print(f"check_explore: renders {first} and {second}, index_bits {ib} -> {ib + 1}; "
                   f"traced ({wx}, {wy}): i_o = {i_o}; volume render {third}, pixel ({vx}, {vy}) "
