@@ -36,6 +36,31 @@ pub const WRITE_TIMEOUT: Duration = Duration::from_secs(10);
 pub const LINGER: Duration = Duration::from_secs(1);
 pub const LINGER_BYTES: u64 = 1 << 20;
 
+/// The bounds a server reads requests under: the constants above, and the largest body.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Bounds {
+    pub max_body: u64,
+    pub connections: usize,
+    pub deadline: Duration,
+    pub write_timeout: Duration,
+    pub linger: Duration,
+    pub linger_bytes: u64,
+}
+
+impl Bounds {
+    /// The constants above, bodies of at most `max_body` bytes.
+    pub const fn new(max_body: u64) -> Bounds {
+        Bounds {
+            max_body,
+            connections: MAX_CONNECTIONS,
+            deadline: REQUEST_DEADLINE,
+            write_timeout: WRITE_TIMEOUT,
+            linger: LINGER,
+            linger_bytes: LINGER_BYTES,
+        }
+    }
+}
+
 /// A request's line and headers.
 #[derive(Debug, Clone)]
 pub struct Head {
@@ -165,11 +190,11 @@ pub trait Handler: Send + Sync + 'static {
     fn answer(&self, head: &Head, body: Vec<u8>) -> Reply;
 }
 
-/// Serves `listener` with `handler` until the process ends; bodies of at most `max_body`
-/// bytes. Returns only if accepting fails for a reason other than a client's.
+/// Serves `listener` with `handler` under `bounds` until the process ends. Returns only if
+/// accepting fails for a reason other than a client's.
 pub fn serve<H: Handler>(
     listener: TcpListener,
-    max_body: u64,
+    bounds: Bounds,
     handler: Arc<H>,
 ) -> std::io::Result<()> {
     let live = Arc::new(AtomicUsize::new(0));
@@ -187,9 +212,9 @@ pub fn serve<H: Handler>(
             }
             Err(e) => return Err(e),
         };
-        if live.fetch_add(1, Ordering::SeqCst) >= MAX_CONNECTIONS {
+        if live.fetch_add(1, Ordering::SeqCst) >= bounds.connections {
             live.fetch_sub(1, Ordering::SeqCst);
-            busy(stream);
+            busy(stream, bounds.connections);
             continue;
         }
         let slot = Slot(live.clone());
@@ -198,7 +223,7 @@ pub fn serve<H: Handler>(
             .name("rmapgen-explore-conn".into())
             .spawn(move || {
                 let _slot = slot;
-                connection(stream, max_body, &*h);
+                connection(stream, &bounds, &*h);
             });
         // The closure (and its slot) is dropped if the thread could not start.
         drop(spawned);
@@ -230,13 +255,13 @@ impl Drop for Slot {
 
 /// The answer to a connection beyond [`MAX_CONNECTIONS`], written from the accepting thread
 /// without reading anything (it fits the socket's buffer; the write cannot wait long).
-fn busy(mut stream: TcpStream) {
+fn busy(mut stream: TcpStream, connections: usize) {
     stream
         .set_write_timeout(Some(Duration::from_millis(100)))
         .ok();
     let r = Reply::error(
         503,
-        &format!("busy: {MAX_CONNECTIONS} connections are open; try again"),
+        &format!("busy: {connections} connections are open; try again"),
     )
     .with_header("Retry-After", "1".into());
     stream.write_all(&r.bytes()).ok();
@@ -252,13 +277,16 @@ enum Bad {
 }
 
 /// One connection: its request read under the bounds, judged, answered, closed.
-fn connection(mut stream: TcpStream, max_body: u64, handler: &dyn Handler) {
+fn connection(mut stream: TcpStream, bounds: &Bounds, handler: &dyn Handler) {
     stream.set_nodelay(true).ok();
-    if stream.set_write_timeout(Some(WRITE_TIMEOUT)).is_err() {
+    if stream
+        .set_write_timeout(Some(bounds.write_timeout))
+        .is_err()
+    {
         return;
     }
-    let deadline = Instant::now() + REQUEST_DEADLINE;
-    let (reply, unread) = match request(&mut stream, max_body, deadline, handler) {
+    let deadline = Instant::now() + bounds.deadline;
+    let (reply, unread) = match request(&mut stream, bounds, deadline, handler) {
         Ok(reply) => (reply, false),
         Err(Bad::Gone) => return,
         Err(Bad::Answer(reply)) => (reply, true),
@@ -269,15 +297,15 @@ fn connection(mut stream: TcpStream, max_body: u64, handler: &dyn Handler) {
     }
     stream.shutdown(Shutdown::Write).ok();
     if unread {
-        linger(&mut stream);
+        linger(&mut stream, bounds);
     }
 }
 
-/// Reads and discards what the client still sends, for at most [`LINGER`] and
-/// [`LINGER_BYTES`], then returns (and the connection closes).
-fn linger(stream: &mut TcpStream) {
-    let end = Instant::now() + LINGER;
-    let mut left = LINGER_BYTES;
+/// Reads and discards what the client still sends, for at most the bounds' linger time and
+/// bytes ([`LINGER`], [`LINGER_BYTES`]), then returns (and the connection closes).
+fn linger(stream: &mut TcpStream, bounds: &Bounds) {
+    let end = Instant::now() + bounds.linger;
+    let mut left = bounds.linger_bytes;
     let mut buf = [0u8; 8192];
     while left > 0 {
         let now = Instant::now();
@@ -295,12 +323,14 @@ fn linger(stream: &mut TcpStream) {
 /// body then unread).
 fn request(
     stream: &mut TcpStream,
-    max_body: u64,
+    bounds: &Bounds,
     deadline: Instant,
     handler: &dyn Handler,
 ) -> Result<Reply, Bad> {
+    let max_body = bounds.max_body;
+    let late = || late(bounds);
     let mut buf = Vec::with_capacity(2048);
-    let end = read_head(stream, &mut buf, deadline)?;
+    let end = read_head(stream, &mut buf, deadline, &late)?;
     let head = parse_head(&buf[..end]).map_err(|m| Bad::Answer(Reply::error(400, &m)))?;
     handler.admit(&head).map_err(Bad::Answer)?;
     if head.all("transfer-encoding").next().is_some() {
@@ -333,24 +363,31 @@ fn request(
     let mut chunk = [0u8; 8192];
     while body.len() < length as usize {
         let want = (length as usize - body.len()).min(chunk.len());
-        let n = timed_read(stream, &mut chunk[..want], deadline)?;
+        let n = timed_read(stream, &mut chunk[..want], deadline, &late)?;
         body.extend_from_slice(&chunk[..n]);
     }
     Ok(handler.answer(&head, body))
 }
 
-/// One read of at most `buf.len()` bytes before `deadline`; `Err` on the deadline (408), an
-/// early close or an error.
-fn timed_read(stream: &mut TcpStream, buf: &mut [u8], deadline: Instant) -> Result<usize, Bad> {
-    let timeout = || {
-        Bad::Answer(Reply::error(
-            408,
-            &format!(
-                "the request did not arrive whole within {} s",
-                REQUEST_DEADLINE.as_secs()
-            ),
-        ))
-    };
+/// The answer to a request not whole by its deadline.
+fn late(bounds: &Bounds) -> Bad {
+    Bad::Answer(Reply::error(
+        408,
+        &format!(
+            "the request did not arrive whole within {} s",
+            bounds.deadline.as_secs_f64()
+        ),
+    ))
+}
+
+/// One read of at most `buf.len()` bytes before `deadline`; `Err` on the deadline (`timeout`,
+/// 408), an early close or an error.
+fn timed_read(
+    stream: &mut TcpStream,
+    buf: &mut [u8],
+    deadline: Instant,
+    timeout: &dyn Fn() -> Bad,
+) -> Result<usize, Bad> {
     loop {
         let now = Instant::now();
         if now >= deadline {
@@ -373,7 +410,12 @@ fn timed_read(stream: &mut TcpStream, buf: &mut [u8], deadline: Instant) -> Resu
 
 /// Reads until the blank line that ends the head; its offset in `buf` (the body's first
 /// bytes may follow it in `buf`).
-fn read_head(stream: &mut TcpStream, buf: &mut Vec<u8>, deadline: Instant) -> Result<usize, Bad> {
+fn read_head(
+    stream: &mut TcpStream,
+    buf: &mut Vec<u8>,
+    deadline: Instant,
+    timeout: &dyn Fn() -> Bad,
+) -> Result<usize, Bad> {
     let mut chunk = [0u8; 2048];
     loop {
         if let Some(i) = find_end(buf) {
@@ -386,7 +428,7 @@ fn read_head(stream: &mut TcpStream, buf: &mut Vec<u8>, deadline: Instant) -> Re
             )));
         }
         let room = (MAX_HEAD - buf.len()).min(chunk.len());
-        let n = timed_read(stream, &mut chunk[..room], deadline)?;
+        let n = timed_read(stream, &mut chunk[..room], deadline, timeout)?;
         buf.extend_from_slice(&chunk[..n]);
     }
 }
@@ -525,5 +567,266 @@ mod tests {
         assert_eq!(find_end(&at), Some(MAX_HEAD - 4));
         at.insert(0, b'a');
         assert_eq!(find_end(&at), None);
+    }
+
+    /// A handler that refuses a head with `x-refuse`, and answers the method, the path and
+    /// the body's length.
+    struct Echo;
+
+    impl Handler for Echo {
+        fn admit(&self, head: &Head) -> Result<(), Reply> {
+            match head.one("x-refuse") {
+                Ok(None) => Ok(()),
+                _ => Err(Reply::error(403, "refused")),
+            }
+        }
+
+        fn answer(&self, head: &Head, body: Vec<u8>) -> Reply {
+            let text = format!("{} {} {}", head.method, head.path(), body.len());
+            Reply::new(200, "text/plain", text.into_bytes())
+        }
+    }
+
+    const TEST: Bounds = Bounds {
+        max_body: 100,
+        connections: 3,
+        deadline: Duration::from_millis(500),
+        write_timeout: Duration::from_secs(5),
+        linger: Duration::from_millis(300),
+        linger_bytes: 1 << 20,
+    };
+
+    /// A server of [`Echo`] under `bounds`; its address.
+    fn echo(bounds: Bounds) -> String {
+        let l = TcpListener::bind(("127.0.0.1", 0)).unwrap();
+        let addr = l.local_addr().unwrap().to_string();
+        std::thread::spawn(move || serve(l, bounds, Arc::new(Echo)));
+        addr
+    }
+
+    /// The whole answer to `request` (the server closes after it), within a minute.
+    fn ask(addr: &str, request: &[u8]) -> String {
+        let mut c = TcpStream::connect(addr).unwrap();
+        c.write_all(request).unwrap();
+        read_all(&mut c)
+    }
+
+    fn read_all(c: &mut TcpStream) -> String {
+        c.set_read_timeout(Some(Duration::from_secs(60))).unwrap();
+        let mut buf = Vec::new();
+        c.read_to_end(&mut buf).unwrap();
+        String::from_utf8_lossy(&buf).into_owned()
+    }
+
+    fn post(len: u64) -> String {
+        format!("POST /p HTTP/1.1\r\nContent-Length: {len}\r\n\r\n")
+    }
+
+    #[test]
+    fn a_request_is_read_whole_and_answered_once() {
+        let a = echo(TEST);
+        let got = ask(&a, format!("{}{}", post(5), "hello and more").as_bytes());
+        assert!(got.starts_with("HTTP/1.1 200 OK\r\n"), "{got}");
+        assert!(
+            got.contains("\r\nContent-Length: 9\r\n") && got.contains("Connection: close"),
+            "{got}"
+        );
+        assert!(got.ends_with("\r\n\r\nPOST /p 5"), "{got}");
+        // The body in several reads; a GET without a length has none.
+        let mut c = TcpStream::connect(&a).unwrap();
+        c.write_all(post(100).as_bytes()).unwrap();
+        for _ in 0..10 {
+            std::thread::sleep(Duration::from_millis(10));
+            c.write_all(&[b'x'; 10]).unwrap();
+        }
+        assert!(read_all(&mut c).ends_with("POST /p 100"));
+        assert!(ask(&a, b"GET /g?q=1 HTTP/1.0\r\n\r\n").ends_with("GET /g 0"));
+    }
+
+    #[test]
+    fn a_body_over_the_bound_is_refused_from_its_length_and_never_read() {
+        let a = echo(TEST);
+        // At the bound: read. One over: refused, whatever follows.
+        let at = format!("{}{}", post(100), "x".repeat(100));
+        assert!(ask(&a, at.as_bytes()).ends_with("POST /p 100"));
+        let got = ask(&a, format!("{}{}", post(101), "x".repeat(101)).as_bytes());
+        assert!(
+            got.starts_with("HTTP/1.1 413 Content Too Large\r\n"),
+            "{got}"
+        );
+        assert!(
+            got.contains("at most 100 bytes; this one says 101"),
+            "{got}"
+        );
+        // 99,999,999,999 announced and a client that keeps sending: the answer arrives, and
+        // the connection closes after the linger, long before the body could.
+        let mut c = TcpStream::connect(&a).unwrap();
+        c.write_all(post(99_999_999_999).as_bytes()).unwrap();
+        let mut w = c.try_clone().unwrap();
+        let t = Instant::now();
+        let sender = std::thread::spawn(move || {
+            let chunk = vec![0u8; 1 << 16];
+            let mut sent = 0u64;
+            while t.elapsed() < Duration::from_secs(30) && w.write_all(&chunk).is_ok() {
+                sent += chunk.len() as u64;
+            }
+            sent
+        });
+        let got = read_all(&mut c);
+        assert!(got.starts_with("HTTP/1.1 413"), "{got}");
+        let sent = sender.join().unwrap();
+        assert!(t.elapsed() < Duration::from_secs(30), "{:?}", t.elapsed());
+        // The linger read at most its bytes (and the kernel's buffers hold a few more).
+        assert!(sent < 64 << 20, "{sent} bytes taken");
+        assert!(ask(&a, b"GET / HTTP/1.1\r\n\r\n").ends_with("GET / 0"));
+    }
+
+    #[test]
+    fn the_handler_judges_the_head_before_the_body_is_read() {
+        let a = echo(TEST);
+        let got = ask(
+            &a,
+            b"POST /p HTTP/1.1\r\nX-Refuse: 1\r\nContent-Length: 99999999999\r\n\r\n",
+        );
+        assert!(got.starts_with("HTTP/1.1 403 Forbidden\r\n"), "{got}");
+        // Refused before its framing is judged too.
+        let got = ask(
+            &a,
+            b"POST /p HTTP/1.1\r\nX-Refuse: 1\r\nTransfer-Encoding: chunked\r\n\r\n",
+        );
+        assert!(got.starts_with("HTTP/1.1 403"), "{got}");
+    }
+
+    #[test]
+    fn framing_the_server_does_not_take_is_refused() {
+        let a = echo(TEST);
+        for (req, status) in [
+            (
+                &b"POST /p HTTP/1.1\r\nTransfer-Encoding: chunked\r\n\r\n0\r\n\r\n"[..],
+                "501 Not Implemented",
+            ),
+            (b"POST /p HTTP/1.1\r\n\r\n", "411 Length Required"),
+            (
+                b"POST /p HTTP/1.1\r\nContent-Length: 1\r\nContent-Length: 2\r\n\r\nab",
+                "400 Bad Request",
+            ),
+            (
+                b"POST /p HTTP/1.1\r\nContent-Length: 0x10\r\n\r\n",
+                "400 Bad Request",
+            ),
+            (b"GET / HTTP/2\r\n\r\n", "400 Bad Request"),
+        ] {
+            let got = ask(&a, req);
+            assert!(got.starts_with(&format!("HTTP/1.1 {status}\r\n")), "{got}");
+        }
+        // A head of exactly the bound is read; one byte more is refused.
+        let pad = |n: usize| format!("GET / HTTP/1.1\r\nX: {}\r\n\r\n", "a".repeat(n));
+        let base = pad(0).len();
+        assert!(ask(&a, pad(MAX_HEAD - base).as_bytes()).ends_with("GET / 0"));
+        let got = ask(&a, pad(MAX_HEAD - base + 1).as_bytes());
+        assert!(
+            got.starts_with("HTTP/1.1 431 Request Header Fields Too Large\r\n"),
+            "{got}"
+        );
+        assert!(got.contains(&format!("exceed {MAX_HEAD} bytes")), "{got}");
+    }
+
+    #[test]
+    fn a_slow_client_is_answered_408_at_its_deadline_and_holds_no_one_else() {
+        let a = echo(TEST);
+        // A head and a body sent a byte every 100 ms: each longer than the deadline.
+        let slow = |first: String, more: usize| {
+            let mut c = TcpStream::connect(&a).unwrap();
+            std::thread::spawn(move || {
+                let t = Instant::now();
+                c.write_all(first.as_bytes()).unwrap();
+                for _ in 0..more {
+                    std::thread::sleep(Duration::from_millis(100));
+                    if c.write_all(b"x").is_err() {
+                        break;
+                    }
+                }
+                (read_all(&mut c), t.elapsed())
+            })
+        };
+        let body = slow(post(50), 50);
+        let head = slow("GET / HTTP/1.1\r\nX: ".into(), 50);
+        std::thread::sleep(Duration::from_millis(100));
+        assert!(ask(&a, b"GET /other HTTP/1.1\r\n\r\n").ends_with("GET /other 0"));
+        assert!(!body.is_finished() && !head.is_finished());
+        for h in [body, head] {
+            let (got, took) = h.join().unwrap();
+            assert!(got.starts_with("HTTP/1.1 408 Request Timeout\r\n"), "{got}");
+            assert!(got.contains("within 0.5 s"), "{got}");
+            assert!(
+                took >= TEST.deadline && took < Duration::from_secs(4),
+                "{took:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn connections_beyond_the_bound_are_told_busy_and_the_slots_come_back() {
+        let a = echo(TEST);
+        let idle: Vec<TcpStream> = (0..TEST.connections)
+            .map(|_| TcpStream::connect(&a).unwrap())
+            .collect();
+        let got = ask(&a, b"GET / HTTP/1.1\r\n\r\n");
+        assert!(
+            got.starts_with("HTTP/1.1 503 Service Unavailable\r\n"),
+            "{got}"
+        );
+        assert!(
+            got.contains("busy: 3 connections are open") && got.contains("Retry-After: 1"),
+            "{got}"
+        );
+        // A client that leaves early frees its slot; so does one that says nothing until
+        // its deadline.
+        drop(idle);
+        let t = Instant::now();
+        while !ask(&a, b"GET / HTTP/1.1\r\n\r\n").ends_with("GET / 0") {
+            assert!(
+                t.elapsed() < Duration::from_secs(10),
+                "the slots stayed taken"
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let silent: Vec<TcpStream> = (0..TEST.connections)
+            .map(|_| TcpStream::connect(&a).unwrap())
+            .collect();
+        let t = Instant::now();
+        while !ask(&a, b"GET / HTTP/1.1\r\n\r\n").ends_with("GET / 0") {
+            assert!(
+                t.elapsed() < Duration::from_secs(10),
+                "the silent ones kept their slots"
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        // Not before their deadline.
+        assert!(
+            t.elapsed() >= TEST.deadline - Duration::from_millis(100),
+            "{:?}",
+            t.elapsed()
+        );
+        drop(silent);
+    }
+
+    #[test]
+    fn every_status_sent_has_its_reason() {
+        for &(code, phrase) in STATUSES {
+            assert_eq!(reason(code), phrase);
+            let r = Reply::error(code, "x").bytes();
+            assert!(String::from_utf8(r)
+                .unwrap()
+                .starts_with(&format!("HTTP/1.1 {code} {phrase}\r\n")));
+        }
+        assert_eq!(reason(299), "Unknown");
+        let mut r = Reply::new(200, "text/toml", b"a = 1".to_vec()).with_header("X-A", "b".into());
+        r.attachment = Some("f.toml");
+        let text = String::from_utf8(r.bytes()).unwrap();
+        assert_eq!(
+            text,
+            "HTTP/1.1 200 OK\r\nContent-Type: text/toml\r\nContent-Length: 5\r\nCache-Control: no-store\r\nX-Content-Type-Options: nosniff\r\nConnection: close\r\nContent-Disposition: attachment; filename=\"f.toml\"\r\nX-A: b\r\n\r\na = 1"
+        );
     }
 }

@@ -630,7 +630,7 @@ pub fn serve_within(
         explorer: Explorer::new(0, limits)?,
     };
     ready(&format!("http://{addr}/"))?;
-    http::serve(listener, MAX_BODY, Arc::new(server))?;
+    http::serve(listener, http::Bounds::new(MAX_BODY), Arc::new(server))?;
     Ok(())
 }
 
