@@ -54,10 +54,12 @@ use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
 use std::time::{Duration, Instant};
 
 /// The page: fields, images, the trace table (no external resources). Served with the
-/// process's token in place of [`TOKEN_SLOT`].
+/// process's token in place of [`TOKEN_SLOT`] and its header's name in place of
+/// [`TOKEN_HEADER_SLOT`].
 pub const PAGE: &str = include_str!("page.html");
-/// Where the page carries the token.
+/// Where the page carries the token, and the header it sends it in.
 pub const TOKEN_SLOT: &str = "__RMAPGEN_TOKEN__";
+pub const TOKEN_HEADER_SLOT: &str = "__RMAPGEN_TOKEN_HEADER__";
 
 /// Largest request body: a configuration and a scene are a few hundred bytes.
 pub const MAX_BODY: u64 = 64 << 10;
@@ -601,7 +603,9 @@ fn page(token: &str) -> Reply {
     Reply::new(
         200,
         "text/html; charset=utf-8",
-        PAGE.replace(TOKEN_SLOT, token).into_bytes(),
+        PAGE.replace(TOKEN_HEADER_SLOT, guard::TOKEN_HEADER)
+            .replace(TOKEN_SLOT, token)
+            .into_bytes(),
     )
     .with_header(
         "Content-Security-Policy",
@@ -854,6 +858,22 @@ mod tests {
         );
         assert_eq!(ex.answer("DELETE", "/", b"").status, 405);
         assert_eq!(ex.answer("GET", "/nothing", b"").status, 404);
+    }
+
+    /// The page carries the token and the header to send it in, every slot filled, and may
+    /// not be framed.
+    #[test]
+    fn the_page_carries_its_token() {
+        let r = page("0123abcd");
+        let text = String::from_utf8(r.body).unwrap();
+        assert!(text.contains(r#"content="0123abcd" data-header="X-Rmapgen-Token""#));
+        assert!(!text.contains("__RMAPGEN"), "a slot left unfilled");
+        let csp = r
+            .headers
+            .iter()
+            .find(|h| h.0 == "Content-Security-Policy")
+            .unwrap();
+        assert!(csp.1.contains("frame-ancestors 'none'"));
     }
 
     #[test]

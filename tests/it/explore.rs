@@ -35,7 +35,11 @@ fn start(limits: Limits) -> Server {
             Ok(())
         })
     });
-    let url = rx.recv().unwrap();
+    at(&rx.recv().unwrap())
+}
+
+/// The server at `url` (as `explore` prints it), with the token read from its page.
+fn at(url: &str) -> Server {
     let addr = url
         .trim_start_matches("http://")
         .trim_end_matches('/')
@@ -662,18 +666,7 @@ fn the_explore_command_stops_on_a_signal_during_a_render() {
     std::io::BufReader::new(child.0.stdout.take().unwrap())
         .read_line(&mut line)
         .unwrap();
-    let url = line.split_whitespace().nth(1).unwrap().to_string();
-    let addr = url
-        .trim_start_matches("http://")
-        .trim_end_matches('/')
-        .to_string();
-    let mut s = Server {
-        addr,
-        token: String::new(),
-    };
-    let page = s.raw(&format!("GET / HTTP/1.1\r\nHost: {}\r\n\r\n", s.addr));
-    let at = page.text.find("name=\"rmapgen-token\" content=\"").unwrap() + 30;
-    s.token = page.text[at..at + 32].to_string();
+    let s = at(line.split_whitespace().nth(1).unwrap());
     let s = std::sync::Arc::new(s);
     let s2 = s.clone();
     // The slow render's answer as bytes: none when the process ends under it.
