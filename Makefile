@@ -484,6 +484,7 @@ mutants-default: build
 #   prove    src/prove but its engines (parts, shards, reports, --merge)
 #   output   src/output (what rmapgen writes and removes)
 #   model    src/model (the golden model)
+#   explore  the explorer's server: its bounds, guard, cost model and runner, and src/cancel.rs
 # Each mutant is built in the `mutants` profile (opt-level 1: 3-30 s to rebuild the crate
 # here, against 23-60 s at the dev profile's opt-level 2) and judged by nextest, which stops
 # at the first failing test, in two passes (scripts/rust-mutants.sh): every mutant with the
@@ -508,11 +509,13 @@ RUST_MUTANTS_FILES_output  := -f 'src/output/**'
 RUST_MUTANTS_TESTS_output  := output_safety|flag_and_path_errors|nothing_left|init_files|stdout
 RUST_MUTANTS_FILES_model   := -f 'src/model/**'
 RUST_MUTANTS_TESTS_model   := rtl_generate|model_stages|vectors|symmetry|stability|fast|map_fit|compare
+RUST_MUTANTS_FILES_explore := -f 'src/explore/**' -e src/explore/mod.rs -f src/cancel.rs
+RUST_MUTANTS_TESTS_explore := explore|limits
 
 .PHONY: rust-mutants
 rust-mutants:
 	@test -n "$(RUST_MUTANTS_FILES_$(RUST_MUTANTS_GROUP))" || \
-	  { echo "RUST_MUTANTS_GROUP=$(RUST_MUTANTS_GROUP): not one of engines aig prove output model"; exit 2; }
+	  { echo "RUST_MUTANTS_GROUP=$(RUST_MUTANTS_GROUP): not one of engines aig prove output model explore"; exit 2; }
 	command -v cargo-mutants >/dev/null || $(CARGO) install cargo-mutants --locked --version 27.1.0
 	command -v cargo-nextest >/dev/null || $(CARGO) install cargo-nextest --locked
 	CARGO="$(CARGO)" scripts/rust-mutants.sh build/rust-mutants/$(RUST_MUTANTS_GROUP) $(RUST_MUTANTS_SHARD) \

@@ -2,6 +2,7 @@
 //! Terwisscha van Scheltinga, Smit and Bosma, with the bit-accurate model that checks it.
 
 pub mod bench;
+pub mod cancel;
 pub mod cmd;
 pub mod config;
 pub mod design;

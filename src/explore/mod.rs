@@ -18,15 +18,26 @@
 //! `/api/scene.toml` are the files `generate --config` and `--scene` (or `volume --scene`)
 //! read.
 //!
+//! The server is a server (docs/EXPLORE.md, "The API"): [`http`] reads every request under
+//! bounds, one thread per connection; [`guard`] admits only the explorer's own page (Host,
+//! token, Origin, JSON); [`cost`] refuses a render whose measured cost exceeds the budget,
+//! and [`runner`] runs the others one at a time off the serving threads, cancelled past their
+//! time or memory ([`LIMITS`]).
+//!
 //! Bounds: a request body of at most [`MAX_BODY`] bytes, images of at most [`MAX_SIZE`]
 //! pixels a side, at most [`MAX_LIGHTS`] lights, and the last [`KEPT`] renders kept.
+
+pub mod cost;
+pub mod guard;
+pub mod http;
+pub mod runner;
 
 use crate::config::{Config, RANGES};
 use crate::model::map_fit::MapFit;
 use crate::model::{MapSet, Model};
 use crate::render::{images, Options, Render};
 use crate::scene::Scene;
-use crate::toml_input::without_place;
+use crate::toml_input::{one_line, without_place};
 use crate::volume::cast::options::CastOptions;
 use crate::volume::prepared::Prepared;
 use crate::volume::renderer::Renderer;
@@ -34,15 +45,21 @@ use crate::volume::report::VolumeRender;
 use crate::volume::shear::Classified;
 use crate::volume::{synthetic, Volume};
 use anyhow::{anyhow, bail, Context, Result};
+use http::{Head, Reply};
+use runner::{Limits, Runner, Stopped};
 use serde::Serialize;
 use serde_json::{json, Value};
 use std::collections::VecDeque;
-use std::io::Read;
-use std::sync::OnceLock;
-use std::time::Instant;
+use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
+use std::time::{Duration, Instant};
 
-/// The page: fields, images, the trace table (no external resources).
+/// The page: fields, images, the trace table (no external resources). Served with the
+/// process's token in place of [`TOKEN_SLOT`] and its header's name in place of
+/// [`TOKEN_HEADER_SLOT`].
 pub const PAGE: &str = include_str!("page.html");
+/// Where the page carries the token, and the header it sends it in.
+pub const TOKEN_SLOT: &str = "__RMAPGEN_TOKEN__";
+pub const TOKEN_HEADER_SLOT: &str = "__RMAPGEN_TOKEN_HEADER__";
 
 /// Largest request body: a configuration and a scene are a few hundred bytes.
 pub const MAX_BODY: u64 = 64 << 10;
@@ -55,6 +72,12 @@ pub const MAX_SIZE: u32 = 512;
 pub const MAX_LIGHTS: usize = 8;
 /// Renders kept for their images and traces (the page shows the last).
 pub const KEPT: usize = 4;
+/// A render's budget: cancelled past this time, or past this growth of the process's
+/// memory. [`cost`] refuses up front what it predicts will not fit.
+pub const LIMITS: Limits = Limits {
+    seconds: Duration::from_secs(30),
+    memory: 2 << 30,
+};
 
 /// The volume the page shows: the synthetic engine block at its default size
 /// ([`synthetic::DIMS`], unit spacing), as `rmapgen volume --synthetic` builds it; built on
@@ -82,22 +105,22 @@ enum Object {
 
 /// A finished render of either object.
 enum Shown {
-    Sphere(Render),
-    Volume(VolumeRender),
+    Sphere(Box<Render>),
+    Volume(Box<VolumeRender>, Arc<Prepared<'static>>),
 }
 
 impl Shown {
     fn cfg(&self) -> &Config {
         match self {
             Shown::Sphere(r) => &r.cfg,
-            Shown::Volume(r) => &r.cfg,
+            Shown::Volume(r, _) => &r.cfg,
         }
     }
 
     fn scene(&self) -> &Scene {
         match self {
             Shown::Sphere(r) => &r.scene,
-            Shown::Volume(r) => &r.scene,
+            Shown::Volume(r, _) => &r.scene,
         }
     }
 }
@@ -113,36 +136,24 @@ struct Kept {
     files: Vec<(&'static str, Vec<u8>)>,
 }
 
-/// The explorer's state: the last renders, and the engine block's gradients and bricks for
-/// the last gradient width.
+/// The renders kept, and the next render's id.
 #[derive(Default)]
-pub struct Explorer {
+struct Kepts {
     next: u64,
-    kept: VecDeque<Kept>,
-    prepared: Option<(u32, Prepared<'static>)>,
+    kept: VecDeque<Arc<Kept>>,
 }
 
-/// An answer: status, content type, body and an optional file name to save it as.
-pub struct Reply {
-    pub status: u16,
-    pub kind: &'static str,
-    pub body: Vec<u8>,
-    pub attachment: Option<&'static str>,
+/// The explorer: the last renders, the engine block's gradients and bricks for the last
+/// gradient width, and the runner of renders. Every request is answered through `&self`,
+/// from any number of threads; renders go one at a time through the runner.
+pub struct Explorer {
+    kept: Mutex<Kepts>,
+    prepared: Mutex<Option<(u32, Arc<Prepared<'static>>)>>,
+    runner: Runner,
 }
 
-impl Reply {
-    fn json(status: u16, v: &Value) -> Reply {
-        Reply {
-            status,
-            kind: "application/json",
-            body: v.to_string().into_bytes(),
-            attachment: None,
-        }
-    }
-
-    fn error(status: u16, msg: &str) -> Reply {
-        Reply::json(status, &json!({ "error": msg }))
-    }
+fn json_reply(status: u16, v: &Value) -> Reply {
+    Reply::new(status, "application/json", v.to_string().into_bytes())
 }
 
 /// The page's fields: the configuration as `config.toml` has it, the scene as `scene.toml`
@@ -163,7 +174,6 @@ fn toml_text(fields: &serde_json::Map<String, Value>, what: &str) -> Result<Stri
         toml::Value::try_from(Value::Object(fields.clone())).map_err(|e| anyhow!("{what}: {e}"))?;
     toml::to_string(&v).map_err(|e| anyhow!("{what}: {e}"))
 }
-
 /// The configuration and the scene of the page's fields, checked as their files are.
 fn parse(ask: &Ask) -> Result<(Config, Scene)> {
     let c = toml_text(&ask.config, "config")?;
@@ -255,8 +265,22 @@ struct RaySample {
 }
 
 impl Explorer {
-    /// Answers one request: `method`, the path with its query, and the body.
-    pub fn answer(&mut self, method: &str, url: &str, body: &[u8]) -> Reply {
+    /// An explorer whose renders run within `limits` on `threads` workers (0: one per core).
+    pub fn new(threads: usize, limits: Limits) -> std::io::Result<Explorer> {
+        Ok(Explorer {
+            kept: Mutex::default(),
+            prepared: Mutex::new(None),
+            runner: Runner::new(threads, limits)?,
+        })
+    }
+
+    fn kept(&self) -> MutexGuard<'_, Kepts> {
+        self.kept.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Answers one admitted request: `method`, the path with its query, and the body. The
+    /// page itself (`/`) is the server's ([`serve`]), which carries the token.
+    pub fn answer(&self, method: &str, url: &str, body: &[u8]) -> Reply {
         let (path, query) = url.split_once('?').unwrap_or((url, ""));
         let q = |k: &str| {
             query
@@ -266,28 +290,17 @@ impl Explorer {
                 .and_then(|(_, v)| v.parse::<u64>().ok())
         };
         match (method, path) {
-            ("GET", "/") => Reply {
-                status: 200,
-                kind: "text/html; charset=utf-8",
-                body: PAGE.as_bytes().to_vec(),
-                attachment: None,
-            },
-            ("GET", "/api/schema") => Reply::json(200, &schema()),
+            ("GET", "/api/schema") => json_reply(200, &schema()),
             // Browsers ask for it; there is none.
-            ("GET", "/favicon.ico") => Reply {
-                status: 204,
-                kind: "image/x-icon",
-                body: Vec::new(),
-                attachment: None,
-            },
-            ("POST", "/api/render") => match self.render(body) {
-                Ok(v) => Reply::json(200, &v),
-                Err(e) => Reply::error(400, &crate::toml_input::one_line(&format!("{e:#}"))),
-            },
+            ("GET", "/favicon.ico") => Reply::new(204, "image/x-icon", Vec::new()),
+            ("POST", "/api/render") => self.render(body),
+            ("POST", "/api/cancel") => {
+                json_reply(200, &json!({ "cancelled": self.runner.cancel() }))
+            }
             ("GET", "/api/trace") => match (q("id"), q("x"), q("y")) {
                 (Some(id), Some(x), Some(y)) => match self.trace(id, x, y) {
                     Ok(r) => r,
-                    Err(e) => Reply::error(500, &crate::toml_input::one_line(&format!("{e:#}"))),
+                    Err(e) => Reply::error(500, &one_line(&format!("{e:#}"))),
                 },
                 _ => Reply::error(400, "trace needs id, x and y"),
             },
@@ -300,12 +313,13 @@ impl Explorer {
                 } else {
                     (toml::to_string(k.shown.scene()), "scene.toml")
                 };
-                Reply {
-                    status: 200,
-                    kind: "application/toml; charset=utf-8",
-                    body: text.expect("config and scene serialise").into_bytes(),
-                    attachment: Some(name),
-                }
+                let mut r = Reply::new(
+                    200,
+                    "application/toml; charset=utf-8",
+                    text.expect("config and scene serialise").into_bytes(),
+                );
+                r.attachment = Some(name);
+                r
             }
             ("GET", p) if p.starts_with("/img/") => self.image(p),
             ("GET" | "POST", _) => Reply::error(404, "no such page"),
@@ -313,24 +327,70 @@ impl Explorer {
         }
     }
 
-    fn find(&self, id: u64) -> Option<&Kept> {
-        self.kept.iter().find(|k| k.id == id)
+    fn find(&self, id: u64) -> Option<Arc<Kept>> {
+        self.kept().kept.iter().find(|k| k.id == id).cloned()
     }
 
-    /// The engine block's gradients and bricks for `grad_bits` (kept for the last width).
-    fn prepared(&mut self, grad_bits: u32) -> Result<&Prepared<'static>> {
-        if self.prepared.as_ref().map(|p| p.0) != Some(grad_bits) {
-            self.prepared = None;
-            let p = Prepared::try_new(engine()?, grad_bits, CastOptions::default().brick)?;
-            self.prepared = Some((grad_bits, p));
+    /// The engine block's gradients and bricks for `grad_bits` (kept for the last width; a
+    /// volume render keeps its own for its traces).
+    fn prepared(&self, grad_bits: u32) -> Result<Arc<Prepared<'static>>> {
+        let mut slot = self.prepared.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((g, p)) = slot.as_ref() {
+            if *g == grad_bits {
+                return Ok(p.clone());
+            }
         }
-        Ok(&self.prepared.as_ref().expect("just prepared").1)
+        *slot = None;
+        let p = Arc::new(Prepared::try_new(
+            engine()?,
+            grad_bits,
+            CastOptions::default().brick,
+        )?);
+        *slot = Some((grad_bits, p.clone()));
+        Ok(p)
     }
 
-    fn render(&mut self, body: &[u8]) -> Result<Value> {
+    /// `POST /api/render`: the fields checked, the cost judged, the render run by the runner.
+    fn render(&self, body: &[u8]) -> Reply {
+        let checked = serde_json::from_slice::<Ask>(body)
+            .context("the request")
+            .and_then(|ask| {
+                let (cfg, scene) = parse(&ask)?;
+                cost::judge(&cfg, &scene, ask.size, ask.object == Object::Volume)?;
+                Ok((ask, cfg, scene))
+            });
+        let (ask, cfg, scene) = match checked {
+            Ok(v) => v,
+            Err(e) => return Reply::error(400, &one_line(&format!("{e:#}"))),
+        };
+        let id = {
+            let mut k = self.kept();
+            k.next += 1;
+            k.next
+        };
+        match self.runner.run(id, || self.draw(id, &ask, cfg, scene)) {
+            Ok(Ok((kept, reply))) => {
+                let mut k = self.kept();
+                k.kept.push_back(Arc::new(kept));
+                while k.kept.len() > KEPT {
+                    k.kept.pop_front();
+                }
+                json_reply(200, &reply)
+            }
+            Ok(Err(e)) => Reply::error(400, &one_line(&format!("{e:#}"))),
+            Err(stopped) => {
+                let r = Reply::error(503, &stopped.message(self.runner.limits()));
+                match stopped {
+                    Stopped::Busy { .. } => r.with_header("Retry-After", "1".into()),
+                    _ => r,
+                }
+            }
+        }
+    }
+
+    /// Render `id` of the page's fields: what is kept of it, and the answer.
+    fn draw(&self, id: u64, ask: &Ask, cfg: Config, scene: Scene) -> Result<(Kept, Value)> {
         let t = Instant::now();
-        let ask: Ask = serde_json::from_slice(body).context("the request")?;
-        let (cfg, scene) = parse(&ask)?;
         let model = Model::new(&cfg);
         let mut files = Vec::new();
         let (shown, maps, summary, metrics, worst) = match ask.object {
@@ -349,7 +409,13 @@ impl Explorer {
                 }
                 let (summary, metrics) = (render.summary(), serde_json::to_value(&render.metrics)?);
                 let worst = serde_json::to_value(render.worst())?;
-                (Shown::Sphere(render), maps, summary, metrics, worst)
+                (
+                    Shown::Sphere(Box::new(render)),
+                    maps,
+                    summary,
+                    metrics,
+                    worst,
+                )
             }
             Object::Volume => {
                 let opts = CastOptions {
@@ -357,7 +423,7 @@ impl Explorer {
                     ..CastOptions::default()
                 };
                 let p = self.prepared(cfg.grad_bits)?;
-                let render = crate::volume::report::render(p, &cfg, &scene, opts, None, false)?;
+                let render = crate::volume::report::render(&p, &cfg, &scene, opts, None, false)?;
                 crate::volume::report::check_covered(&render, p.vol)?;
                 for (name, img) in render.images() {
                     files.push((name, crate::volume::picture::png(&img)?));
@@ -369,11 +435,15 @@ impl Explorer {
                 let maps = p.vol.shading_scene(&scene).maps(&cfg);
                 let (summary, metrics) = (render.summary(), serde_json::to_value(&render.metrics)?);
                 let worst = serde_json::to_value(render.worst())?;
-                (Shown::Volume(render), maps, summary, metrics, worst)
+                (
+                    Shown::Volume(Box::new(render), p),
+                    maps,
+                    summary,
+                    metrics,
+                    worst,
+                )
             }
         };
-        self.next += 1;
-        let id = self.next;
         let addr = |name: &str| format!("/img/{id}/{name}");
         let images: serde_json::Map<String, Value> = files
             .iter()
@@ -390,7 +460,7 @@ impl Explorer {
             "rom_bits": cfg.rom_total_bits(),
             "map_bits": cfg.map_total_bits(),
         });
-        self.kept.push_back(Kept {
+        let kept = Kept {
             id,
             shown,
             model,
@@ -399,41 +469,30 @@ impl Explorer {
                 scene: maps,
             },
             files,
-        });
-        while self.kept.len() > KEPT {
-            self.kept.pop_front();
-        }
-        Ok(reply)
+        };
+        Ok((kept, reply))
     }
 
     fn image(&self, path: &str) -> Reply {
         let mut parts = path.trim_start_matches("/img/").splitn(2, '/');
         let id = parts.next().and_then(|s| s.parse::<u64>().ok());
         let name = parts.next().unwrap_or("");
-        let file = id
-            .and_then(|id| self.find(id))
-            .and_then(|k| k.files.iter().find(|(n, _)| *n == name));
-        match file {
-            Some((_, png)) => Reply {
-                status: 200,
-                kind: "image/png",
-                body: png.clone(),
-                attachment: None,
-            },
+        let Some(k) = id.and_then(|id| self.find(id)) else {
+            return Reply::error(404, "no such image");
+        };
+        match k.files.iter().find(|(n, _)| *n == name) {
+            Some((_, png)) => Reply::new(200, "image/png", png.clone()),
             None => Reply::error(404, "no such image"),
         }
     }
 
-    fn trace(&mut self, id: u64, x: u64, y: u64) -> Result<Reply> {
+    fn trace(&self, id: u64, x: u64, y: u64) -> Result<Reply> {
         let Some(k) = self.find(id) else {
             return Ok(Reply::error(404, "no such render"));
         };
         let r = match &k.shown {
             Shown::Sphere(r) => r,
-            Shown::Volume(v) => {
-                let (cfg, scene, opts) = (v.cfg.clone(), v.scene.clone(), v.opts);
-                return self.trace_volume(id, &cfg, &scene, opts, x, y);
-            }
+            Shown::Volume(v, p) => return trace_volume(&k, v, p, x, y),
         };
         let Some(i) = r
             .pixels
@@ -461,110 +520,122 @@ impl Explorer {
             samples: None,
             alpha: None,
         };
-        Ok(Reply::json(200, &serde_json::to_value(p)?))
+        Ok(json_reply(200, &serde_json::to_value(p)?))
+    }
+}
+
+/// A volume pixel: the samples its ray composites (marched again by the same caster, view
+/// and options, through the render's own prepared volume), and the path of the one of
+/// largest weight.
+fn trace_volume(
+    k: &Kept,
+    v: &VolumeRender,
+    p: &Prepared<'static>,
+    x: u64,
+    y: u64,
+) -> Result<Reply> {
+    let (cfg, scene, opts) = (&v.cfg, &v.scene, v.opts);
+    let n = opts.size as u64;
+    if x >= n || y >= n {
+        return Ok(Reply::error(
+            404,
+            &format!("pixel ({x}, {y}) is outside the {n}x{n} image"),
+        ));
+    }
+    let (shading, (alpha, samples)) = {
+        let classified = Classified::new(p, crate::volume::report::scene_transfer(scene)?)?;
+        let caster = Renderer::new(&classified, scene.view.direction, opts)?;
+        let ray = caster.pixel(x as u32, y as u32);
+        (p.vol.shading_scene(scene), ray.unwrap_or((0.0, Vec::new())))
+    };
+    let reference = crate::reference::Reference::new(cfg, &shading);
+    let i = (y * n + x) as usize;
+    let Some(&(_, g)) = samples.iter().max_by(|a, b| a.0.total_cmp(&b.0)) else {
+        return Ok(Reply::error(
+            404,
+            &format!("pixel ({x}, {y}) shows no part of the volume"),
+        ));
+    };
+    let maps = &k.maps.scene;
+    let list = samples
+        .iter()
+        .map(|&(weight, gradient)| RaySample {
+            weight,
+            gradient,
+            model: k.model.intensity(maps, gradient),
+            reference: reference.intensity(gradient),
+        })
+        .collect();
+    let reply = PathReply {
+        x: x as u32,
+        y: y as u32,
+        gradient: g,
+        model: v.model[i],
+        reference: v.reference.as_ref().map_or(0, |r| r[i]),
+        signals: crate::stages::path(&k.model, &k.maps, 0, g, [0; 3]),
+        samples: Some(list),
+        alpha: Some(alpha),
+    };
+    Ok(json_reply(200, &serde_json::to_value(reply)?))
+}
+
+/// The server: its guard, and the explorer behind it.
+struct Server {
+    guard: guard::Guard,
+    explorer: Explorer,
+}
+
+impl http::Handler for Server {
+    fn admit(&self, head: &Head) -> std::result::Result<(), Reply> {
+        self.guard.admit(head)
     }
 
-    /// A volume pixel: the samples its ray composites (marched again by the same caster,
-    /// view and options), and the path of the one of largest weight.
-    fn trace_volume(
-        &mut self,
-        id: u64,
-        cfg: &Config,
-        scene: &Scene,
-        opts: CastOptions,
-        x: u64,
-        y: u64,
-    ) -> Result<Reply> {
-        let n = opts.size as u64;
-        if x >= n || y >= n {
-            return Ok(Reply::error(
-                404,
-                &format!("pixel ({x}, {y}) is outside the {n}x{n} image"),
-            ));
+    fn answer(&self, head: &Head, body: Vec<u8>) -> Reply {
+        if (head.method.as_str(), head.path()) == ("GET", "/") {
+            return page(self.guard.token());
         }
-        let (shading, (alpha, samples)) = {
-            let p = self.prepared(cfg.grad_bits)?;
-            let classified = Classified::new(p, crate::volume::report::scene_transfer(scene)?)?;
-            let caster = Renderer::new(&classified, scene.view.direction, opts)?;
-            let ray = caster.pixel(x as u32, y as u32);
-            (p.vol.shading_scene(scene), ray.unwrap_or((0.0, Vec::new())))
-        };
-        let reference = crate::reference::Reference::new(cfg, &shading);
-        let k = self.find(id).expect("found above");
-        let Shown::Volume(v) = &k.shown else {
-            unreachable!("a volume render")
-        };
-        let i = (y * n + x) as usize;
-        let Some(&(_, g)) = samples.iter().max_by(|a, b| a.0.total_cmp(&b.0)) else {
-            return Ok(Reply::error(
-                404,
-                &format!("pixel ({x}, {y}) shows no part of the volume"),
-            ));
-        };
-        let maps = &k.maps.scene;
-        let list = samples
-            .iter()
-            .map(|&(weight, gradient)| RaySample {
-                weight,
-                gradient,
-                model: k.model.intensity(maps, gradient),
-                reference: reference.intensity(gradient),
-            })
-            .collect();
-        let reply = PathReply {
-            x: x as u32,
-            y: y as u32,
-            gradient: g,
-            model: v.model[i],
-            reference: v.reference.as_ref().map_or(0, |r| r[i]),
-            signals: crate::stages::path(&k.model, &k.maps, 0, g, [0; 3]),
-            samples: Some(list),
-            alpha: Some(alpha),
-        };
-        Ok(Reply::json(200, &serde_json::to_value(reply)?))
+        self.explorer.answer(&head.method, &head.target, &body)
     }
+}
+
+/// The page with its token, and the headers that keep other sites from framing it.
+fn page(token: &str) -> Reply {
+    Reply::new(
+        200,
+        "text/html; charset=utf-8",
+        PAGE.replace(TOKEN_HEADER_SLOT, guard::TOKEN_HEADER)
+            .replace(TOKEN_SLOT, token)
+            .into_bytes(),
+    )
+    .with_header(
+        "Content-Security-Policy",
+        "default-src 'none'; script-src 'unsafe-inline'; style-src 'unsafe-inline'; img-src blob:; connect-src 'self' blob:; frame-ancestors 'none'; base-uri 'none'; form-action 'none'".into(),
+    )
+    .with_header("X-Frame-Options", "DENY".into())
 }
 
 /// Serves the page on 127.0.0.1:`port` (0: a free port) until the process is stopped; calls
-/// `ready` with the address once it listens.
+/// `ready` with the address once it listens. Renders run within [`LIMITS`].
 pub fn serve(port: u16, ready: impl FnOnce(&str) -> Result<()>) -> Result<()> {
-    let server = tiny_http::Server::http(("127.0.0.1", port))
-        .map_err(|e| anyhow!("cannot listen on 127.0.0.1:{port}: {e}"))?;
-    let addr = server
-        .server_addr()
-        .to_ip()
-        .ok_or_else(|| anyhow!("the server has no IP address"))?;
-    ready(&format!("http://{addr}/"))?;
-    let mut ex = Explorer::default();
-    for mut rq in server.incoming_requests() {
-        let method = rq.method().as_str().to_string();
-        let url = rq.url().to_string();
-        let mut body = Vec::new();
-        let reply = match rq.as_reader().take(MAX_BODY + 1).read_to_end(&mut body) {
-            Ok(_) if body.len() as u64 > MAX_BODY => {
-                Reply::error(413, &format!("a request body of at most {MAX_BODY} bytes"))
-            }
-            Ok(_) => ex.answer(&method, &url, &body),
-            Err(e) => Reply::error(400, &format!("reading the request: {e}")),
-        };
-        let mut resp = tiny_http::Response::from_data(reply.body)
-            .with_status_code(reply.status)
-            .with_header(header("Content-Type", reply.kind))
-            .with_header(header("Cache-Control", "no-store"));
-        if let Some(name) = reply.attachment {
-            resp = resp.with_header(header(
-                "Content-Disposition",
-                &format!("attachment; filename=\"{name}\""),
-            ));
-        }
-        // A page closed mid-answer is not the server's failure.
-        rq.respond(resp).ok();
-    }
-    Ok(())
+    serve_within(port, LIMITS, ready)
 }
 
-fn header(k: &str, v: &str) -> tiny_http::Header {
-    tiny_http::Header::from_bytes(k.as_bytes(), v.as_bytes()).expect("a valid header")
+/// [`serve`] with other limits (the tests: a render's budget in milliseconds).
+pub fn serve_within(
+    port: u16,
+    limits: Limits,
+    ready: impl FnOnce(&str) -> Result<()>,
+) -> Result<()> {
+    let listener = std::net::TcpListener::bind(("127.0.0.1", port))
+        .map_err(|e| anyhow!("cannot listen on 127.0.0.1:{port}: {e}"))?;
+    let addr = listener.local_addr()?;
+    let server = Server {
+        guard: guard::Guard::new(addr.port()).context("the token (/dev/urandom)")?,
+        explorer: Explorer::new(0, limits)?,
+    };
+    ready(&format!("http://{addr}/"))?;
+    http::serve(listener, http::Bounds::new(MAX_BODY), Arc::new(server))?;
+    Ok(())
 }
 
 #[cfg(test)]
@@ -578,13 +649,17 @@ mod tests {
             .into_bytes()
     }
 
+    fn explorer() -> Explorer {
+        Explorer::new(0, LIMITS).unwrap()
+    }
+
     fn body(r: &Reply) -> Value {
         serde_json::from_slice(&r.body).unwrap()
     }
 
     #[test]
     fn a_render_gives_renders_images_and_each_pixels_path() {
-        let mut ex = Explorer::default();
+        let ex = explorer();
         let r = ex.answer("POST", "/api/render", &ask(json!({"index_bits": 4}), 64));
         assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.body));
         let v = body(&r);
@@ -647,7 +722,7 @@ mod tests {
 
     #[test]
     fn a_volume_render_is_the_volume_commands_and_a_pixel_lists_its_rays_samples() {
-        let mut ex = Explorer::default();
+        let ex = explorer();
         let scene = engine_scene();
         let b = json!({"config": {"index_bits": 4}, "scene": serde_json::to_value(&scene).unwrap(),
                        "size": 64, "object": "volume"});
@@ -751,33 +826,31 @@ mod tests {
 
     #[test]
     fn bad_fields_are_one_line_naming_the_field() {
-        let mut ex = Explorer::default();
-        let say = |ex: &mut Explorer, b: Vec<u8>| {
+        let ex = explorer();
+        let say = |ex: &Explorer, b: Vec<u8>| {
             let r = ex.answer("POST", "/api/render", &b);
             assert_eq!(r.status, 400);
             body(&r)["error"].as_str().unwrap().to_string()
         };
         assert_eq!(
-            say(&mut ex, ask(json!({"grad_bits": 40}), 64)),
+            say(&ex, ask(json!({"grad_bits": 40}), 64)),
             "config: grad_bits = 40 is out of range; allowed 8..=16"
         );
-        assert!(
-            say(&mut ex, ask(json!({"grad_bitz": 8}), 64)).contains("unknown field `grad_bitz`")
-        );
-        assert!(say(&mut ex, ask(json!({}), 5000)).starts_with("size 5000 is out of range"));
-        assert!(say(&mut ex, b"{".to_vec()).starts_with("the request"));
+        assert!(say(&ex, ask(json!({"grad_bitz": 8}), 64)).contains("unknown field `grad_bitz`"));
+        assert!(say(&ex, ask(json!({}), 5000)).starts_with("size 5000 is out of range"));
+        assert!(say(&ex, b"{".to_vec()).starts_with("the request"));
         let mut scene = serde_json::to_value(Scene::standard()).unwrap();
         scene["map_fit"] = json!("table");
         let b = json!({"config": {}, "scene": scene, "size": 64})
             .to_string()
             .into_bytes();
-        assert!(say(&mut ex, b).contains("comp-table ram"));
+        assert!(say(&ex, b).contains("comp-table ram"));
         let mut scene = serde_json::to_value(Scene::standard()).unwrap();
         let light = scene["light"][0].clone();
         scene["light"] = Value::Array(vec![light; MAX_LIGHTS + 1]);
         let b = json!({"config": {}, "scene": scene, "size": 64});
         assert_eq!(
-            say(&mut ex, b.to_string().into_bytes()),
+            say(&ex, b.to_string().into_bytes()),
             format!(
                 "scene: {} lights; the explorer takes at most {MAX_LIGHTS}",
                 MAX_LIGHTS + 1
@@ -787,43 +860,20 @@ mod tests {
         assert_eq!(ex.answer("GET", "/nothing", b"").status, 404);
     }
 
-    /// The server refuses a body over [`MAX_BODY`] before the explorer sees it, and answers
-    /// one at the bound.
+    /// The page carries the token and the header to send it in, every slot filled, and may
+    /// not be framed.
     #[test]
-    fn a_request_body_beyond_the_bound_is_refused() {
-        use std::io::Write;
-        let (tx, rx) = std::sync::mpsc::channel();
-        // The server runs until the test process ends.
-        std::thread::spawn(move || {
-            serve(0, |url| {
-                tx.send(url.to_string()).unwrap();
-                Ok(())
-            })
-        });
-        let url = rx.recv().unwrap();
-        let addr = url.trim_start_matches("http://").trim_end_matches('/');
-        let post = |len: u64| {
-            let mut c = std::net::TcpStream::connect(addr).unwrap();
-            write!(
-                c,
-                "POST /api/render HTTP/1.1\r\nHost: x\r\nContent-Length: {len}\r\nConnection: close\r\n\r\n"
-            )
+    fn the_page_carries_its_token() {
+        let r = page("0123abcd");
+        let text = String::from_utf8(r.body).unwrap();
+        assert!(text.contains(r#"content="0123abcd" data-header="X-Rmapgen-Token""#));
+        assert!(!text.contains("__RMAPGEN"), "a slot left unfilled");
+        let csp = r
+            .headers
+            .iter()
+            .find(|h| h.0 == "Content-Security-Policy")
             .unwrap();
-            c.write_all(&vec![b' '; len as usize]).unwrap();
-            let mut reply = String::new();
-            c.read_to_string(&mut reply).unwrap();
-            reply
-        };
-        let over = post(MAX_BODY + 1);
-        assert!(over.starts_with("HTTP/1.1 413"), "{over}");
-        assert!(
-            over.contains(&format!("at most {MAX_BODY} bytes")),
-            "{over}"
-        );
-        // At the bound the body is read and judged (spaces are no request).
-        let at = post(MAX_BODY);
-        assert!(at.starts_with("HTTP/1.1 400"), "{at}");
-        assert!(at.contains("the request"), "{at}");
+        assert!(csp.1.contains("frame-ancestors 'none'"));
     }
 
     #[test]

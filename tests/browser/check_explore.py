@@ -18,7 +18,8 @@ for the new render. It checks:
   scene it saves (pixels and bytes), and a click on its worst pixel lists the samples of that
   pixel's ray and traces the heaviest: i_o equal to that sample's intensity in the list.
 Before that it shows that the check can fail: against the render of the configuration before
-the slider moved, the image must be refused. Exit 0 when all pass, 1 when not, 2 for bad input.
+the slider moved, the image must be refused. Last, a slow render (the fitted table) is stopped
+with the page's button, and the page must say it was. Exit 0 when all pass, 1 when not, 2 for bad input.
 """
 
 import argparse
@@ -27,6 +28,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import urllib.error
 import urllib.request
 import zlib
 from pathlib import Path
@@ -202,22 +204,34 @@ def main() -> int:
             g = ", ".join(str(c) for c in m["worst"]["gradient"])
             if f"gradient ({g})" not in head:
                 errors.append(f"the trace is of another gradient: {head!r}, want ({g})")
-            # The configuration the page saves: what generate --config reads.
+            # The configuration the page saves: what generate --config reads. The API answers
+            # the page's token and nothing else.
             rid = page.evaluate("() => document.body.dataset.renderId")
-            saved = urllib.request.urlopen(f"{url}api/config.toml?id={rid}").read().decode()
+            token = page.eval_on_selector('meta[name="rmapgen-token"]', "e => e.content")
+            get = lambda path: urllib.request.urlopen(urllib.request.Request(
+                f"{url}{path}", headers={"X-Rmapgen-Token": token})).read()
+            try:
+                urllib.request.urlopen(f"{url}api/config.toml?id={rid}")
+                errors.append("the API answered a request without the token")
+            except urllib.error.HTTPError as e:
+                if e.code != 403:
+                    errors.append(f"without the token the API answered {e.code}, not 403")
+            saved = get(f"api/config.toml?id={rid}").decode()
             if f"index_bits = {ib + 1}" not in saved.splitlines():
                 errors.append(f"the saved config.toml has not index_bits = {ib + 1}:\n{saved}")
             with page.expect_download() as dl:
                 page.click("#save-config")
             if dl.value.suggested_filename != "config.toml":
                 errors.append(f"the save button saves {dl.value.suggested_filename}")
+            elif Path(dl.value.path()).read_text() != saved:
+                errors.append("the save button's config.toml is not the API's")
             # The volume: the engine block, as `rmapgen volume --synthetic` renders it from the
             # configuration and scene the page saves.
             page.select_option("#object", "volume")
             third = wait_render(page, rid)
             cfg_file, scene_file = tmp / "v-config.toml", tmp / "v-scene.toml"
             for f, what in ((cfg_file, "config"), (scene_file, "scene")):
-                f.write_bytes(urllib.request.urlopen(f"{url}api/{what}.toml?id={third}").read())
+                f.write_bytes(get(f"api/{what}.toml?id={third}"))
             vol = tmp / "volume"
             subprocess.run([a.rmapgen, "volume", "--synthetic", "--config", str(cfg_file),
                             "--scene", str(scene_file), "--size", str(size), "--out", str(vol),
@@ -237,6 +251,21 @@ def main() -> int:
             if f"model {vm['worst']['model']}," not in head:
                 errors.append(f"volume: the trace is not of the worst pixel (model {vm['worst']['model']}): {head!r}")
             errors += [f"the page logged an error: {e}" for e in logged]
+            # A slow render (the fitted table) stopped with the page's button: the page says
+            # why (the 503 it answers is logged by the browser, and expected).
+            page.select_option("#comp_table", "ram")
+            wait_render(page, page.evaluate("() => document.body.dataset.renderId"))
+            page.select_option("#map_fit", "table")
+            stopped = None
+            for _ in range(600):
+                if page.is_visible("#stop"):
+                    page.click("#stop")
+                stopped = page.evaluate("() => document.body.dataset.error || null")
+                if stopped:
+                    break
+                page.wait_for_timeout(100)
+            if stopped != "cancelled: stopped by a request to /api/cancel":
+                errors.append(f"the stop button: the page says {stopped!r}")
             browser.close()
             print(f"check_explore: renders {first} and {second}, index_bits {ib} -> {ib + 1}; "
                   f"traced ({wx}, {wy}): i_o = {i_o}; volume render {third}, pixel ({vx}, {vy}) "

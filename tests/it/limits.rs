@@ -854,6 +854,19 @@ fn usage_limits_table_quotes_the_constants() {
             rmapgen::explore::MAX_LIGHTS
         ),
         format!("the last `{}`", rmapgen::explore::KEPT),
+        format!(
+            "a head of `{}` bytes, `{}` connections at once, `{}` s",
+            rmapgen::explore::http::MAX_HEAD,
+            rmapgen::explore::http::MAX_CONNECTIONS,
+            rmapgen::explore::http::REQUEST_DEADLINE.as_secs()
+        ),
+        format!(
+            "predicted at most `{}` core-seconds and `{}` MiB; cancelled past `{}` s or `{}` MiB",
+            rmapgen::explore::cost::CORE_SECONDS,
+            rmapgen::explore::cost::BYTES >> 20,
+            rmapgen::explore::LIMITS.seconds.as_secs(),
+            rmapgen::explore::LIMITS.memory >> 20
+        ),
     ] {
         assert!(
             table.contains(&want),

@@ -10,6 +10,7 @@ mod design_matrix;
 mod design_reads;
 mod ecp5;
 mod errors;
+mod explore;
 mod family;
 mod fast;
 mod fit;

@@ -161,6 +161,7 @@ impl MinimaxFit {
             .maxes
             .par_iter()
             .map(|&m| {
+                crate::cancel::point();
                 let mut r: Vec<Option<(f64, f64)>> = vec![None; positions];
                 for c in plan.components(m) {
                     let p = model.trace(&blank, [m as i32, c as i32, 0], [0; 3]).p_u as usize;
@@ -227,6 +228,7 @@ impl MinimaxFit {
             .map(|q| {
                 let pairs = self.pairs(q, &shade);
                 let lsq = self.lsq.fit_quadrant(q, &shade);
+                crate::cancel::point();
                 let (real, solved) = match self.solve(&pairs, &lsq) {
                     Some((e, _)) => (e, true),
                     None => (lsq, false),
@@ -267,6 +269,7 @@ impl MinimaxFit {
         let light = super::light(cfg, q, shade);
         let mut pairs = Vec::new();
         for (pu, ru) in self.range.iter().enumerate() {
+            crate::cancel::point();
             let Some(u) = *ru else { continue };
             for (pv, rv) in self.range.iter().enumerate() {
                 let Some(v) = *rv else { continue };
@@ -328,6 +331,7 @@ impl MinimaxFit {
         let mut chosen = vec![false; pairs.len()];
         active.iter().for_each(|&k| chosen[k] = true);
         for _ in 0..CUT_ROUNDS {
+            crate::cancel::point();
             let (x, t) = self.solve_rows(pairs, &taps, &active, anchor)?;
             let mut violated: Vec<(f64, usize)> = (0..pairs.len())
                 .filter(|&k| !chosen[k])
@@ -496,6 +500,7 @@ impl MinimaxFit {
             }
             let mut moved = false;
             'entries: for &j in &entries {
+                crate::cancel::point();
                 {
                     for delta in [1i64, -1] {
                         let v = e[j] as i64 + delta;
@@ -572,6 +577,7 @@ impl MinimaxFit {
         for _ in 0..POLISH_MOVES_PER_ENTRY {
             let mut moved = false;
             for j in 0..e.len() {
+                crate::cancel::point();
                 let before: f64 = readers[j]
                     .iter()
                     .map(|&r| sq(&pairs[r], self.value(&pairs[r], e)))

@@ -170,6 +170,7 @@ impl LsqFit {
             }
         };
         for j in 0..k {
+            crate::cancel::point();
             // Position in entry spacings, 0..=n-1.
             let x = j as f64 / q as f64;
             let t = tangent_at(cfg, x);
@@ -282,6 +283,7 @@ impl LsqFit {
         let light = light(&self.cfg, q, shade);
         let mut f = Vec::with_capacity(self.tangent.len().pow(2));
         for &tu in &self.tangent {
+            crate::cancel::point();
             for &tv in &self.tangent {
                 f.push(light(tu, tv));
             }
@@ -362,6 +364,7 @@ impl LsqFit {
             a.iter_mut().for_each(|x| *x = 0.0);
             b.iter_mut().for_each(|x| *x = 0.0);
             for ju in 0..k {
+                crate::cancel::point();
                 for jv in 0..k {
                     let wk = w[ju * k + jv];
                     phi.clear();

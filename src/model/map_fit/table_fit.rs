@@ -83,6 +83,7 @@ impl TableFit {
             .maxes
             .par_iter()
             .map(|&m| {
+                crate::cancel::point();
                 let mut r = vec![None; n];
                 for c in plan.components(m) {
                     let u = model.trace(&blank, [m as i32, c as i32, 0], [0; 3]).norm.u;
@@ -179,6 +180,7 @@ impl TableFit {
                 let mut lo = vec![f64::NAN; n * n];
                 let mut hi = vec![f64::NAN; n * n];
                 for &cu in &self.codes {
+                    crate::cancel::point();
                     let u = self.range[cu].expect("reachable");
                     for &cv in &self.codes {
                         let v = self.range[cv].expect("reachable");
@@ -211,6 +213,7 @@ impl TableFit {
         let radius = RADIUS_STEPS * self.cfg.step().max(1);
         let mut moved = 0;
         for (i, &c) in self.codes.iter().enumerate() {
+            crate::cancel::point();
             let cost = |pc: u32| -> f64 {
                 let mut sum = 0.0;
                 for (qd, e) in quadrants.iter().zip(ents) {

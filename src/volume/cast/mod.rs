@@ -132,6 +132,7 @@ impl<'a> Caster<'a> {
             .zip(alpha.par_chunks_mut(n))
             .enumerate()
             .map(|(y, (vrow, arow))| {
+                crate::cancel::point();
                 let mut st = Stats::default();
                 for x in 0..n {
                     if let Some(r) = self.ray(x as u32, y as u32) {
