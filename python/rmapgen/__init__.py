@@ -14,6 +14,6 @@ The same Rust crate as the ``rmapgen`` command line (docs/PYTHON.md)::
 ``Design`` holds every ROM and map ``rmapgen generate`` would write.
 """
 
-from ._rmapgen import TRACE_MAX, Config, Design, Scene, metrics, sphere
+from ._rmapgen import TRACE_MAX, Config, Design, Scene, metrics, quantize, sphere
 
-__all__ = ["Config", "Design", "Scene", "metrics", "sphere", "TRACE_MAX"]
+__all__ = ["Config", "Design", "Scene", "metrics", "quantize", "sphere", "TRACE_MAX"]
