@@ -111,12 +111,12 @@ pub fn ints<'py>(x: &Bound<'py, PyAny>, spec: &IntArg<'_>) -> PyResult<Ints<'py>
     read_ints(&a, spec, |v| v as i32).map(Ints::Owned)
 }
 
-/// The rows of a real argument (N, 3) as float64, each value exactly as given.
-pub fn reals(x: &Bound<'_, PyAny>, arg: Arg<'_>) -> PyResult<Vec<[f64; 3]>> {
+/// The values of a real argument (N, 3) as float64, row-major, each exactly as given.
+pub fn reals(x: &Bound<'_, PyAny>, arg: Arg<'_>) -> PyResult<Vec<f64>> {
     debug_assert_eq!(arg.cols, Some(3));
     let a = ndarray(x, &arg)?;
     let dtype = a.dtype();
-    let flat: Vec<f64> = match dtype.kind() {
+    Ok(match dtype.kind() {
         b'f' if dtype.itemsize() <= 8 => {
             // float16 and float32 widen to float64 exactly.
             let np = x.py().import("numpy")?;
@@ -148,8 +148,7 @@ pub fn reals(x: &Bound<'_, PyAny>, arg: Arg<'_>) -> PyResult<Vec<[f64; 3]>> {
             read_numbers(&a, &spec, "a real number", |v| v as f64, Some)?
         }
         _ => return Err(not_of_kind(&arg, &dtype, "a real", "")),
-    };
-    Ok(flat.chunks_exact(3).map(|r| [r[0], r[1], r[2]]).collect())
+    })
 }
 
 /// The argument as a numpy array of its shape: an array as it is, a list or tuple as an array

@@ -279,7 +279,8 @@ impl Scene {
     /// against.
     fn shade<'py>(&self, normals: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let py = normals.py();
-        let rows = arrays::reals(normals, normals_arg())?;
+        let flat = arrays::reals(normals, normals_arg())?;
+        let (rows, _) = flat.as_chunks::<3>();
         let p = self.inner.prepared();
         let mut out = buffer(rows.len(), "the intensities")?;
         for (k, row) in rows.iter().enumerate() {
@@ -678,15 +679,16 @@ fn quantize<'py>(
     config: PyRef<'py, Config>,
 ) -> PyResult<Bound<'py, PyArray2<i32>>> {
     let py = normals.py();
-    let rows = arrays::reals(normals, normals_arg())?;
+    let flat = arrays::reals(normals, normals_arg())?;
+    let (rows, _) = flat.as_chunks::<3>();
     let cfg = &config.inner;
-    let mut flat = buffer(3 * rows.len(), "the gradients")?;
+    let mut out = buffer(3 * rows.len(), "the gradients")?;
     for (k, row) in rows.iter().enumerate() {
         let g = rmapgen::geometry::full_scale_gradient(cfg, glam::DVec3::from_array(*row))
             .ok_or_else(|| no_direction(k, row))?;
-        flat.extend(g);
+        out.extend(g);
     }
-    let g = Array2::from_shape_vec((rows.len(), 3), flat).expect("three per row");
+    let g = Array2::from_shape_vec((rows.len(), 3), out).expect("three per row");
     Ok(g.into_pyarray(py))
 }
 
