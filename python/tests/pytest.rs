@@ -16,13 +16,11 @@ use std::process::Command;
 fn pytest_over_this_builds_extension() {
     let python = Path::new(env!("CARGO_MANIFEST_DIR"));
     let root = python.parent().expect("python/ is in the repository");
-    // This test runs from target/<profile>/deps; the extension is target/<profile>/lib_rmapgen.so.
+    // This test runs from target/<profile>/deps, where `cargo test` leaves the extension it
+    // built for it (the `rlib` crate type makes it the test's dependency; only `cargo build`
+    // copies it up to target/<profile>/).
     let exe = std::env::current_exe().expect("the test's path");
-    let profile = exe
-        .ancestors()
-        .nth(2)
-        .expect("target/<profile>/deps/<test>");
-    let so = profile.join("lib_rmapgen.so");
+    let so = exe.with_file_name("lib_rmapgen.so");
     assert!(so.is_file(), "{} is built with the test", so.display());
     // The package beside nothing else: python/rmapgen/__init__.py and this extension.
     let site =
