@@ -182,6 +182,11 @@ def test_trace_reads_rgb_exactly():
                 np.array([[10, 20, 255]], dtype=">u2")):
         got = d.trace(g, rgb)
         assert all(np.array_equal(got[k], want[k]) for k in want)
+    # Each channel reaches its own port: the colour reversed, the ports reversed.
+    back = d.trace(g, [[255, 20, 10]])
+    assert [want[f"{c}_i"][0] for c in "rgb"] == [10, 20, 255]
+    assert [back[f"{c}_o"][0] for c in "rgb"] == [want[f"{c}_o"][0] for c in "bgr"]
+    assert want["r_o"][0] < want["g_o"][0] < want["b_o"][0]
     with pytest.raises(TypeError, match=r"^rgb: dtype float64 is not an integer dtype; nothing is cast$"):
         d.trace(g, np.array([[10.5, 20, 255]]))
     with pytest.raises(TypeError, match=r"^rgb: dtype bool"):
