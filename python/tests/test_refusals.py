@@ -197,6 +197,18 @@ def test_trace_reads_rgb_exactly():
         d.trace(g, np.array([[2**64 - 1, 0, 0]], dtype=np.uint64))
 
 
+def test_a_long_trace_is_every_samples_path():
+    # The trace fills its columns in blocks of 4096 samples: three blocks and a part, each
+    # sample's column entries those of its own trace, at the blocks' edges too.
+    g, _ = rmapgen.sphere(D12.config, 128)
+    g = g[: 3 * 4096 + 5]
+    t = D12.trace(g)
+    assert np.array_equal(t["i_o"], D12.shade(g))
+    for k in (0, 4095, 4096, 8191, 8192, 12287, 12288, len(g) - 1):
+        one = D12.trace(g[k : k + 1])
+        assert all(t[name][k] == one[name][0] for name in one), k
+
+
 def test_metrics_reads_output_values_exactly():
     a = np.array([3, 0, 255], dtype=np.uint8)
     want = rmapgen.metrics(a, [1, 0, 250], 255)
@@ -311,7 +323,7 @@ SHORT = {
     # 60-odd signals of 2^20 samples, 4 MB each: the columns stop at the limit.
     "trace": ("d = rmapgen.Design(); g = np.ones((2**20, 3), dtype=np.int32); d.trace(g[:10])",
               "d.trace(g)", "a traced signal"),
-    # 2^23 float normals: the gradients need 96 MB.
+    # 2^23 float normals: reading them needs 192 MB.
     "quantize": ("c = rmapgen.Config(); n = np.ones((2**23, 3)); rmapgen.quantize(n[:10], c)",
                  "rmapgen.quantize(n, c)", "normals"),
     # The largest sphere, 8192^2 pixels: 805 MB of gradients.
@@ -325,3 +337,11 @@ def test_an_output_larger_than_memory_is_a_memory_error_not_an_abort(case):
     setup, call, what = case
     out = run_short_of_memory(setup, call, spare_mb=16)
     assert out.startswith(f"MemoryError: no memory for {what}"), out
+
+
+def test_quantizes_output_larger_than_memory_is_a_memory_error():
+    # 2^22 normals: reading them takes 96 MB of the 120 spare, the gradients need 48 MB more.
+    out = run_short_of_memory(
+        "c = rmapgen.Config(); n = np.ones((2**22, 3)); rmapgen.quantize(n[:10], c)",
+        "rmapgen.quantize(n, c)", spare_mb=120)
+    assert out.startswith("MemoryError: no memory for the gradients"), out
