@@ -39,6 +39,15 @@ pub fn buffer<T>(n: usize, what: &str) -> PyResult<Vec<T>> {
     Ok(v)
 }
 
+/// Appends `items` to a buffer from [`buffer`] without growing it: a value past its reservation
+/// is a bug here (a panic), never a second, infallible allocation that could abort.
+pub fn append<T>(v: &mut Vec<T>, items: impl IntoIterator<Item = T>) {
+    for x in items {
+        assert!(v.len() < v.capacity(), "more values than reserved");
+        v.push(x);
+    }
+}
+
 /// An array argument: its name in messages and its shape.
 pub struct Arg<'a> {
     /// `g`, `rgb`, `a`, `normals`.
@@ -108,7 +117,7 @@ pub fn ints<'py>(x: &Bound<'py, PyAny>, spec: &IntArg<'_>) -> PyResult<Ints<'py>
             };
         }
     }
-    read_ints(&a, spec, |v| v as i32).map(Ints::Owned)
+    read_numbers(&a, spec, "an integer", |v| v as i32, |_| None).map(Ints::Owned)
 }
 
 /// The values of a real argument (N, 3) as float64, row-major, each exactly as given.
@@ -127,7 +136,7 @@ pub fn reals(x: &Bound<'_, PyAny>, arg: Arg<'_>) -> PyResult<Vec<f64>> {
                 .map_err(|e| PyValueError::new_err(format!("{}: {e}", arg.name)))?;
             let view = t.as_array();
             let mut v = buffer(view.len(), arg.name)?;
-            v.extend(view.iter().copied());
+            append(&mut v, view.iter().copied());
             v
         }
         b'f' => {
@@ -206,22 +215,9 @@ fn py_shape(s: &[usize]) -> String {
     }
 }
 
-/// The values of an integer-dtype or object array, checked and converted by `conv`.
-fn read_ints<O>(
-    a: &Bound<'_, PyUntypedArray>,
-    spec: &IntArg<'_>,
-    conv: impl Fn(i64) -> O,
-) -> PyResult<Vec<O>> {
-    let dtype = a.dtype();
-    match dtype.kind() {
-        b'i' | b'u' | b'O' => read_numbers(a, spec, "an integer", conv, |_| None),
-        _ => Err(not_of_kind(&spec.arg, &dtype, "an integer", spec.hint)),
-    }
-}
-
 /// The values of an integer-dtype array (`i`, `u`) or an object array, each checked against
 /// the range and converted by `conv`; in an object array a float is taken by `float` (None:
-/// refused as not `want`).
+/// refused as not `want`). Any other dtype is not an integer dtype.
 fn read_numbers<O>(
     a: &Bound<'_, PyUntypedArray>,
     spec: &IntArg<'_>,

@@ -9,7 +9,7 @@
 
 mod arrays;
 
-use arrays::{buffer, Arg, IntArg, Ints};
+use arrays::{append, buffer, Arg, IntArg, Ints};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::exceptions::{PyAttributeError, PyTypeError, PyValueError};
@@ -622,7 +622,7 @@ fn samples(x: &Bound<'_, PyAny>, name: &str, peak: u32) -> PyResult<Vec<u32>> {
     let v = arrays::ints(x, &spec)?;
     let v = v.as_slice();
     let mut out = buffer(v.len(), name)?;
-    out.extend(v.iter().map(|&x| x as u32));
+    append(&mut out, v.iter().map(|&x| x as u32));
     Ok(out)
 }
 
@@ -686,7 +686,7 @@ fn quantize<'py>(
     for (k, row) in rows.iter().enumerate() {
         let g = rmapgen::geometry::full_scale_gradient(cfg, glam::DVec3::from_array(*row))
             .ok_or_else(|| no_direction(k, row))?;
-        out.extend(g);
+        append(&mut out, g);
     }
     let g = Array2::from_shape_vec((rows.len(), 3), out).expect("three per row");
     Ok(g.into_pyarray(py))
@@ -720,8 +720,8 @@ fn sphere<'py>(
     let mut g = buffer(3 * most, "the sphere's gradients")?;
     let mut xy = buffer(2 * most, "the sphere's pixels")?;
     for (x, y, grad) in rmapgen::render::sphere::pixels(cfg, size, shrink) {
-        g.extend(grad);
-        xy.extend([x, y]);
+        append(&mut g, grad);
+        append(&mut xy, [x, y]);
     }
     let n = xy.len() / 2;
     let g = Array2::from_shape_vec((n, 3), g).expect("three per pixel");
