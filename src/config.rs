@@ -596,6 +596,12 @@ impl Config {
     pub fn map_max(&self) -> u32 {
         (1 << self.map_bits) - 1
     }
+    /// A gradient component's range, two's complement in `grad_bits`:
+    /// -2^(G-1) ..= 2^(G-1) - 1.
+    pub fn grad_range(&self) -> std::ops::RangeInclusive<i32> {
+        let half = 1i32 << (self.grad_bits - 1);
+        -half..=half - 1
+    }
 
     // Widths and constants of the generated RTL (src/stages, src/hdl, templates/). Each is defined here
     // once; the templates only name them.

@@ -9,11 +9,14 @@ The same Rust crate as the ``rmapgen`` command line (docs/PYTHON.md)::
     ref = d.reference(g)                   # the float light model, quantised
     print(rmapgen.metrics(out, ref, d.peak)["max_abs_error"])
     path = d.trace(g[:1])                  # every port of every stage, by Verilog name
+    n = np.array([[0.6, 0.0, 0.8]])        # float normals, unit or not, ...
+    print(rmapgen.quantize(n, d.config))   # ... as gradients: [[1535    0 2047]]
 
 ``Config`` takes the fields of ``config.toml``, ``Scene`` reads the files of ``scenes/``,
-``Design`` holds every ROM and map ``rmapgen generate`` would write.
+``Design`` holds every ROM and map ``rmapgen generate`` would write. Arguments are read
+exactly or refused (docs/PYTHON.md, "What the package refuses"): floats are not gradients.
 """
 
-from ._rmapgen import TRACE_MAX, Config, Design, Scene, metrics, sphere
+from ._rmapgen import TRACE_MAX, Config, Design, Scene, metrics, quantize, sphere
 
-__all__ = ["Config", "Design", "Scene", "metrics", "sphere", "TRACE_MAX"]
+__all__ = ["Config", "Design", "Scene", "metrics", "quantize", "sphere", "TRACE_MAX"]

@@ -4,10 +4,14 @@
 //! configuration and scene are parsed and validated by the same code as their TOML files, the
 //! ROMs and maps are the ones `generate` writes, `shade` is the fast path `render` and `bench`
 //! run, `trace` is [`rmapgen::stages::path`] (the ports the per-stage vectors check), and the
-//! reference and metrics are `render`'s. This file only converts between Python and Rust.
+//! reference and metrics are `render`'s. This file only converts between Python and Rust;
+//! `arrays` reads every array argument exactly or refuses it.
 
+mod arrays;
+
+use arrays::{append, buffer, Arg, IntArg, Ints};
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::exceptions::{PyAttributeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString};
@@ -270,25 +274,18 @@ impl Scene {
         toml::to_string(&self.inner).expect("a Scene serialises")
     }
 
-    /// The float light model at each direction of an (N, 3) array (normalised here; 1.0 is
-    /// full scale, before quantising or clamping): the truth every design is measured against.
-    fn shade<'py>(
-        &self,
-        py: Python<'py>,
-        normals: PyReadonlyArray2<'py, f64>,
-    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let n = rows3(&normals)?;
-        let flat = normals.as_array();
+    /// The float light model at each direction of an (N, 3) real array (normalised here; 1.0
+    /// is full scale, before quantising or clamping): the truth every design is measured
+    /// against.
+    fn shade<'py>(&self, normals: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let py = normals.py();
+        let flat = arrays::reals(normals, normals_arg())?;
+        let (rows, _) = flat.as_chunks::<3>();
         let p = self.inner.prepared();
-        let mut out = Vec::with_capacity(n);
-        for (k, row) in flat.rows().into_iter().enumerate() {
-            let v = glam::DVec3::new(row[0], row[1], row[2]);
-            let u = rmapgen::geometry::unit_direction(v).ok_or_else(|| {
-                PyValueError::new_err(format!(
-                    "normal {k} = ({}, {}, {}) has no direction (zero or not finite)",
-                    row[0], row[1], row[2]
-                ))
-            })?;
+        let mut out = buffer(rows.len(), "the intensities")?;
+        for (k, row) in rows.iter().enumerate() {
+            let u = rmapgen::geometry::unit_direction(glam::DVec3::from_array(*row))
+                .ok_or_else(|| no_direction(k, row))?;
             out.push(p.shade(u));
         }
         Ok(out.into_pyarray(py))
@@ -303,17 +300,25 @@ impl Scene {
     }
 }
 
-/// The row count of an (N, 3) array, or why it is not one.
-fn rows3<T: numpy::Element>(a: &PyReadonlyArray2<'_, T>) -> PyResult<usize> {
-    let s = a.shape();
-    if s[1] != 3 {
-        return Err(PyValueError::new_err(format!(
-            "expected an (N, 3) array, got shape ({}, {})",
-            s[0], s[1]
-        )));
+/// Float normals, an (N, 3) real array (Scene.shade, quantize).
+fn normals_arg() -> Arg<'static> {
+    Arg {
+        name: "normals",
+        cols: Some(3),
+        max_rows: usize::MAX,
     }
-    Ok(s[0])
 }
+
+/// The ValueError of a normal that has no direction.
+fn no_direction(k: usize, row: &[f64; 3]) -> PyErr {
+    PyValueError::new_err(format!(
+        "normals[{k}] = ({}, {}, {}) has no direction (zero, NaN or infinite)",
+        row[0], row[1], row[2]
+    ))
+}
+
+/// What the TypeError of a gradient that is not an integer suggests.
+const QUANTIZE_HINT: &str = "rmapgen.quantize(normals, config) turns float normals into gradients";
 
 /// A design: its configuration, its scene, every ROM and map `generate` would write, and the
 /// model that shades with them. Building it fits the maps as the scene's `map_fit` says.
@@ -328,84 +333,50 @@ struct Design {
 }
 
 impl Design {
-    /// The gradients of an (N, 3) integer array, checked against the configuration's range;
-    /// an int32 C-contiguous array is read in place.
-    fn gradients<'py>(&self, g: &Bound<'py, PyAny>) -> PyResult<GradArray<'py>> {
-        let py = g.py();
-        let arr: PyReadonlyArray2<'py, i32> = match g.extract() {
-            Ok(a) => a,
-            Err(_) => {
-                let np = py.import("numpy")?;
-                let wide = np.call_method1("asarray", (g, "int64"))?;
-                let wide: PyReadonlyArray2<'py, i64> = wide.extract().map_err(|_| {
-                    PyValueError::new_err("expected an (N, 3) array of integer gradients")
-                })?;
-                rows3(&wide)?;
-                let a = wide.as_array();
-                self.check_range(a.iter().copied())?;
-                let narrow = np.call_method1("ascontiguousarray", (wide.as_any(), "int32"))?;
-                narrow.extract()?
-            }
+    /// The gradients of an (N, 3) integer array (at most `max_rows`), each component in the
+    /// configuration's range; an int32 C-contiguous array is read in place.
+    fn gradients<'py>(&self, g: &Bound<'py, PyAny>, max_rows: usize) -> PyResult<Grads<'py>> {
+        let cfg = &self.config.inner;
+        let r = cfg.grad_range();
+        let spec = IntArg {
+            arg: Arg {
+                name: "g",
+                cols: Some(3),
+                max_rows,
+            },
+            range: *r.start() as i64..=*r.end() as i64,
+            why: format!("grad_bits = {}", cfg.grad_bits),
+            hint: QUANTIZE_HINT,
         };
-        rows3(&arr)?;
-        let arr = if arr.is_c_contiguous() {
-            arr
-        } else {
-            let np = py.import("numpy")?;
-            np.call_method1("ascontiguousarray", (arr.as_any(),))?
-                .extract()?
-        };
-        let grads = GradArray { arr };
-        let (lo, hi) = self.range();
-        let flat = grads.arr.as_slice().expect("made C-contiguous");
-        // In parallel, in blocks: the first component out of range, if any.
-        let bad = py.detach(|| {
-            flat.par_chunks(1 << 16)
-                .enumerate()
-                .find_map_first(|(b, c)| {
-                    c.iter()
-                        .position(|&x| !(lo..=hi).contains(&(x as i64)))
-                        .map(|k| b * (1 << 16) + k)
-                })
-        });
-        if let Some(k) = bad {
-            self.check_range(std::iter::repeat_n(0, k).chain([flat[k] as i64]))?;
+        Ok(Grads(arrays::ints(g, &spec)?))
+    }
+
+    /// The gradients of `g` for the float reference: none may be zero, which has no direction.
+    fn directions<'py>(&self, g: &Bound<'py, PyAny>) -> PyResult<Grads<'py>> {
+        let grads = self.gradients(g, usize::MAX)?;
+        let gs = grads.as_grads();
+        let zero = g
+            .py()
+            .detach(|| gs.par_iter().position_first(|g| *g == [0, 0, 0]));
+        if let Some(k) = zero {
+            return Err(PyValueError::new_err(format!(
+                "g[{k}] = (0, 0, 0) has no direction, so no reference (shade gives it 0, the \
+                 hardware's zero case); leave zero gradients out first: \
+                 g[np.any(g != 0, axis=1)]"
+            )));
         }
         Ok(grads)
     }
-
-    /// The range of a gradient component, -2^(G-1) ..= 2^(G-1) - 1.
-    fn range(&self) -> (i64, i64) {
-        let g = self.config.inner.grad_bits;
-        (-(1i64 << (g - 1)), (1i64 << (g - 1)) - 1)
-    }
-
-    fn check_range(&self, comps: impl Iterator<Item = i64>) -> PyResult<()> {
-        let g = self.config.inner.grad_bits;
-        let (lo, hi) = self.range();
-        for (k, c) in comps.enumerate() {
-            if !(lo..=hi).contains(&c) {
-                return Err(PyValueError::new_err(format!(
-                    "gradient {} has component {c}, outside {lo}..={hi} (grad_bits = {g})",
-                    k / 3
-                )));
-            }
-        }
-        Ok(())
-    }
 }
 
-/// An (N, 3) int32 C-contiguous array, read as N gradients.
-struct GradArray<'py> {
-    arr: PyReadonlyArray2<'py, i32>,
-}
+/// An (N, 3) integer argument's values, read as N gradients.
+struct Grads<'py>(Ints<'py>);
 
-impl GradArray<'_> {
+impl Grads<'_> {
     fn as_grads(&self) -> &[[i32; 3]] {
-        let flat = self.arr.as_slice().expect("made C-contiguous");
-        // SAFETY: [i32; 3] has the size of three i32 and the alignment of one; `flat` holds
-        // 3 N of them in row-major order, so it is N rows of three.
-        unsafe { std::slice::from_raw_parts(flat.as_ptr() as *const [i32; 3], flat.len() / 3) }
+        let (rows, rest) = self.0.as_slice().as_chunks::<3>();
+        debug_assert!(rest.is_empty(), "an (N, 3) array");
+        rows
     }
 }
 
@@ -486,14 +457,12 @@ impl Design {
     /// core, with the interpreter released.
     fn shade<'py>(&self, g: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray1<u16>>> {
         let py = g.py();
-        let grads = self.gradients(g)?;
+        let grads = self.gradients(g, usize::MAX)?;
         let gs = grads.as_grads();
+        let mut out = buffer(gs.len(), "the intensities")?;
+        out.resize(gs.len(), 0u16);
         let shader = &self.shader;
-        let out = py.detach(|| {
-            let mut out = vec![0u16; gs.len()];
-            shader.shade_batch_par(gs, &mut out);
-            out
-        });
+        py.detach(|| shader.shade_batch_par(gs, &mut out));
         Ok(out.into_pyarray(py))
     }
 
@@ -505,84 +474,110 @@ impl Design {
     fn trace<'py>(
         &self,
         g: &Bound<'py, PyAny>,
-        rgb: Option<PyReadonlyArray2<'py, i64>>,
+        rgb: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let py = g.py();
-        let grads = self.gradients(g)?;
+        let grads = self.gradients(g, TRACE_MAX)?;
         let gs = grads.as_grads();
-        if gs.len() > TRACE_MAX {
-            return Err(PyValueError::new_err(format!(
-                "trace takes at most {TRACE_MAX} samples, got {}",
-                gs.len()
-            )));
-        }
-        let colours: Vec<[u32; 3]> = match &rgb {
-            None => vec![[0; 3]; gs.len()],
+        let colours = match rgb {
+            None => None,
             Some(c) => {
-                if rows3(c)? != gs.len() {
+                let spec = IntArg {
+                    arg: Arg {
+                        name: "rgb",
+                        cols: Some(3),
+                        max_rows: TRACE_MAX,
+                    },
+                    range: 0..=COLOUR_MAX,
+                    why: "8 bits a channel".into(),
+                    hint: "",
+                };
+                let c = arrays::ints(c, &spec)?;
+                let (rows, _) = c.as_slice().as_chunks::<3>();
+                if rows.len() != gs.len() {
                     return Err(PyValueError::new_err(format!(
                         "rgb has {} rows for {} gradients",
-                        c.shape()[0],
+                        rows.len(),
                         gs.len()
                     )));
                 }
-                let a = c.as_array();
-                let mut v = Vec::with_capacity(gs.len());
-                for (k, row) in a.rows().into_iter().enumerate() {
-                    if row.iter().any(|&x| !(0..=255).contains(&x)) {
-                        return Err(PyValueError::new_err(format!(
-                            "rgb {k} = ({}, {}, {}) is outside 0..=255",
-                            row[0], row[1], row[2]
-                        )));
-                    }
-                    v.push([row[0] as u32, row[1] as u32, row[2] as u32]);
-                }
-                v
+                Some(c)
             }
+        };
+        let cs = colours.as_ref().map(|c| c.as_slice());
+        let colour = |k: usize| match cs {
+            None => [0; 3],
+            Some(c) => [c[3 * k] as u32, c[3 * k + 1] as u32, c[3 * k + 2] as u32],
         };
         let (model, maps) = (&self.model, &self.maps);
         let names = rmapgen::stages::path(model, maps, 0, [0; 3], [0; 3]);
-        let values: Vec<Vec<u32>> = py.detach(|| {
-            gs.par_iter()
-                .zip(&colours)
-                .map(|(&g, &c)| {
-                    rmapgen::stages::path(model, maps, 0, g, c)
-                        .into_iter()
-                        .map(|s| s.value as u32)
-                        .collect()
+        // One column per signal, every one reserved before any is filled.
+        let mut columns: Vec<Vec<u32>> = buffer(names.len(), "the trace's signals")?;
+        for _ in &names {
+            let mut col = buffer(gs.len(), "a traced signal")?;
+            col.resize(gs.len(), 0);
+            columns.push(col);
+        }
+        // In blocks of samples, each block with its part of every column.
+        const BLOCK: usize = 4096;
+        let mut blocks: Vec<Vec<&mut [u32]>> =
+            (0..gs.len().div_ceil(BLOCK)).map(|_| Vec::new()).collect();
+        for col in &mut columns {
+            for (b, part) in blocks.iter_mut().zip(col.chunks_mut(BLOCK)) {
+                b.push(part);
+            }
+        }
+        py.detach(|| {
+            blocks
+                .into_par_iter()
+                .enumerate()
+                .for_each(|(b, mut cols)| {
+                    for k in b * BLOCK..((b + 1) * BLOCK).min(gs.len()) {
+                        let path = rmapgen::stages::path(model, maps, 0, gs[k], colour(k));
+                        for (col, s) in cols.iter_mut().zip(path) {
+                            col[k - b * BLOCK] = s.value as u32;
+                        }
+                    }
                 })
-                .collect()
         });
         let d = PyDict::new(py);
-        for (k, s) in names.iter().enumerate() {
+        for (s, col) in names.iter().zip(columns) {
             debug_assert!(s.bits <= 32, "{} is {} bits", s.name, s.bits);
-            let col: Vec<u32> = values.iter().map(|v| v[k]).collect();
             d.set_item(&s.name, col.into_pyarray(py))?;
         }
         Ok(d)
     }
 
     /// The float reference (the scene's light model at each gradient's exact direction),
-    /// quantised to the output's width as `render`'s reference image: the truth.
+    /// quantised to the output's width as `render`'s reference image: the truth. The zero
+    /// gradient has no direction and is refused.
     fn reference<'py>(&self, g: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray1<u16>>> {
         let py = g.py();
-        let grads = self.gradients(g)?;
+        let grads = self.directions(g)?;
         let gs = grads.as_grads();
+        let mut out = buffer(gs.len(), "the reference")?;
+        out.resize(gs.len(), 0u16);
         let r = &self.reference;
-        let out: Vec<u16> = py.detach(|| gs.par_iter().map(|&g| r.intensity(g) as u16).collect());
+        py.detach(|| {
+            out.par_iter_mut()
+                .zip(gs)
+                .for_each(|(o, &g)| *o = r.intensity(g) as u16)
+        });
         Ok(out.into_pyarray(py))
     }
 
-    /// The light model before quantising (1.0 is full scale), NaN for the zero gradient.
+    /// The light model before quantising (1.0 is full scale); the zero gradient is refused.
     fn exact<'py>(&self, g: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let py = g.py();
-        let grads = self.gradients(g)?;
+        let grads = self.directions(g)?;
         let gs = grads.as_grads();
+        let mut out = buffer(gs.len(), "the exact intensities")?;
+        out.resize(gs.len(), 0.0);
         let r = &self.reference;
-        let out: Vec<f64> = py.detach(|| {
-            gs.par_iter()
-                .map(|&g| r.exact(g).unwrap_or(f64::NAN))
-                .collect()
+        py.detach(|| {
+            out.par_iter_mut().zip(gs).for_each(|(o, &g)| {
+                *o = r.exact(g).expect("no zero gradient (directions)");
+            })
         });
         Ok(out.into_pyarray(py))
     }
@@ -602,37 +597,62 @@ impl Design {
     }
 }
 
-/// A 1-D array of output values (any integer dtype), each in 0..=2^32 - 1.
-fn samples(x: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<u32>> {
-    let np = x.py().import("numpy")?;
-    let wide = np
-        .call_method1("asarray", (x, "int64"))
-        .map_err(|_| PyTypeError::new_err(format!("{what}: expected a 1-D array of integers")))?;
-    let wide: numpy::PyReadonlyArray1<'_, i64> = wide
-        .extract()
-        .map_err(|_| PyValueError::new_err(format!("{what}: expected a 1-D array of integers")))?;
-    wide.as_array()
-        .iter()
-        .enumerate()
-        .map(|(k, &v)| {
-            u32::try_from(v).map_err(|_| {
-                PyValueError::new_err(format!("{what}[{k}] = {v} is not an output value"))
-            })
-        })
-        .collect()
+/// The largest output value a channel of colour takes (`trace`'s `rgb`).
+const COLOUR_MAX: i64 = 255;
+
+/// The largest `peak` of `metrics`: the largest design's, 2^map_bits - 1 at the widest
+/// map_bits.
+fn peak_max() -> u32 {
+    let (_, widest) = rmapgen::config::range_of("map_bits").expect("map_bits has a range");
+    (1 << widest) - 1
+}
+
+/// A 1-D array of output values (any integer dtype), each in 0..=peak.
+fn samples(x: &Bound<'_, PyAny>, name: &str, peak: u32) -> PyResult<Vec<u32>> {
+    let spec = IntArg {
+        arg: Arg {
+            name,
+            cols: None,
+            max_rows: usize::MAX,
+        },
+        range: 0..=peak as i64,
+        why: format!("output values, peak = {peak}"),
+        hint: "",
+    };
+    let v = arrays::ints(x, &spec)?;
+    let v = v.as_slice();
+    let mut out = buffer(v.len(), name)?;
+    append(&mut out, v.iter().map(|&x| x as u32));
+    Ok(out)
 }
 
 /// Error figures of `a` (the design) against `b` (the reference), in output LSBs, as
 /// `render`'s metrics.json: max_abs_error, mean_abs_error, mean_error, rmse, psnr_db, the
-/// histogram of absolute errors and the first worst sample.
+/// histogram of absolute errors and the first worst sample. Every value is an output value,
+/// 0..=peak; no samples is refused (there is nothing to measure).
 #[pyfunction]
 fn metrics<'py>(
     py: Python<'py>,
     a: &Bound<'py, PyAny>,
     b: &Bound<'py, PyAny>,
-    peak: u32,
+    peak: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let (a, b) = (samples(a, "a")?, samples(b, "b")?);
+    let most = peak_max();
+    if peak.is_instance_of::<PyBool>() {
+        return Err(PyTypeError::new_err("peak: expected an int, got a bool"));
+    }
+    let peak: i64 = peak.extract()?;
+    let peak = u32::try_from(peak)
+        .ok()
+        .filter(|p| (1..=most).contains(p))
+        .ok_or_else(|| {
+            PyValueError::new_err(format!(
+                "peak = {peak} is outside 1..={most} (2^map_bits - 1, map_bits up to \
+                 {})",
+                most.ilog2() + 1
+            ))
+        })?;
+    let (a, b) = (samples(a, "a", peak)?, samples(b, "b", peak)?);
     if a.len() != b.len() {
         return Err(PyValueError::new_err(format!(
             "metrics of {} and {} samples",
@@ -640,8 +660,36 @@ fn metrics<'py>(
             b.len()
         )));
     }
+    if a.is_empty() {
+        return Err(PyValueError::new_err(
+            "metrics of no samples: there is nothing to measure",
+        ));
+    }
     let m = rmapgen::render::metrics::metrics(&a, &b, peak);
     from_json(py, &serde_json::to_value(m).expect("metrics serialise"))
+}
+
+/// Float normals (an (N, 3) real array, unit or not) as the design's gradients, at full scale:
+/// each row divided by its largest |component|, times 2^(G-1) - 1, rounded to the nearest
+/// integer, halves away from zero (`rmapgen::geometry::full_scale_gradient`). A row that is
+/// zero, NaN or infinite has no direction and is refused.
+#[pyfunction]
+fn quantize<'py>(
+    normals: &Bound<'py, PyAny>,
+    config: PyRef<'py, Config>,
+) -> PyResult<Bound<'py, PyArray2<i32>>> {
+    let py = normals.py();
+    let flat = arrays::reals(normals, normals_arg())?;
+    let (rows, _) = flat.as_chunks::<3>();
+    let cfg = &config.inner;
+    let mut out = buffer(3 * rows.len(), "the gradients")?;
+    for (k, row) in rows.iter().enumerate() {
+        let g = rmapgen::geometry::full_scale_gradient(cfg, glam::DVec3::from_array(*row))
+            .ok_or_else(|| no_direction(k, row))?;
+        append(&mut out, g);
+    }
+    let g = Array2::from_shape_vec((rows.len(), 3), out).expect("three per row");
+    Ok(g.into_pyarray(py))
 }
 
 /// The sphere test image of `render` (the paper's Figures 4-7): every inside pixel of a
@@ -667,12 +715,17 @@ fn sphere<'py>(
             "shrink {shrink} exceeds {max} (grad_bits - 1)"
         )));
     }
-    let px = rmapgen::render::sphere::sphere_gradients(cfg, size, shrink);
-    let n = px.len();
-    let g = Array2::from_shape_vec((n, 3), px.iter().flat_map(|p| p.2).collect())
-        .expect("three per pixel");
-    let xy = Array2::from_shape_vec((n, 2), px.iter().flat_map(|p| [p.0, p.1]).collect())
-        .expect("two per pixel");
+    // Room for every pixel of the image (about 4/π the inside ones), before any is made.
+    let most = size as usize * size as usize;
+    let mut g = buffer(3 * most, "the sphere's gradients")?;
+    let mut xy = buffer(2 * most, "the sphere's pixels")?;
+    for (x, y, grad) in rmapgen::render::sphere::pixels(cfg, size, shrink) {
+        append(&mut g, grad);
+        append(&mut xy, [x, y]);
+    }
+    let n = xy.len() / 2;
+    let g = Array2::from_shape_vec((n, 3), g).expect("three per pixel");
+    let xy = Array2::from_shape_vec((n, 2), xy).expect("two per pixel");
     Ok((g.into_pyarray(py), xy.into_pyarray(py)))
 }
 
@@ -686,11 +739,12 @@ fn _fast_path_seconds(
     repeats: u32,
 ) -> PyResult<f64> {
     let py = g.py();
-    let grads = design.gradients(g)?;
+    let grads = design.gradients(g, usize::MAX)?;
     let gs = grads.as_grads();
     let shader = &design.shader;
+    let mut out = buffer(gs.len(), "the intensities")?;
+    out.resize(gs.len(), 0u16);
     Ok(py.detach(|| {
-        let mut out = vec![0u16; gs.len()];
         (0..repeats.max(1))
             .map(|_| {
                 let t = std::time::Instant::now();
@@ -708,6 +762,7 @@ fn _rmapgen(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Scene>()?;
     m.add_class::<Design>()?;
     m.add_function(wrap_pyfunction!(metrics, m)?)?;
+    m.add_function(wrap_pyfunction!(quantize, m)?)?;
     m.add_function(wrap_pyfunction!(sphere, m)?)?;
     m.add_function(wrap_pyfunction!(_fast_path_seconds, m)?)?;
     m.add("TRACE_MAX", TRACE_MAX)?;

@@ -54,7 +54,7 @@ def test_shade_reads_int32_in_place_and_checks_every_other_input():
             d.shade(np.array(bad, dtype=np.int64))
     with pytest.raises(ValueError, match=r"expected an \(N, 3\) array"):
         d.shade(np.zeros((4, 2), dtype=np.int32))
-    with pytest.raises(ValueError, match="integer gradients"):
+    with pytest.raises(ValueError, match=r"^g: expected an \(N, 3\) array, got shape \(3,\)$"):
         d.shade(np.zeros(3, dtype=np.int32))
     assert d.shade(np.zeros((0, 3), dtype=np.int32)).shape == (0,)
 
@@ -66,7 +66,6 @@ def test_reference_exact_and_metrics_are_renders():
     ref, exact = d.reference(g), d.exact(g)
     # The quantised reference is the exact light model rounded and clamped to 8 bits.
     assert np.abs(ref - np.clip(exact * 255, 0, 255)).max() <= 0.5 + 1e-9
-    assert np.isnan(d.exact(np.array([[0, 0, 0]], dtype=np.int32)))[0]
     m = rmapgen.metrics(d.shade(g), ref, d.peak)
     assert m["pixels"] == len(g) and m["peak"] == 255
     assert sum(m["abs_error_histogram"]) == len(g)
@@ -74,7 +73,7 @@ def test_reference_exact_and_metrics_are_renders():
     assert same["max_abs_error"] == 0 and same["psnr_db"] is None
     with pytest.raises(ValueError, match="metrics of 2 and 1 samples"):
         rmapgen.metrics([1, 2], [1], 255)
-    with pytest.raises(ValueError, match=r"a\[0\] = -1 is not an output value"):
+    with pytest.raises(ValueError, match=r"^a\[0\] = -1 is outside 0..=255"):
         rmapgen.metrics([-1], [1], 255)
     with pytest.raises(ValueError, match="size 0 is outside"):
         rmapgen.sphere(d.config, 0)

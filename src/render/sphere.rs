@@ -33,27 +33,28 @@ pub fn normal(n: u32, x: u32, y: u32) -> Option<DVec3> {
 /// once rather than rounding the full-range gradient and then halving it k times keeps the
 /// shrunk gradient the nearest integer vector to the normal at that scale.
 pub fn gradient(cfg: &Config, n: DVec3, shrink: u32) -> [i32; 3] {
-    let scale = ((1u32 << (cfg.grad_bits - 1)) - 1) as f64 / (1u64 << shrink) as f64;
-    (n * scale).round().to_array().map(|c| c as i32)
+    let scale = *cfg.grad_range().end() as f64 / (1u64 << shrink) as f64;
+    crate::geometry::round_gradient(n, scale)
 }
 
 /// Every inside pixel of an `n` x `n` sphere image in raster order (top row first, left to
 /// right), with its gradient. Panics if `shrink` exceeds [`max_shrink`].
 pub fn sphere_gradients(cfg: &Config, n: u32, shrink: u32) -> Vec<Pixel> {
+    let mut v = Vec::with_capacity((n as usize * n as usize) * 4 / 5);
+    v.extend(pixels(cfg, n, shrink));
+    v
+}
+
+/// [`sphere_gradients`] one pixel at a time, for a caller that holds them its own way.
+pub fn pixels(cfg: &Config, n: u32, shrink: u32) -> impl Iterator<Item = Pixel> + '_ {
     assert!(
         shrink <= max_shrink(cfg),
         "shrink {shrink} exceeds {}",
         max_shrink(cfg)
     );
-    let mut v = Vec::with_capacity((n as usize * n as usize) * 4 / 5);
-    for y in 0..n {
-        for x in 0..n {
-            if let Some(nv) = normal(n, x, y) {
-                v.push((x, y, gradient(cfg, nv, shrink)));
-            }
-        }
-    }
-    v
+    (0..n).flat_map(move |y| {
+        (0..n).filter_map(move |x| normal(n, x, y).map(|nv| (x, y, gradient(cfg, nv, shrink))))
+    })
 }
 
 #[cfg(test)]

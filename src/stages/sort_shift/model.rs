@@ -34,8 +34,7 @@ pub fn sign_mag(cfg: &Config, v: i32) -> (u32, u32) {
 
 /// Whether `v` is a valid `grad_bits` two's-complement value.
 pub fn in_range(cfg: &Config, v: i32) -> bool {
-    let half = 1i32 << (cfg.grad_bits - 1);
-    (-half..half).contains(&v)
+    cfg.grad_range().contains(&v)
 }
 
 /// Index of the max axis under the tie rule, from the three magnitudes.
