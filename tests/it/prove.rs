@@ -908,7 +908,10 @@ fn merge_refuses_reports_that_do_not_cover_the_run() {
     });
     let other_config = forge("config.json", &|v| {
         v["config"]["map_bits"] = 7.into();
-        let summary = v["config_summary"].as_str().unwrap().replace(" M6 ", " M7 ");
+        let summary = v["config_summary"]
+            .as_str()
+            .unwrap()
+            .replace(" M6 ", " M7 ");
         v["config_summary"] = summary.into();
     });
     let old = forge("old.json", &|v| v["format"] = "rmapgen-prove-1".into());
