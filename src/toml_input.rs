@@ -168,7 +168,8 @@ pub fn parse<T: DeserializeOwned>(text: &str, what: &str) -> Result<T> {
     }
 }
 
-/// A syntax error, with the case of `key =` with nothing after it said plainly.
+/// A syntax error: where, the key whose value holds it, and the parser's message; `key =`
+/// with nothing after it and an array item without a comma after it said plainly.
 fn syntax_error(text: &str, what: &str, e: &toml::de::Error) -> String {
     let span = e.span();
     if let Some(s) = &span {
@@ -187,7 +188,145 @@ fn syntax_error(text: &str, what: &str, e: &toml::de::Error) -> String {
             }
         }
     }
-    format!("{}: {}", place(what, text, span), one_line(e.message()))
+    // The parser's message, with the key whose value it is about.
+    let key = span.as_ref().and_then(|s| key_at(text, s.start));
+    let mut msg = place(what, text, span.clone());
+    if let Some(k) = &key {
+        msg.push_str(&format!(": {}", k.path));
+    }
+    msg.push_str(&format!(": {}", one_line(e.message())));
+    if let (Some(k), Some(s)) = (&key, &span) {
+        if let Some((a, b)) = comma_missing(text, k, s) {
+            msg.push_str(&format!(" (is a comma missing between {a} and {b}?)"));
+        }
+    }
+    msg
+}
+
+/// The key whose value holds a syntax error, found in the text (which does not parse).
+#[derive(Debug, PartialEq, Eq)]
+struct KeyAt {
+    /// As a key path is written elsewhere in messages: `light[0].direction`.
+    path: String,
+    /// Where its value (or the line of it that holds the error) starts, and how many arrays
+    /// are open there.
+    from: usize,
+    depth: usize,
+}
+
+/// The key whose value holds byte `at` of TOML `text`, from the lines up to it: the table in
+/// force (`[material]`, or the n-th `[[light]]` as `light[n-1]`) and the key of the value,
+/// also when the value is an array over several lines. None when `at` is in no value (a
+/// table header, a key).
+fn key_at(text: &str, at: usize) -> Option<KeyAt> {
+    let mut table = String::new();
+    let mut counts: std::collections::HashMap<String, usize> = Default::default();
+    // The key of a value that continues past its line (an open array), and its depth.
+    let mut open: Option<(String, usize)> = None;
+    let mut start = 0;
+    for line in text.split_inclusive('\n') {
+        let end = start + line.len();
+        let here = (start..end).contains(&at);
+        match open.take() {
+            Some((key, depth)) => {
+                if here {
+                    return Some(KeyAt {
+                        path: key,
+                        from: start,
+                        depth,
+                    });
+                }
+                let depth = depth_after(&line[..code_len(line)], depth);
+                if depth > 0 {
+                    open = Some((key, depth));
+                }
+            }
+            None => {
+                let code = &line[..code_len(line)];
+                let t = code.trim();
+                if let Some(name) = t.strip_prefix("[[").and_then(|r| r.strip_suffix("]]")) {
+                    let name = unquoted(name);
+                    let n = counts.entry(name.clone()).or_insert(0);
+                    table = format!("{name}[{n}]");
+                    *n += 1;
+                } else if let Some(name) = t.strip_prefix('[').and_then(|r| r.strip_suffix(']')) {
+                    table = unquoted(name);
+                } else if let Some(eq) = code.find('=') {
+                    let key = unquoted(&code[..eq]);
+                    let path = if table.is_empty() {
+                        key
+                    } else {
+                        format!("{table}.{key}")
+                    };
+                    let value = start + eq + 1;
+                    if here && at >= value {
+                        return Some(KeyAt {
+                            path,
+                            from: value,
+                            depth: 0,
+                        });
+                    }
+                    let depth = depth_after(&code[eq + 1..], 0);
+                    if depth > 0 {
+                        open = Some((path, depth));
+                    }
+                }
+                if here {
+                    return None;
+                }
+            }
+        }
+        start = end;
+    }
+    None
+}
+
+/// A key as written (`direction`, `"a b"`, ` a . b `), without its quotes and spaces.
+fn unquoted(key: &str) -> String {
+    key.split('.')
+        .map(|k| k.trim().trim_matches(|c| c == '"' || c == '\''))
+        .collect::<Vec<_>>()
+        .join(".")
+}
+
+/// The bytes of a line before its comment (a `#` outside a string).
+fn code_len(line: &str) -> usize {
+    let mut quote = None;
+    for (i, c) in line.char_indices() {
+        match (quote, c) {
+            (None, '#') => return i,
+            (None, '"' | '\'') => quote = Some(c),
+            (Some(q), _) if c == q => quote = None,
+            _ => {}
+        }
+    }
+    line.len()
+}
+
+/// The depth of open arrays after `code`, starting at `depth` (brackets in strings skipped).
+fn depth_after(code: &str, mut depth: usize) -> usize {
+    let mut quote = None;
+    for c in code.chars() {
+        match (quote, c) {
+            (None, '"' | '\'') => quote = Some(c),
+            (Some(q), _) if c == q => quote = None,
+            (None, '[') => depth += 1,
+            (None, ']') => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+    }
+    depth
+}
+
+/// The two items a syntax error at `span` runs together inside an array of the value of
+/// `key`, when a comma between them is what is missing: the parser reads `[1.0 1.0, 2.0]` as
+/// a bare string `1.0 1.0` ("string values must be quoted"), whose words are each a value.
+fn comma_missing(text: &str, key: &KeyAt, span: &Range<usize>) -> Option<(String, String)> {
+    let inside = depth_after(&text[key.from..span.start], key.depth) > 0;
+    let words: Vec<&str> = text[span.clone()].split_whitespace().collect();
+    let value = |w: &str| toml::from_str::<toml::Table>(&format!("v = {w}")).is_ok();
+    (inside && words.len() >= 2 && words.iter().all(|w| value(w)))
+        .then(|| (words[0].to_string(), words[1].to_string()))
 }
 
 /// A validation error located in the file: `what:line:col: message`.
@@ -257,6 +396,59 @@ mod tests {
         assert_eq!(line_col("ab\ncd\n", 4), (2, 2));
         assert_eq!(line_col("é\nx", 3), (2, 1));
         assert_eq!(line_col("ab", 99), (1, 3));
+    }
+
+    /// A syntax error names the key whose value holds it, from the text that does not parse:
+    /// through tables, the n-th array table, multi-line arrays, comments and quotes.
+    #[test]
+    fn a_syntax_error_names_its_key() {
+        let err = |t: &str| {
+            parse::<toml::Table>(t, "scene s.toml")
+                .unwrap_err()
+                .to_string()
+        };
+        let m = "[material]\nambient = 0.1\n";
+        assert_eq!(
+            err(&format!("{m}[[light]]\ndirection = [1.0, 1.0, 2.0]\n[[light]]\ndirection = [1.0 1.0, 2.0]\n")),
+            "scene s.toml:6:14: light[1].direction: string values must be quoted, expected literal string (is a comma missing between 1.0 and 1.0?)"
+        );
+        // Over several lines, a comment with a bracket and a string with one on the way.
+        assert_eq!(
+            err(&format!("{m}[[light]] # [x]\nname = \"[a\"\ndirection = [\n  1.0, # ]\n  1.0 2.0,\n]\n")),
+            "scene s.toml:7:3: light[0].direction: string values must be quoted, expected literal string (is a comma missing between 1.0 and 2.0?)"
+        );
+        // The parser's own missing-comma message; a key at the top; a table's key.
+        assert_eq!(
+            err("a = [\"x\" \"y\"]\n"),
+            "scene s.toml:1:10: a: missing comma between array elements, expected `,`"
+        );
+        assert_eq!(
+            err(&format!("{m}shininess = [1 2 3]\n")),
+            "scene s.toml:3:14: material.shininess: string values must be quoted, expected literal string (is a comma missing between 1 and 2?)"
+        );
+        // Words that are no values are not a missing comma; outside an array neither.
+        assert_eq!(
+            err("v = [a b]\n"),
+            "scene s.toml:1:6: v: string values must be quoted, expected literal string"
+        );
+        assert_eq!(
+            err("v = 1 2\n"),
+            "scene s.toml:1:7: v: unexpected content, expected nothing"
+        );
+        // In a header or a key: no key named.
+        assert_eq!(
+            err("a = 1\n[foo\n"),
+            "scene s.toml:2:5: unclosed table, expected `]`"
+        );
+        assert_eq!(
+            err("[t]\nb c = 1\n"),
+            "scene s.toml:2:3: unexpected content, expected nothing"
+        );
+        // Quoted and dotted keys as written, without quotes or spaces.
+        assert_eq!(
+            err("[\"my t\"]\n \"k\" . x = [1 2]\n"),
+            "scene s.toml:2:13: my t.k.x: string values must be quoted, expected literal string (is a comma missing between 1 and 2?)"
+        );
     }
 
     #[test]

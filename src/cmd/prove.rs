@@ -172,16 +172,15 @@ fn slurm(a: &ProveArgs, design: &DesignDir, policy: &crate::output::Policy) -> R
     prove::slurm::check(&o)?;
     prove::slurm::check_tools()?;
     let exe = std::env::current_exe().context("the path of rmapgen itself, for the jobs")?;
-    // The job directory is committed at once: the jobs write into it at its final path.
-    let staged = StagedDir::new(&a.build.join(format!("{}-slurm", design.name())), policy)?;
-    let root = staged.commit()?;
-    let layout = prove::slurm::Layout {
-        root: absolute(&root),
-    };
+    // The job directory is put in place at once: the jobs write into it at its final path.
+    // It is provisional until the jobs are submitted: nothing is left if they cannot be.
+    let shown = a.build.join(format!("{}-slurm", design.name()));
+    let job_dir = StagedDir::new(&shown, policy)?.commit_in_place()?;
     let steps = super::progress::Progress::steps("prove");
     let outcome = prove::slurm::run(
         design,
-        &layout,
+        job_dir,
+        &shown,
         &exe,
         &o,
         &|line| steps.suspend(|| crate::outln!("{line}")),

@@ -173,7 +173,7 @@ impl StagedDir {
         let shown = self.target.display().to_string();
         std::fs::remove_file(self.staging.join(STAGING_MARK))
             .with_context(|| format!("cannot finish {shown}"))?;
-        stamp::write(&self.staging).with_context(|| format!("cannot finish {shown}"))?;
+        seal(&self.staging).with_context(|| format!("cannot finish {shown}"))?;
         // Not with_extension: the staging name's extension is `staging-PID`, and the old
         // output must be found by remove_stale as `<staging>.old`.
         let mut old = self.staging.clone().into_os_string();
@@ -214,6 +214,138 @@ impl StagedDir {
         self.created.keep();
         Ok(self.target.clone())
     }
+}
+
+impl StagedDir {
+    /// Puts the directory in place now, before the work that fills it is done, for work that
+    /// must write at the final path (jobs of a batch system, which run later, elsewhere, and
+    /// write their logs and reports there). The target is checked again first, as by
+    /// [`StagedDir::commit`]. Until [`InPlace::keep`] the directory is provisional: dropped
+    /// (the work could not start) or interrupted, it is removed, the previous output it
+    /// replaced is put back, and the parents made for it are removed.
+    pub fn commit_in_place(mut self) -> Result<InPlace> {
+        self.policy.check_dir(&self.target)?;
+        let shown = self.target.display().to_string();
+        std::fs::remove_file(self.staging.join(STAGING_MARK))
+            .with_context(|| format!("cannot finish {shown}"))?;
+        let mut old = self.staging.clone().into_os_string();
+        old.push(".old");
+        let old = PathBuf::from(old);
+        let token = self.token.take().expect("registered until commit");
+        let mut held = signals::hold();
+        let had_old = self.target.exists();
+        if had_old {
+            if let Err(e) = std::fs::rename(&self.target, &old) {
+                self.token = Some(token);
+                return Err(e).with_context(|| format!("cannot replace {shown}"));
+            }
+        }
+        if let Err(e) = std::fs::rename(&self.staging, &self.target) {
+            if had_old {
+                std::fs::rename(&old, &self.target).ok();
+            }
+            self.token = Some(token);
+            return Err(e).with_context(|| format!("cannot move output into {shown}"));
+        }
+        // Undone last first: the new directory removed, then the old one put back.
+        let mut tokens = Vec::new();
+        if had_old {
+            held.replace(
+                &token,
+                Undo::Restore {
+                    from: old.clone(),
+                    to: self.target.clone(),
+                },
+            );
+            tokens.push(token);
+            tokens.push(held.register(Undo::Remove(self.target.clone())));
+        } else {
+            held.replace(&token, Undo::Remove(self.target.clone()));
+            tokens.push(token);
+        }
+        drop(held);
+        Ok(InPlace {
+            target: self.target.clone(),
+            old: had_old.then_some(old),
+            tokens,
+            created: std::mem::replace(&mut self.created, CreatedParents { dirs: Vec::new() }),
+        })
+    }
+}
+
+/// A directory in place whose work is still under way ([`StagedDir::commit_in_place`]):
+/// dropped before [`InPlace::keep`], it is taken back.
+pub struct InPlace {
+    target: PathBuf,
+    /// The previous output, moved aside until the new one is kept.
+    old: Option<PathBuf>,
+    /// What an interrupt undoes; empty once kept.
+    tokens: Vec<Token>,
+    created: CreatedParents,
+}
+
+impl InPlace {
+    /// The directory, at its final path.
+    pub fn path(&self) -> &Path {
+        &self.target
+    }
+
+    /// The work has run: the directory stays, recorded ([`seal`]) as every output is, so that
+    /// a later run replaces it; the previous output goes, the parents made for it stay.
+    pub fn keep(mut self) -> Result<PathBuf> {
+        if let Some(old) = self.old.take() {
+            std::fs::remove_dir_all(old).ok();
+        }
+        for t in self.tokens.drain(..) {
+            t.release();
+        }
+        self.created.keep();
+        seal(&self.target).with_context(|| format!("cannot finish {}", self.target.display()))?;
+        Ok(self.target.clone())
+    }
+}
+
+impl Drop for InPlace {
+    fn drop(&mut self) {
+        if self.tokens.is_empty() {
+            return;
+        }
+        {
+            let _held = signals::hold();
+            std::fs::remove_dir_all(&self.target).ok();
+            if let Some(old) = &self.old {
+                std::fs::rename(old, &self.target).ok();
+            }
+        }
+        for t in self.tokens.drain(..).rev() {
+            t.release();
+        }
+        // Then `created` drops: the parents made for the directory go, if empty.
+    }
+}
+
+/// Records directory `dir`, which rmapgen (or work it started) has just written whole, as
+/// rmapgen's: its empty directories removed (a directory rmapgen wrote holds a file it wrote:
+/// an empty one would count as another's, and the next run would refuse to replace it), then
+/// its stamp written.
+fn seal(dir: &Path) -> Result<()> {
+    remove_empty_dirs(dir)?;
+    stamp::write(dir)
+}
+
+/// Removes every empty directory below `dir` (not `dir` itself; symbolic links are not
+/// followed), deepest first; whether `dir` is left empty.
+fn remove_empty_dirs(dir: &Path) -> Result<bool> {
+    let mut empty = true;
+    for (name, ty) in stamp::sorted_entries(dir)? {
+        let p = dir.join(&name);
+        if ty.is_dir() && remove_empty_dirs(&p)? {
+            std::fs::remove_dir(&p).with_context(|| format!("cannot remove {}", p.display()))?;
+        } else {
+            empty = false;
+        }
+    }
+    Ok(empty)
 }
 
 impl Drop for StagedDir {
@@ -720,6 +852,72 @@ mod tests {
         assert!(live.is_dir() && unmarked.is_dir() && file.is_file() && not_a_pid.is_dir());
         assert!(process_alive(&std::process::id().to_string()));
         assert!(!process_alive("4000000"));
+    }
+
+    /// A directory put in place before its work: dropped, it goes with the parents made for
+    /// it, or the previous output comes back as it was; kept, it stays, stamped, without its
+    /// empty directories, and a later run replaces it.
+    #[test]
+    fn a_directory_in_place_is_taken_back_unless_kept() {
+        let tmp = tempfile::tempdir().unwrap();
+        let policy = Policy::new(false);
+        let target = tmp.path().join("a").join("b").join("jobs");
+        let dir = StagedDir::new(&target, &policy).unwrap();
+        dir.write_text("job.sh", "true").unwrap();
+        let job = dir.commit_in_place().unwrap();
+        assert_eq!(job.path(), target);
+        assert_eq!(
+            tree(tmp.path()),
+            ["a", "a/b", "a/b/jobs", "a/b/jobs/job.sh"],
+            "in place, unmarked, unstamped"
+        );
+        std::fs::create_dir_all(target.join("logs")).unwrap();
+        drop(job);
+        assert_eq!(tree(tmp.path()), Vec::<String>::new(), "taken back whole");
+
+        // Kept: the empty directories (at any depth) go, the rest is stamped.
+        let dir = StagedDir::new(&target, &policy).unwrap();
+        dir.write_text("job.sh", "true").unwrap();
+        let job = dir.commit_in_place().unwrap();
+        for d in ["logs", "status/a/b", "reports"] {
+            std::fs::create_dir_all(target.join(d)).unwrap();
+        }
+        std::fs::write(target.join("reports").join("r.json"), "{}").unwrap();
+        assert_eq!(job.keep().unwrap(), target);
+        assert_eq!(
+            tree(&target),
+            [".rmapgen-files", "job.sh", "reports", "reports/r.json"]
+        );
+        assert_eq!(
+            stamp::read(&target).unwrap().keys().collect::<Vec<_>>(),
+            ["job.sh", "reports/r.json"]
+        );
+        let kept = tree(tmp.path());
+
+        // Over that output: dropped, it is back byte for byte; kept, it is replaced.
+        let dir = StagedDir::new(&target, &policy).unwrap();
+        dir.write_text("job.sh", "false").unwrap();
+        let job = dir.commit_in_place().unwrap();
+        assert_eq!(std::fs::read(target.join("job.sh")).unwrap(), b"false\n");
+        drop(job);
+        assert_eq!(tree(tmp.path()), kept);
+        assert_eq!(std::fs::read(target.join("job.sh")).unwrap(), b"true\n");
+        let dir = StagedDir::new(&target, &policy).unwrap();
+        dir.write_text("job.sh", "false").unwrap();
+        dir.commit_in_place().unwrap().keep().unwrap();
+        assert_eq!(tree(&target), [".rmapgen-files", "job.sh"]);
+        assert_eq!(
+            tree(target.parent().unwrap()),
+            ["jobs", "jobs/.rmapgen-files", "jobs/job.sh"]
+        );
+        assert_eq!(std::fs::read(target.join("job.sh")).unwrap(), b"false\n");
+        // A committed output loses its empty directories too (the next run may replace it).
+        let dir = StagedDir::new(&target, &policy).unwrap();
+        std::fs::create_dir_all(dir.path().join("empty").join("deeper")).unwrap();
+        dir.write_text("x/y.v", "").unwrap();
+        dir.commit().unwrap();
+        assert_eq!(tree(&target), [".rmapgen-files", "x", "x/y.v"]);
+        assert!(StagedDir::new(&target, &policy).is_ok());
     }
 
     /// A parent that exists as a file is still an error (only a directory made meanwhile is

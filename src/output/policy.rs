@@ -107,11 +107,11 @@ impl Policy {
             None => Ok(()),
             Some(Foreign::NotWritten(rel)) => bail!(
                 "will not replace {shown}: it holds {rel}, which rmapgen did not write; nothing \
-                 was changed (move it, choose another --out, or use --force)"
+                 was changed (move it, choose another output directory, or use --force)"
             ),
             Some(Foreign::Changed(rel)) => bail!(
                 "will not replace {shown}: {rel} was changed since rmapgen wrote it; nothing \
-                 was changed (move it, choose another --out, or use --force)"
+                 was changed (move it, choose another output directory, or use --force)"
             ),
         }
     }

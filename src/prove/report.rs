@@ -426,7 +426,10 @@ pub fn merge(files: &[PathBuf]) -> Result<Merged> {
             at == total,
             "part {name}: the shards stop at {at} of {total}"
         );
-        let failures: u64 = ranges.iter().map(|(p, _)| p.failures).sum();
+        // Saturating: forged counts that wrapped around to 0 would pass.
+        let failures = ranges
+            .iter()
+            .fold(0u64, |n, (p, _)| n.saturating_add(p.failures));
         passed &= failures == 0;
         // The engines the shards used for the part (shards may differ: each proves its range).
         let mut engines: Vec<&str> = ranges
@@ -476,17 +479,22 @@ pub fn merge(files: &[PathBuf]) -> Result<Merged> {
     Ok(Merged { passed, text })
 }
 
+/// Reads report `f`: at most [`MAX_REPORT_BYTES`] (one byte more is read to tell, never the
+/// length a file's metadata claims: a device or a FIFO says 0 and never ends), a report of
+/// this format whose fields agree with each other ([`contradiction`]).
 fn read(f: &Path) -> Result<Report> {
-    let len = std::fs::metadata(f)
-        .with_context(|| format!("cannot read {}", f.display()))?
-        .len();
+    use std::io::Read;
+    let mut bytes = Vec::new();
+    std::fs::File::open(f)
+        .and_then(|file| file.take(MAX_REPORT_BYTES + 1).read_to_end(&mut bytes))
+        .with_context(|| format!("cannot read {}", f.display()))?;
     ensure!(
-        len <= MAX_REPORT_BYTES,
-        "{} is {len} bytes, not a report of rmapgen prove (at most {MAX_REPORT_BYTES})",
+        bytes.len() as u64 <= MAX_REPORT_BYTES,
+        "{} is larger than {MAX_REPORT_BYTES} bytes, not a report of rmapgen prove",
         f.display()
     );
-    let text =
-        std::fs::read_to_string(f).with_context(|| format!("cannot read {}", f.display()))?;
+    let text = String::from_utf8(bytes)
+        .with_context(|| format!("{} is not a report of rmapgen prove", f.display()))?;
     let v: serde_json::Value = serde_json::from_str(&text)
         .with_context(|| format!("{} is not a report of rmapgen prove", f.display()))?;
     ensure!(
@@ -506,7 +514,114 @@ fn read(f: &Path) -> Result<Report> {
         r.shard.count,
         super::MAX_SHARDS
     );
+    if let Some(c) = contradiction(&r) {
+        bail!(
+            "{}: {c}; rmapgen prove writes no such report (was it edited?): prove the shard again",
+            f.display()
+        );
+    }
     Ok(r)
+}
+
+/// The first field of report `r` that contradicts another, as `field: what`: rmapgen prove
+/// writes every report consistent, so such a report was edited or damaged and gives no
+/// verdict (the merge refuses it, rather than trust one field over the other).
+/// - `passed` is true exactly when no part failed;
+/// - a part keeps the first [`super::KEEP_FAILURES`] of its `failures` as `examples`, so
+///   there are as many examples as failures, up to that many;
+/// - a part without failures checked exactly the inputs of its range (one that checked
+///   fewer or more has failed: [`Part::new`]), and its range lies within its `total`;
+/// - times are finite and not negative;
+/// - `config_summary` is the configuration's, the front names the engine that evaluated it
+///   (and no other part names one), and the files are listed once each, sorted, by a
+///   SHA-256 (64 lower-case hex digits).
+pub fn contradiction(r: &Report) -> Option<String> {
+    let time = |field: &str, s: f64| {
+        (!(s.is_finite() && s >= 0.0))
+            .then(|| format!("{field} is {s}, not a time (finite, at least 0)"))
+    };
+    if let Some(e) = time("seconds", r.seconds) {
+        return Some(e);
+    }
+    let failed = r.parts.iter().any(|p| p.failures > 0);
+    if r.passed == failed {
+        return Some(format!(
+            "passed is {}, but {} part failed",
+            r.passed,
+            if failed { "a" } else { "no" }
+        ));
+    }
+    let summary = r.config.summary();
+    if r.config_summary != summary {
+        return Some(format!(
+            "config_summary is {:?}, but its config is {summary:?}",
+            r.config_summary
+        ));
+    }
+    for (i, p) in r.parts.iter().enumerate() {
+        let at = format!("parts[{i}] ({})", p.name);
+        let kept = p.failures.min(super::KEEP_FAILURES as u64);
+        if p.examples.len() as u64 != kept {
+            return Some(format!(
+                "{at}: examples lists {} failures, but failures is {} (the first {} are kept)",
+                p.examples.len(),
+                p.failures,
+                super::KEEP_FAILURES
+            ));
+        }
+        if !(p.first <= p.end && p.end <= p.total) {
+            return Some(format!(
+                "{at}: the range [{}..{}) is not within its total {}",
+                p.first, p.end, p.total
+            ));
+        }
+        if p.failures == 0 && p.ran != p.end - p.first {
+            return Some(format!(
+                "{at}: ran is {}, not the {} inputs of its range [{}..{}), but failures is 0 (checked other than its range is a failure)",
+                p.ran,
+                p.end - p.first,
+                p.first,
+                p.end
+            ));
+        }
+        if let Some(e) = time(&format!("{at}: seconds"), p.seconds)
+            .or_else(|| time(&format!("{at}: cpu_seconds"), p.cpu_seconds))
+        {
+            return Some(e);
+        }
+        let engine_ok = if p.name == "front" {
+            <super::FrontEngine as clap::ValueEnum>::value_variants()
+                .iter()
+                .any(|e| e.name() == p.engine)
+        } else {
+            p.engine.is_empty()
+        };
+        if !engine_ok {
+            return Some(format!(
+                "{at}: engine {:?} is not what evaluates it",
+                p.engine
+            ));
+        }
+    }
+    for (i, f) in r.files.iter().enumerate() {
+        let hex = f.sha256.len() == 64
+            && f.sha256
+                .bytes()
+                .all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b));
+        if !hex {
+            return Some(format!(
+                "files[{i}] ({}): sha256 {:?} is not a SHA-256 (64 lower-case hex digits)",
+                f.name, f.sha256
+            ));
+        }
+        if i > 0 && r.files[i - 1].name >= f.name {
+            return Some(format!(
+                "files[{i}] ({}) is listed twice or out of order",
+                f.name
+            ));
+        }
+    }
+    None
 }
 
 #[cfg(test)]
@@ -724,8 +839,30 @@ mod tests {
         let mut r = run(2, false);
         r[1].parts[1].failures = 1;
         r[1].parts[1].examples = vec!["states (buffer 0 as loaded): sample 7".into()];
+        r[1].passed = false;
         let m = merge_reports(&r).unwrap();
         assert!(!m.passed && m.text.contains("FAILED") && m.text.contains("sample 7"));
+        assert!(
+            m.text.contains("  states ") && m.text.contains(": 1 FAILED\n"),
+            "{}",
+            m.text
+        );
+        // Failures counted past the kept examples; counts that would wrap around to 0 when
+        // summed still fail (saturating at the largest count).
+        let mut r = run(2, false);
+        for rep in r.iter_mut() {
+            rep.parts[3].failures = 1 << 63;
+            rep.parts[3].examples = vec!["front: gradient".into(); crate::prove::KEEP_FAILURES];
+            rep.passed = false;
+        }
+        let m = merge_reports(&r).unwrap();
+        assert!(!m.passed, "{}", m.text);
+        assert!(
+            m.text.contains(&format!("{} FAILED", u64::MAX)),
+            "{}",
+            m.text
+        );
+        assert!(m.text.ends_with(" s of shard time\n") && m.text.contains("\nFAILED: G8 "));
         // An edited file is named.
         let mut r = run(1, false);
         r[0].files[1].as_generated = false;
@@ -777,9 +914,17 @@ mod tests {
             }),
             "claims 10 inputs; the configuration gives 16777216",
         );
+        // A part that checked one input less and says so (a failure) is a verdict of a shard
+        // that did not finish its range: refused as a whole.
         refused(
-            &edit(&|r| r[0].parts[1].ran -= 1),
-            "checked 3743999 inputs of its 3744000",
+            &edit(&|r| {
+                let p = &mut r[0].parts[1];
+                p.ran -= 1;
+                p.failures = 1;
+                p.examples = vec!["states: checked 3743999 inputs".into()];
+                r[0].passed = false;
+            }),
+            "part states of shard 1/2 checked 3743999 inputs of its 3744000",
         );
         refused(
             &edit(&|r| {
@@ -806,7 +951,10 @@ mod tests {
             "proved other files",
         );
         refused(
-            &edit(&|r| r[1].config.map_bits += 1),
+            &edit(&|r| {
+                r[1].config.map_bits += 1;
+                r[1].config_summary = r[1].config.summary();
+            }),
             "another configuration or mode",
         );
         refused(
@@ -822,8 +970,10 @@ mod tests {
         );
         refused(
             &edit(&|r| {
-                r[0].config.grad_bits = 14;
-                r[1].config.grad_bits = 14;
+                for rep in r.iter_mut() {
+                    rep.config.grad_bits = 14;
+                    rep.config_summary = rep.config.summary();
+                }
             }),
             "grad_bits = 14 is above 12",
         );
@@ -839,6 +989,198 @@ mod tests {
         refused(
             &edit(&|r| r[0].format = "rmapgen-prove-1".into()),
             "its format is",
+        );
+    }
+
+    /// Every field that can contradict another, edited as one would edit the JSON: the
+    /// merge names the file and the field and gives no verdict.
+    #[test]
+    fn a_report_that_contradicts_itself_is_refused_naming_its_file_and_field() {
+        let base = run(2, false);
+        let edit = |f: &dyn Fn(&mut Vec<Report>)| {
+            let mut r = base.clone();
+            f(&mut r);
+            r
+        };
+        let example = || vec!["states (buffer 0 as loaded): sample 7".to_string()];
+        for (r, want) in [
+            (
+                edit(&|r| r[1].passed = false),
+                "1.json: passed is false, but no part failed; rmapgen prove writes no such report (was it edited?)",
+            ),
+            (
+                edit(&|r| {
+                    r[0].parts[1].failures = 1;
+                    r[0].parts[1].examples = example();
+                }),
+                "0.json: passed is true, but a part failed",
+            ),
+            (
+                edit(&|r| r[1].parts[1].examples = example()),
+                "1.json: parts[1] (states): examples lists 1 failures, but failures is 0",
+            ),
+            (
+                edit(&|r| {
+                    r[1].parts[1].failures = 2;
+                    r[1].parts[1].examples = example();
+                    r[1].passed = false;
+                }),
+                "parts[1] (states): examples lists 1 failures, but failures is 2 (the first 20 are kept)",
+            ),
+            (
+                edit(&|r| {
+                    r[1].parts[1].failures = 1;
+                    r[1].passed = false;
+                }),
+                "parts[1] (states): examples lists 0 failures, but failures is 1",
+            ),
+            (
+                edit(&|r| {
+                    r[1].parts[1].failures = 30;
+                    r[1].parts[1].examples = vec!["x".into(); 21];
+                    r[1].passed = false;
+                }),
+                "examples lists 21 failures, but failures is 30",
+            ),
+            (
+                edit(&|r| r[1].seconds = -5.0),
+                "1.json: seconds is -5, not a time (finite, at least 0)",
+            ),
+            (
+                edit(&|r| r[0].parts[2].seconds = -0.5),
+                "0.json: parts[2] (zero): seconds is -0.5, not a time",
+            ),
+            (
+                edit(&|r| r[0].parts[3].cpu_seconds = -1.0),
+                "0.json: parts[3] (front): cpu_seconds is -1, not a time",
+            ),
+            (
+                edit(&|r| {
+                    let p = &mut r[1].parts[3];
+                    p.end = p.total + 1;
+                    p.ran = p.end - p.first;
+                }),
+                "parts[3] (front): the range [8388608..16777217) is not within its total 16777216",
+            ),
+            (
+                edit(&|r| {
+                    let p = &mut r[1].parts[3];
+                    (p.first, p.end, p.ran) = (p.end, p.first, 0);
+                }),
+                "parts[3] (front): the range [16777216..8388608) is not within its total",
+            ),
+            (
+                edit(&|r| r[0].parts[1].ran += 1),
+                "0.json: parts[1] (states): ran is 3744001, not the 3744000 inputs of its range [0..3744000), but failures is 0",
+            ),
+            (
+                edit(&|r| r[0].config_summary = "G12 R8".into()),
+                "0.json: config_summary is \"G12 R8\", but its config is \"G8 ",
+            ),
+            (
+                edit(&|r| r[0].parts[3].engine = "magic".into()),
+                "0.json: parts[3] (front): engine \"magic\" is not what evaluates it",
+            ),
+            (
+                edit(&|r| r[0].parts[3].engine = String::new()),
+                "parts[3] (front): engine \"\" is not",
+            ),
+            (
+                edit(&|r| r[1].parts[1].engine = "gates".into()),
+                "parts[1] (states): engine \"gates\" is not",
+            ),
+            (
+                edit(&|r| r[0].files[1].sha256 = "A".repeat(64)),
+                "0.json: files[1] (recip_rom.hex): sha256 \"AAAA",
+            ),
+            (
+                edit(&|r| r[0].files[1].sha256 = "a".repeat(63)),
+                "files[1] (recip_rom.hex): sha256",
+            ),
+            (
+                edit(&|r| r[0].files[1].sha256 = "g".repeat(64)),
+                "files[1] (recip_rom.hex): sha256",
+            ),
+            (
+                edit(&|r| r[0].files[2].name = "manifest.json".into()),
+                "0.json: files[2] (manifest.json) is listed twice or out of order",
+            ),
+            (
+                edit(&|r| r[0].files.swap(1, 2)),
+                "files[2] (recip_rom.hex) is listed twice or out of order",
+            ),
+        ] {
+            refused(&r, want);
+        }
+        // As many examples as failures up to the kept 20, or exactly 20 beyond: a verdict.
+        for (failures, examples) in [(1, 1), (20, 20), (21, 20), (1 << 40, 20)] {
+            let r = edit(&|r| {
+                r[1].parts[1].failures = failures;
+                r[1].parts[1].examples = vec!["x".into(); examples];
+                r[1].passed = false;
+            });
+            let m = merge_reports(&r).unwrap();
+            assert!(!m.passed, "{}", m.text);
+            assert!(m.text.contains(&format!("{failures} FAILED")), "{}", m.text);
+        }
+        // Times JSON cannot carry (it has no NaN or infinity), as the check sees them; zero
+        // times are times.
+        for bad in [
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            -f64::MIN_POSITIVE,
+        ] {
+            let mut r = base[0].clone();
+            r.seconds = bad;
+            let e = contradiction(&r).expect("refused");
+            assert!(
+                e.starts_with(&format!("seconds is {bad}, not a time")),
+                "{e}"
+            );
+            let mut r = base[0].clone();
+            r.parts[0].cpu_seconds = bad;
+            let e = contradiction(&r).expect("refused");
+            assert!(e.starts_with("parts[0] (structure): cpu_seconds"), "{e}");
+        }
+        let mut r = base[0].clone();
+        r.seconds = 0.0;
+        r.parts[0].seconds = 0.0;
+        assert_eq!(contradiction(&r), None);
+        for r in &base {
+            assert_eq!(contradiction(r), None);
+        }
+    }
+
+    /// The bound is read, never a file's metadata: a device, a FIFO or a file that grows
+    /// is read up to one byte past it.
+    #[test]
+    fn a_report_is_read_up_to_its_bound_whatever_its_metadata_says() {
+        let e = format!("{:#}", read(Path::new("/dev/zero")).unwrap_err());
+        assert_eq!(
+            e,
+            format!(
+                "/dev/zero is larger than {MAX_REPORT_BYTES} bytes, not a report of rmapgen prove"
+            )
+        );
+        let dir = tempfile::tempdir().unwrap();
+        // A report padded to the bound exactly is read; one byte more is not.
+        let mut text = serde_json::to_string(&run(1, false)[0]).unwrap();
+        let p = dir.path().join("r.json");
+        text.push_str(&" ".repeat(MAX_REPORT_BYTES as usize - text.len()));
+        std::fs::write(&p, &text).unwrap();
+        assert!(read(&p).is_ok());
+        text.push(' ');
+        std::fs::write(&p, &text).unwrap();
+        let e = format!("{:#}", read(&p).unwrap_err());
+        assert!(
+            e.ends_with("r.json is larger than 4194304 bytes, not a report of rmapgen prove"),
+            "{e}"
+        );
+        let e = format!("{:#}", read(&dir.path().join("none.json")).unwrap_err());
+        assert!(
+            e.starts_with("cannot read ") && e.contains("none.json"),
+            "{e}"
         );
     }
 

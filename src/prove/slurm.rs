@@ -22,6 +22,7 @@
 use super::{FrontEngine, MAX_SHARDS};
 use crate::design_dir::DesignDir;
 use crate::output::signals::{self, Undo};
+use crate::output::InPlace;
 use crate::toolchain::{self, shell_word, slurm};
 use anyhow::{ensure, Context, Result};
 use std::path::{Path, PathBuf};
@@ -45,10 +46,19 @@ pub const MAX_ARRAY: u64 = 1000;
 
 /// The job directory: the scripts, the logs, the exit statuses, the reports and the builds.
 pub struct Layout {
+    /// Absolute: what the scripts name, on every node.
     pub root: PathBuf,
+    /// As the user gave it: what messages name.
+    pub shown: PathBuf,
 }
 
 impl Layout {
+    /// A path below [`Layout::root`] as messages name it: below [`Layout::shown`].
+    pub fn as_given(&self, p: &Path) -> PathBuf {
+        p.strip_prefix(&self.root)
+            .map_or_else(|_| p.to_path_buf(), |rel| self.shown.join(rel))
+    }
+
     pub fn script(&self, job: &str) -> PathBuf {
         self.root.join(format!("{job}.sh"))
     }
@@ -224,7 +234,7 @@ pub fn submit(layout: &Layout, o: &Options) -> Result<(Jobs, signals::Token)> {
         a.extend(o.sbatch_args.iter().cloned());
         a
     };
-    let build = slurm::submit(&common("build"), &layout.script("build"))?;
+    let build = slurm::submit(&common("build"), &layout.script("build"), "the build job")?;
     let token = signals::register(Undo::Run(slurm::cancel_words(std::slice::from_ref(&build))));
     let cancel_all = |ids: &[String]| {
         signals::hold().replace(&token, Undo::Run(slurm::cancel_words(ids)));
@@ -237,7 +247,7 @@ pub fn submit(layout: &Layout, o: &Options) -> Result<(Jobs, signals::Token)> {
         format!("--dependency=afterok:{build}"),
         "--kill-on-invalid-dep=yes".into(),
     ]);
-    let shards = match slurm::submit(&args, &layout.script("shards")) {
+    let shards = match slurm::submit(&args, &layout.script("shards"), "the shards' array job") {
         Ok(id) => id,
         Err(e) => {
             // Cancelled now, and no longer for an interrupt or the guardian to cancel.
@@ -252,7 +262,7 @@ pub fn submit(layout: &Layout, o: &Options) -> Result<(Jobs, signals::Token)> {
         format!("--dependency=afterany:{shards}"),
         "--kill-on-invalid-dep=yes".into(),
     ]);
-    let merge = match slurm::submit(&args, &layout.script("merge")) {
+    let merge = match slurm::submit(&args, &layout.script("merge"), "the merge job") {
         Ok(id) => id,
         Err(e) => {
             cancel(&[build, shards]);
@@ -357,6 +367,8 @@ const NAMED: usize = 20;
 /// The verdict once the jobs have ended: the merge's text, and a line for each job that did
 /// not end with exit 0 (a shard that failed the proof, failed to run, or was cancelled).
 pub fn verdict(layout: &Layout, jobs: &Jobs, n: u64) -> Outcome {
+    // Paths as the user gave them.
+    let log = |job: &str| layout.as_given(&layout.log(job)).display().to_string();
     let mut problems = Vec::new();
     match exit_of(&layout.status("build")) {
         Some(0) => {}
@@ -364,34 +376,34 @@ pub fn verdict(layout: &Layout, jobs: &Jobs, n: u64) -> Outcome {
             "the build job {} failed (exit {c}): {} ({})",
             jobs.build,
             last_line(&layout.log("build")),
-            layout.log("build").display()
+            log("build")
         )),
         None => problems.push(format!(
             "the build job {} was cancelled or killed before it ended (no exit status; {})",
             jobs.build,
-            layout.log("build").display()
+            log("build")
         )),
     }
     let mut bad = 0usize;
     for k in 1..=n {
-        let log = layout.log(&format!("shard-{k}"));
-        let line = match exit_of(&layout.status(&format!("shard-{k}"))) {
+        let job = format!("shard-{k}");
+        let line = match exit_of(&layout.status(&job)) {
             Some(0) => continue,
             Some(1) => format!(
                 "shard {k}/{n} (task {}_{k}) found inputs where the design differs from its model ({})",
                 jobs.shards,
-                layout.report(k, n).display()
+                layout.as_given(&layout.report(k, n)).display()
             ),
             Some(c) => format!(
                 "shard {k}/{n} (task {}_{k}) failed (exit {c}): {} ({})",
                 jobs.shards,
-                last_line(&log),
-                log.display()
+                last_line(&layout.log(&job)),
+                log(&job)
             ),
             None => format!(
                 "shard {k}/{n} (task {}_{k}) was cancelled or killed before it ended (no exit status; {})",
                 jobs.shards,
-                log.display()
+                log(&job)
             ),
         };
         bad += 1;
@@ -411,12 +423,12 @@ pub fn verdict(layout: &Layout, jobs: &Jobs, n: u64) -> Outcome {
             "the merge job {} failed (exit {c}): {} ({})",
             jobs.merge,
             last_line(&merge_log),
-            merge_log.display()
+            log("merge")
         )),
         None => problems.push(format!(
             "the merge job {} was cancelled or killed before it ended (no exit status; {})",
             jobs.merge,
-            merge_log.display()
+            log("merge")
         )),
     }
     let passed = problems.is_empty() && merge == Some(0);
@@ -443,49 +455,57 @@ pub fn verdict(layout: &Layout, jobs: &Jobs, n: u64) -> Outcome {
     Outcome { passed, text }
 }
 
-/// The whole run: scripts into `layout` (a directory rmapgen owns), the jobs submitted, waited
-/// for, and the verdict. `exe` is the rmapgen every job runs.
+/// The whole run in `job_dir` (put in place, provisional, by [`crate::output::StagedDir`]),
+/// which messages name as `shown`: the scripts written, the jobs submitted, waited for, and
+/// the verdict. `exe` is the rmapgen every job runs.
+///
+/// Until the jobs are submitted and announced, a failure (sbatch refusing a job: no
+/// controller, a bad partition) or an interrupt leaves nothing behind: the jobs already
+/// submitted are cancelled, the job directory is taken back with the parents made for it,
+/// and a previous run's directory is put back. Once the jobs have run, their directory is
+/// kept, recorded as rmapgen's (the jobs are rmapgen), so that the next run replaces it.
+#[allow(clippy::too_many_arguments)]
 pub fn run(
     d: &DesignDir,
-    layout: &Layout,
+    job_dir: InPlace,
+    shown: &Path,
     exe: &Path,
     o: &Options,
     announce: &dyn Fn(&str) -> Result<()>,
     progress: &dyn Fn(&str),
 ) -> Result<Outcome> {
     check(o)?;
-    write_scripts(d, layout, exe, o)?;
-    // An interrupt cancels the jobs (registered later, so undone first), then removes the
-    // job directory: nothing half-written is left.
-    let remove = signals::register(Undo::Remove(layout.root.clone()));
-    let (jobs, token) = match submit(layout, o) {
-        Ok(s) => s,
-        Err(e) => {
-            remove.release();
-            crate::output::stamp::write(&layout.root)?;
-            return Err(e);
-        }
+    let layout = Layout {
+        root: crate::output::absolute(job_dir.path()),
+        shown: shown.to_path_buf(),
     };
-    announce(&format!(
+    write_scripts(d, &layout, exe, o)?;
+    // An interrupt cancels the jobs (registered after the job directory, so undone first),
+    // then takes the job directory back.
+    let (jobs, token) = submit(&layout, o)?;
+    let announced = announce(&format!(
         "slurm: submitted build job {}, shards job {} (array 1-{}), merge job {}; scripts and logs in {}",
         jobs.build,
         jobs.shards,
         o.shards,
         jobs.merge,
-        layout.root.display()
-    ))?;
-    let waited = wait(layout, &jobs, o.shards, progress);
+        shown.display()
+    ));
+    if let Err(e) = announced {
+        // Nobody to tell the verdict to (a closed standard output): as on an interrupt.
+        cancel(&jobs.all());
+        token.release();
+        return Err(e);
+    }
+    let waited = wait(&layout, &jobs, o.shards, progress);
     if waited.is_err() {
         // Waiting failed (squeue broke): the jobs are not left behind.
         cancel(&jobs.all());
     }
     token.release();
-    remove.release();
-    // Everything in the directory is rmapgen's (the jobs are rmapgen): recorded, so that the
-    // next run replaces it.
-    crate::output::stamp::write(&layout.root)?;
+    job_dir.keep()?;
     waited.context("waiting for the Slurm jobs")?;
-    Ok(verdict(layout, &jobs, o.shards))
+    Ok(verdict(&layout, &jobs, o.shards))
 }
 
 /// The programs a run needs, checked before anything is written.
@@ -519,8 +539,10 @@ mod tests {
         merge: Option<i32>,
     ) -> (tempfile::TempDir, Outcome) {
         let tmp = tempfile::tempdir().unwrap();
+        // Messages name the directory as the user gave it.
         let layout = Layout {
             root: tmp.path().to_path_buf(),
+            shown: PathBuf::from("build/prove/d-slurm"),
         };
         for sub in ["logs", "status", "reports"] {
             std::fs::create_dir_all(tmp.path().join(sub)).unwrap();
@@ -561,9 +583,9 @@ mod tests {
         let (_t, v) = ended(Some(0), &[Some(1), Some(2), None, Some(0)], Some(1));
         assert!(!v.passed);
         for want in [
-            "\n  shard 1/4 (task 8_1) found inputs where the design differs from its model (",
-            "\n  shard 2/4 (task 8_2) failed (exit 2): its last line (",
-            "\n  shard 3/4 (task 8_3) was cancelled or killed before it ended (no exit status; ",
+            "\n  shard 1/4 (task 8_1) found inputs where the design differs from its model (build/prove/d-slurm/reports/shard-1-of-4.json)",
+            "\n  shard 2/4 (task 8_2) failed (exit 2): its last line (build/prove/d-slurm/logs/shard-2.log)",
+            "\n  shard 3/4 (task 8_3) was cancelled or killed before it ended (no exit status; build/prove/d-slurm/logs/shard-3.log)",
         ] {
             assert!(v.text.contains(want), "{want:?} in {}", v.text);
         }
@@ -572,7 +594,9 @@ mod tests {
         let (_t, v) = ended(Some(0), &[Some(0)], None);
         assert!(!v.passed);
         assert!(
-            v.text.contains("the merge job 9 was cancelled or killed"),
+            v.text.contains(
+                "the merge job 9 was cancelled or killed before it ended (no exit status; build/prove/d-slurm/logs/merge.log)"
+            ),
             "{}",
             v.text
         );
@@ -584,13 +608,15 @@ mod tests {
         let (_t, v) = ended(Some(2), &[None], Some(2));
         assert!(!v.passed);
         assert!(
-            v.text
-                .contains("the build job 7 failed (exit 2): its last line"),
+            v.text.contains(
+                "the build job 7 failed (exit 2): its last line (build/prove/d-slurm/logs/build.log)"
+            ),
             "{}",
             v.text
         );
         assert!(
-            v.text.contains("the merge job 9 failed (exit 2)"),
+            v.text
+                .contains("the merge job 9 failed (exit 2): its last line (build/prove/d-slurm/logs/merge.log)"),
             "{}",
             v.text
         );
@@ -615,6 +641,7 @@ mod tests {
         }
         let layout = Layout {
             root: tmp.path().to_path_buf(),
+            shown: tmp.path().to_path_buf(),
         };
         (tmp, layout)
     }
@@ -640,6 +667,7 @@ mod tests {
         assert_eq!(shards_ended(&layout), (5, 3));
         let none = Layout {
             root: layout.root.join("no such dir"),
+            shown: layout.root.join("no such dir"),
         };
         assert_eq!(shards_ended(&none), (0, 0));
     }
@@ -754,7 +782,10 @@ mod tests {
         .unwrap();
         use std::os::unix::fs::PermissionsExt;
         std::fs::set_permissions(&exe, std::fs::Permissions::from_mode(0o755)).unwrap();
-        let layout = Layout { root: root.clone() };
+        let layout = Layout {
+            root: root.clone(),
+            shown: root.clone(),
+        };
         let o = Options {
             shards: 4,
             partition: None,

@@ -182,6 +182,15 @@ impl Scene {
         check_coef("material.diffuse", m.diffuse)?;
         check_coef("material.specular", m.specular)?;
         check_coef("material.shininess", m.shininess)?;
+        // The maps of a scene without lights are its ambient term alone, one value
+        // everywhere: a scene that lost its [[light]] tables, not one meant so (an
+        // ambient-only scene says it with a light of intensity 0).
+        if self.lights.is_empty() {
+            return Err(Invalid::new(
+                "light",
+                "no [[light]]: a scene has one or more lights, each a [[light]] table with a direction (for the ambient term alone, give a light of intensity 0)",
+            ));
+        }
         for (i, l) in self.lights.iter().enumerate() {
             check_direction(&format!("light[{i}].direction"), l.direction)?;
             check_coef(&format!("light[{i}].intensity"), l.intensity)?;
@@ -354,12 +363,28 @@ mod tests {
         assert!(bad(&format!("{mat}[[light]]\ndirection=[nan,0,1]\n")).contains("not finite"));
         assert!(bad(&mat.replace("shininess=20", "shininess=-1")).contains("shininess"));
         assert!(bad("[material\n").len() > 3);
+        // No light at all: refused, the file named; a light of intensity 0 is the way to say
+        // ambient alone, and its maps are the ambient term everywhere.
+        assert_eq!(
+            bad(mat),
+            "scene: no [[light]]: a scene has one or more lights, each a [[light]] table with a direction (for the ambient term alone, give a light of intensity 0)"
+        );
+        let e = Scene::from_toml_named(mat, "scene s.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("scene s.toml: no [[light]]"), "{e}");
+        let ambient =
+            Scene::from_toml_str(&format!("{mat}[[light]]\ndirection=[0,0,1]\nintensity=0\n"))
+                .unwrap();
+        assert!(ambient.prepared().lights.is_empty());
+        assert_eq!(ambient.shade(DVec3::new(0.6, 0.0, 0.8)), 0.1);
+        assert_eq!(ambient.shade(DVec3::Z), 0.1);
     }
 
     #[test]
     fn optional_transfer_function() {
         assert_eq!(Scene::standard().transfer, None);
-        let mat = "[material]\nambient=0.1\ndiffuse=0.6\nspecular=0.3\nshininess=20\n";
+        let mat = "[material]\nambient=0.1\ndiffuse=0.6\nspecular=0.3\nshininess=20\n[[light]]\ndirection=[1,1,2]\n";
         let s =
             Scene::from_toml_str(&format!("{mat}[transfer]\npoints=[[10,0],[20,1]]\n")).unwrap();
         assert_eq!(s.transfer.unwrap().points, vec![[10.0, 0.0], [20.0, 1.0]]);
@@ -435,7 +460,7 @@ mod tests {
 
     #[test]
     fn colour_is_optional_and_checked() {
-        let mat = "[material]\nambient=0.1\ndiffuse=0.6\nspecular=0.3\nshininess=20\n";
+        let mat = "[material]\nambient=0.1\ndiffuse=0.6\nspecular=0.3\nshininess=20\n[[light]]\ndirection=[1,1,2]\n";
         assert_eq!(Scene::standard().color8(), None);
         let s = Scene::from_toml_str(&format!("color = [1.0, 0.5, 0.0]\n{mat}")).unwrap();
         assert_eq!(s.color8(), Some([255, 128, 0]));

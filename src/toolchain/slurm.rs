@@ -22,8 +22,8 @@ pub fn scancel() -> String {
 }
 
 /// Submits `script` with the options `args` (before the script); the job id Slurm gave it.
-/// A refusal is an error quoting sbatch's complaint.
-pub fn submit(args: &[String], script: &Path) -> Result<String> {
+/// A refusal is an error naming the job as `what` and quoting sbatch's complaint.
+pub fn submit(args: &[String], script: &Path, what: &str) -> Result<String> {
     let mut cmd = Command::new(sbatch());
     cmd.arg("--parsable").args(args).arg(script);
     let out = child::output(&mut cmd).with_context(|| super::shell_line(&cmd))?;
@@ -31,15 +31,13 @@ pub fn submit(args: &[String], script: &Path) -> Result<String> {
     if !out.status.success() {
         let stderr = String::from_utf8_lossy(&out.stderr);
         bail!(
-            "sbatch refused {}: {}",
-            script.display(),
+            "sbatch refused {what}: {}",
             super::complaint(&format!("{stdout}{stderr}"))
         );
     }
     job_id(&stdout).with_context(|| {
         format!(
-            "sbatch --parsable printed no job id for {}: {:?}",
-            script.display(),
+            "sbatch --parsable printed no job id for {what}: {:?}",
             stdout.trim()
         )
     })

@@ -113,7 +113,7 @@ fn an_unwritable_output_names_its_path() {
             "--build",
             s(&build),
         ],
-        vec!["maps", "--out", "/sys/rmapgen-m.hex"],
+        vec!["maps", s(&d), "--out", "/sys/rmapgen-m.hex"],
         vec!["vectors", "--count", "10", "--out", "/sys/rmapgen-v.hex"],
         vec!["stress", "--samples", "10", "--json", "/sys/rmapgen-s.json"],
         vec!["generate", "--out", "/sys/rmapgen-g"],
@@ -151,7 +151,10 @@ fn an_output_below_a_file_or_a_dangling_link_names_it() {
     for blocker in [&file, &link] {
         for below in [blocker.clone(), blocker.join("sub")] {
             let (hex, dir) = (below.join("m.hex"), below.join("d"));
-            for args in [["maps", "--out", s(&hex)], ["generate", "--out", s(&dir)]] {
+            for args in [
+                ["maps", "--prefix", "p", "--out", s(&hex)],
+                ["generate", "--prefix", "p", "--out", s(&dir)],
+            ] {
                 let o = run(&args);
                 assert_error(&o, &format!("{} is not a directory", blocker.display()));
                 assert_eq!(helpers::entries(t.path()), ["file", "link"], "{args:?}");
@@ -161,8 +164,8 @@ fn an_output_below_a_file_or_a_dangling_link_names_it() {
     assert_eq!(std::fs::read(&file).unwrap(), b"mine\n");
     // Any other failure to make a parent names the parent and the system's reason.
     for args in [
-        ["maps", "--out", "/sys/rmapgen-x/sub/m.hex"],
-        ["generate", "--out", "/sys/rmapgen-x/d"],
+        ["maps", "--prefix", "p", "--out", "/sys/rmapgen-x/sub/m.hex"],
+        ["generate", "--prefix", "p", "--out", "/sys/rmapgen-x/d"],
     ] {
         let o = run(&args);
         assert_error(&o, "/sys/rmapgen-x: Operation not permitted");

@@ -38,6 +38,15 @@ pub fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// The committed default design (`rtl_out/`, `make golden`), for commands that take a design.
+pub fn default_design() -> String {
+    root()
+        .join("rtl_out")
+        .to_str()
+        .expect("utf-8 path")
+        .to_string()
+}
+
 /// A fresh temporary directory.
 pub fn tempdir() -> tempfile::TempDir {
     tempfile::tempdir().expect("temp dir")

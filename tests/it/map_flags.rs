@@ -7,7 +7,7 @@ use std::path::Path;
 
 /// Each command that builds maps: its arguments before `--out`, whether `--out` names a file
 /// (else a directory), and the output file that holds (or reports) its maps.
-fn commands(scene: &str) -> Vec<(Vec<&str>, &'static str)> {
+fn commands<'a>(scene: &'a str, design: &'a str) -> Vec<(Vec<&'a str>, &'static str)> {
     vec![
         (vec!["generate", "--vectors", "0"], "map_x.hex"),
         (vec!["roms"], "map_y.hex"),
@@ -52,7 +52,7 @@ fn commands(scene: &str) -> Vec<(Vec<&str>, &'static str)> {
             "map_z.hex",
         ),
         (vec!["vectors", "--count", "200"], ""),
-        (vec!["maps"], ""),
+        (vec!["maps", design], ""),
         (vec!["stress", "--samples", "500"], ""),
     ]
 }
@@ -98,7 +98,8 @@ fn every_command_that_builds_maps_follows_map_fit() {
     let t = helpers::tempdir();
     let scene = helpers::root().join("scenes/standard.toml");
     let scene = scene.to_str().unwrap();
-    for (k, (args, file)) in commands(scene).into_iter().enumerate() {
+    let design = helpers::default_design();
+    for (k, (args, file)) in commands(scene, &design).into_iter().enumerate() {
         let name = if args[0] == "stress" { "r.json" } else { "o" };
         let (a, b) = (
             t.path().join(format!("{k}a{name}")),
@@ -137,7 +138,8 @@ fn a_bad_map_fit_or_scene_is_one_line_on_every_command() {
     let scene = helpers::root().join("scenes/standard.toml");
     let scene = scene.to_str().unwrap();
     let out = t.path().join("out");
-    for (args, _) in commands(scene) {
+    let design = helpers::default_design();
+    for (args, _) in commands(scene, &design) {
         let mut v = args.clone();
         v.extend([
             "--map-fit",

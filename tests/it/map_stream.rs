@@ -146,6 +146,7 @@ fn the_exported_stream_written_through_the_host_port_is_what_the_rtl_reads() {
     let stream = t.path().join("stream.hex");
     let o = helpers::run(&[
         "maps",
+        d.to_str().unwrap(),
         "--scene",
         &diffuse,
         "--format",
@@ -221,23 +222,25 @@ fn every_format_holds_the_maps_generate_writes() {
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         let cfg = rmapgen::design_dir::DesignDir::open(&d).unwrap().config;
         let committed = read_maps(&cfg, &d, 0).unwrap();
+        let config = d.join("tb").join("config.toml");
         for (format, name) in [(Format::Hex, "hex"), (Format::Bin, "bin"), (Format::C, "c")] {
             let f = t.path().join(format!("maps.{name}"));
-            let mut a = vec!["maps", "--scene", &scene, "--format", name];
-            a.extend(&flags);
-            a.extend(["--out", f.to_str().unwrap()]);
-            let o = helpers::run(&a);
-            assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-            let bytes = std::fs::read(&f).unwrap();
-            let writes = map_stream::decode(format, &bytes).unwrap();
-            assert_eq!(
-                writes,
-                map_stream::writes(&cfg, &committed),
-                "{name} {flags:?}"
-            );
-            // A second run replaces the file it wrote without --force.
-            let o = helpers::run(&a);
-            assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+            // The design read (its scene and fit are its manifest's), or its configuration
+            // described with the scene and flags it was generated with.
+            let mut by_config = vec!["maps", "--config", config.to_str().unwrap()];
+            by_config.extend(["--scene", &scene]);
+            by_config.extend(&flags);
+            for mut a in [vec!["maps", d.to_str().unwrap()], by_config] {
+                a.extend(["--format", name, "--out", f.to_str().unwrap()]);
+                let o = helpers::run(&a);
+                assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+                let bytes = std::fs::read(&f).unwrap();
+                let writes = map_stream::decode(format, &bytes).unwrap();
+                assert_eq!(writes, map_stream::writes(&cfg, &committed), "{a:?}");
+                // A second run replaces the file it wrote without --force.
+                let o = helpers::run(&a);
+                assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+            }
         }
     }
 }
@@ -254,8 +257,10 @@ fn bad_input_is_one_line_and_writes_nothing() {
     helpers::assert_error(&o, "--map-fit");
     let o = helpers::run(&["maps", "--index-bits", "9", "--out", out.to_str().unwrap()]);
     helpers::assert_error(&o, "--index-bits");
+    let rtl = helpers::default_design();
     let o = helpers::run(&[
         "maps",
+        &rtl,
         "--scene",
         "/nonexistent.toml",
         "--out",
@@ -265,15 +270,36 @@ fn bad_input_is_one_line_and_writes_nothing() {
     assert!(!out.exists());
     // A file rmapgen did not write is not replaced, in any format.
     for f in ["hex", "bin", "c"] {
-        let o = helpers::run(&["maps", "--format", f, "--out", notes.to_str().unwrap()]);
+        let o = helpers::run(&[
+            "maps",
+            &rtl,
+            "--format",
+            f,
+            "--out",
+            notes.to_str().unwrap(),
+        ]);
         helpers::assert_error(&o, "was not written by rmapgen");
         assert_eq!(std::fs::read_to_string(&notes).unwrap(), "my notes\n");
     }
     // rmapgen's own stream, unchanged, is replaced in another format too (the rule of
     // directories: what rmapgen wrote and nobody changed since).
-    let o = helpers::run(&["maps", "--format", "c", "--out", out.to_str().unwrap()]);
+    let o = helpers::run(&[
+        "maps",
+        &rtl,
+        "--format",
+        "c",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
     assert!(o.status.success());
-    let o = helpers::run(&["maps", "--format", "hex", "--out", out.to_str().unwrap()]);
+    let o = helpers::run(&[
+        "maps",
+        &rtl,
+        "--format",
+        "hex",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
     assert!(o.status.success());
     assert_eq!(
         helpers::entries(t.path()),
@@ -326,4 +352,116 @@ fn the_c_array_compiles_and_holds_the_writes() {
         ..Config::default()
     };
     assert_eq!(got, map_stream::writes(&cfg, &Scene::standard().maps(&cfg)));
+}
+
+/// Issue 60: `maps DIR` reads the design as every command given a design does (its
+/// configuration, prefix and scene from manifest.json), refuses a flag that contradicts it,
+/// and with neither a design nor a configuration refuses to assume the default design,
+/// whose 12-bit header and `rmap_top_*` names would be wrong for any other.
+#[test]
+fn maps_reads_the_design_and_refuses_to_guess() {
+    let t = helpers::tempdir();
+    let d = t.path().join("d");
+    let scene = scene_path("grazing.toml");
+    let o = helpers::run(&[
+        "generate",
+        "--grad-bits",
+        "8",
+        "--red-bits",
+        "6",
+        "--prefix",
+        "cam0_",
+        "--scene",
+        &scene,
+        "--vectors",
+        "0",
+        "--out",
+        d.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let design = rmapgen::design_dir::DesignDir::open(&d).unwrap();
+    let committed = read_maps(&design.config, &d, 0).unwrap();
+    let h = t.path().join("maps.h");
+    let ds = d.to_str().unwrap();
+    let o = helpers::run(&["maps", ds, "--format", "c", "--out", h.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(&h).unwrap();
+    assert!(
+        text.starts_with("/* rmapgen map stream: scene grazing.toml, map_fit sample, G8 R6 "),
+        "{text}"
+    );
+    assert!(
+        text.contains(
+            "static const uint16_t cam0_rmap_top_map_writes[CAM0_RMAP_TOP_MAP_WRITES_COUNT][3]"
+        ),
+        "{text}"
+    );
+    let writes = map_stream::decode(Format::C, text.as_bytes()).unwrap();
+    assert_eq!(writes, map_stream::writes(&design.config, &committed));
+    // Flags that agree are taken; one that contradicts the design is refused, naming both.
+    let hex = t.path().join("m.hex");
+    let o = helpers::run(&[
+        "maps",
+        ds,
+        "--grad-bits",
+        "8",
+        "--prefix",
+        "cam0_",
+        "--out",
+        hex.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::fs::remove_file(&hex).unwrap();
+    let record = t.path().join(".m.hex.rmapgen-sha256");
+    std::fs::remove_file(&record).unwrap();
+    for (flags, want) in [
+        (
+            vec!["--grad-bits", "12"],
+            "d: --grad-bits 12 sets grad_bits 12, the design has 8",
+        ),
+        (
+            vec!["--prefix", "cam1_"],
+            "--prefix cam1_ sets prefix \"cam1_\", the design has \"cam0_\"",
+        ),
+        (vec!["--map-fit", "table"], "map_fit table"),
+    ] {
+        let mut a = vec!["maps", ds];
+        a.extend(flags);
+        a.extend(["--out", hex.to_str().unwrap()]);
+        helpers::assert_error(&helpers::run(&a), want);
+        assert!(!hex.exists() && !record.exists());
+    }
+    // Neither a design nor a configuration: refused, nothing written.
+    let before = helpers::entries(t.path());
+    for a in [
+        vec!["maps", "--out", hex.to_str().unwrap()],
+        vec![
+            "maps",
+            "--scene",
+            &scene,
+            "--format",
+            "bin",
+            "--out",
+            hex.to_str().unwrap(),
+        ],
+    ] {
+        helpers::assert_error(
+            &helpers::run(&a),
+            "maps: give the design (rmapgen maps DIR) or its configuration (--config FILE or the flags it was generated with)",
+        );
+    }
+    // Not a design.
+    let not = t.path().join("scenes");
+    std::fs::create_dir(&not).unwrap();
+    helpers::assert_error(
+        &helpers::run(&[
+            "maps",
+            not.to_str().unwrap(),
+            "--out",
+            hex.to_str().unwrap(),
+        ]),
+        "is not a design rmapgen generated (no manifest.json)",
+    );
+    std::fs::remove_dir(&not).unwrap();
+    assert_eq!(helpers::entries(t.path()), before);
 }

@@ -507,6 +507,7 @@ fn an_interrupted_generate_leaves_nothing_and_keeps_the_old_design() {
 /// the shortened names are still recognised and removed.
 #[test]
 fn outputs_at_the_name_limit() {
+    let rtl = helpers::default_design();
     let t = tempdir();
     let dir_name = "d".repeat(250);
     let file_name = "m".repeat(254);
@@ -532,7 +533,7 @@ fn outputs_at_the_name_limit() {
             t.path(),
             &["generate", "--vectors", "10", "--out", &dir_name],
         ));
-        ok(&run_in(t.path(), &["maps", "--out", &file_name]));
+        ok(&run_in(t.path(), &["maps", &rtl, "--out", &file_name]));
         only(t.path(), &[&dir_name, &file_name, &record]);
     }
     assert!(helpers::nonempty(&t.path().join(&dir_name)));
@@ -542,18 +543,19 @@ fn outputs_at_the_name_limit() {
 /// it since (its record `.NAME.rmapgen-sha256`), as a directory is by `.rmapgen-files`.
 #[test]
 fn maps_keeps_a_users_bin_stream_and_an_edited_hex_file() {
+    let rtl = helpers::default_design();
     let t = tempdir();
     let d = t.path();
     // A user's own binary stream: the very bytes rmapgen writes, but not written there by it.
     ok(&run_in(
         d,
-        &["maps", "--format", "bin", "--out", "ours.bin"],
+        &["maps", &rtl, "--format", "bin", "--out", "ours.bin"],
     ));
     let stream = std::fs::read(d.join("ours.bin")).unwrap();
     let mut mine = stream.clone();
     mine[4] ^= 1;
     std::fs::write(d.join("f.bin"), &mine).unwrap();
-    let o = run_in(d, &["maps", "--format", "bin", "--out", "f.bin"]);
+    let o = run_in(d, &["maps", &rtl, "--format", "bin", "--out", "f.bin"]);
     assert_error(
         &o,
         "will not replace f.bin: it exists and was not written by rmapgen",
@@ -563,18 +565,18 @@ fn maps_keeps_a_users_bin_stream_and_an_edited_hex_file() {
     // rmapgen's own, unchanged: replaced without --force (in any format).
     ok(&run_in(
         d,
-        &["maps", "--format", "bin", "--out", "ours.bin"],
+        &["maps", &rtl, "--format", "bin", "--out", "ours.bin"],
     ));
     ok(&run_in(
         d,
-        &["maps", "--format", "hex", "--out", "ours.bin"],
+        &["maps", &rtl, "--format", "hex", "--out", "ours.bin"],
     ));
     // An rmapgen hex file the user edited is kept.
-    ok(&run_in(d, &["maps", "--out", "f.hex"]));
+    ok(&run_in(d, &["maps", &rtl, "--out", "f.hex"]));
     let mut edited = std::fs::read_to_string(d.join("f.hex")).unwrap();
     edited.push_str("// my note\n");
     std::fs::write(d.join("f.hex"), &edited).unwrap();
-    let o = run_in(d, &["maps", "--out", "f.hex"]);
+    let o = run_in(d, &["maps", &rtl, "--out", "f.hex"]);
     assert_error(
         &o,
         "will not replace f.hex: it was changed since rmapgen wrote it; nothing was changed \
@@ -582,13 +584,16 @@ fn maps_keeps_a_users_bin_stream_and_an_edited_hex_file() {
     );
     assert_eq!(std::fs::read_to_string(d.join("f.hex")).unwrap(), edited);
     // With --force both are replaced, and recorded as rmapgen's.
-    ok(&run_in(d, &["maps", "--out", "f.hex", "--force"]));
+    ok(&run_in(d, &["maps", &rtl, "--out", "f.hex", "--force"]));
     ok(&run_in(
         d,
-        &["maps", "--format", "bin", "--out", "f.bin", "--force"],
+        &["maps", &rtl, "--format", "bin", "--out", "f.bin", "--force"],
     ));
     assert_eq!(std::fs::read(d.join("f.bin")).unwrap(), stream);
-    ok(&run_in(d, &["maps", "--format", "bin", "--out", "f.bin"]));
+    ok(&run_in(
+        d,
+        &["maps", &rtl, "--format", "bin", "--out", "f.bin"],
+    ));
     // The record is sha256sum's format: `sha256sum -c` checks the file.
     let check = Command::new("sha256sum")
         .args(["-c", ".f.bin.rmapgen-sha256"])
@@ -698,16 +703,17 @@ fn a_users_file_named_like_a_partial_file_is_kept() {
 /// overwritten without --force, and the refused run writes nothing.
 #[test]
 fn a_users_file_at_the_records_name_is_kept() {
+    let rtl = helpers::default_design();
     let t = tempdir();
     let d = t.path();
     let mine = "my notes, not a record\n";
     std::fs::write(d.join(".f.bin.rmapgen-sha256"), mine).unwrap();
-    let o = run_in(d, &["maps", "--format", "bin", "--out", "f.bin"]);
+    let o = run_in(d, &["maps", &rtl, "--format", "bin", "--out", "f.bin"]);
     assert_error(&o, "it is not rmapgen's record of f.bin");
     only(d, &[".f.bin.rmapgen-sha256"]);
     // With a file of the user's at the target too.
     std::fs::write(d.join("f.bin"), "theirs").unwrap();
-    let o = run_in(d, &["maps", "--format", "bin", "--out", "f.bin"]);
+    let o = run_in(d, &["maps", &rtl, "--format", "bin", "--out", "f.bin"]);
     assert_error(&o, "will not replace f.bin");
     only(d, &[".f.bin.rmapgen-sha256", "f.bin"]);
     assert_eq!(

@@ -886,7 +886,10 @@ fn merge_refuses_reports_that_do_not_cover_the_run() {
     let front10 = forge("front10.json", &|v| {
         for p in v["parts"].as_array_mut().unwrap() {
             if p["name"] == "front" {
+                // Consistent in itself: its range within the total it claims.
                 p["total"] = 10.into();
+                p["end"] = 10.into();
+                p["ran"] = 10.into();
             }
         }
     });
@@ -905,9 +908,29 @@ fn merge_refuses_reports_that_do_not_cover_the_run() {
     });
     let other_config = forge("config.json", &|v| {
         v["config"]["map_bits"] = 7.into();
+        let summary = v["config_summary"]
+            .as_str()
+            .unwrap()
+            .replace(" M6 ", " M7 ");
+        v["config_summary"] = summary.into();
     });
     let old = forge("old.json", &|v| v["format"] = "rmapgen-prove-1".into());
+    // Issue 60's edits: a shard's own verdict, a failure added, a negative time.
+    let failed = forge("failed.json", &|v| v["passed"] = false.into());
+    let example = forge("example.json", &|v| {
+        v["parts"][1]["examples"] = serde_json::json!(["states (buffer 0 as loaded): sample 7"]);
+    });
+    let negative = forge("negative.json", &|v| v["seconds"] = (-100.0).into());
     for (files, want) in [
+        (
+            vec![&failed, &r2],
+            "failed.json: passed is false, but no part failed; rmapgen prove writes no such report (was it edited?)",
+        ),
+        (
+            vec![&r2, &example],
+            "example.json: parts[1] (states): examples lists 1 failures, but failures is 0",
+        ),
+        (vec![&negative, &r2], "negative.json: seconds is -100, not a time"),
         (vec![&only_structure], "front, states, zero missing"),
         (vec![&no_parts], "has the parts []"),
         (
@@ -926,4 +949,55 @@ fn merge_refuses_reports_that_do_not_cover_the_run() {
         a.extend(files.iter().map(|p| s(p)));
         helpers::assert_error(&helpers::run(&a), want);
     }
+    // A shard that failed and says so throughout is a verdict: FAILED, exit 1, its failure
+    // shown.
+    let failing = forge("failing.json", &|v| {
+        v["passed"] = false.into();
+        v["parts"][1]["failures"] = 1.into();
+        v["parts"][1]["examples"] = serde_json::json!(["states (buffer 0 as loaded): sample 7"]);
+    });
+    let o = helpers::run(&["prove", "--merge", s(&failing), s(&r2)]);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{t}");
+    assert!(t.contains("\nFAILED: G8 ") && !t.contains("PROVEN"), "{t}");
+    assert!(
+        t.contains("    states (buffer 0 as loaded): sample 7"),
+        "{t}"
+    );
+}
+
+/// `--merge` reads at most its bound of each report, whatever the file's metadata says: a
+/// device (whose length is 0) and a FIFO fed without end are refused after one byte past it.
+#[test]
+fn merge_reads_a_device_or_a_fifo_only_up_to_its_bound() {
+    helpers::assert_error(
+        &helpers::run(&["prove", "--merge", "/dev/zero"]),
+        "/dev/zero is larger than 4194304 bytes, not a report of rmapgen prove",
+    );
+    let tmp = helpers::tempdir();
+    let fifo = tmp.path().join("fifo.json");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap();
+    assert!(made.success());
+    // A writer that never stops (until its reader goes: a broken pipe).
+    let writer = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || {
+            use std::io::Write;
+            let mut f = std::fs::OpenOptions::new().write(true).open(&fifo).unwrap();
+            let block = vec![b' '; 1 << 16];
+            let mut sent = 0u64;
+            while f.write_all(&block).is_ok() {
+                sent += block.len() as u64;
+            }
+            sent
+        })
+    };
+    let o = helpers::run(&["prove", "--merge", s(&fifo)]);
+    helpers::assert_error(&o, "fifo.json is larger than 4194304 bytes");
+    let sent = writer.join().unwrap();
+    // What the pipe holds beyond what was read: at most a few of its buffers.
+    assert!(sent < (4 << 20) + (4 << 20), "{sent} bytes sent");
 }
