@@ -9,8 +9,10 @@
 //! template slices `tdata` with them, the manifest carries them (for the cocotb test,
 //! tb/cocotb/test_axis.py) and the README prints them.
 
+mod vectors;
+
 use super::rmap_top::{top_latency, RmapTop};
-use super::unit::{Head, Memory, Unit};
+use super::unit::{Head, Memory, Unit, Vectors};
 use super::TOP;
 use crate::config::Config;
 use crate::hdl::ports::{i, o, Dir, Port, Width};
@@ -287,6 +289,10 @@ impl Unit for RmapAxis {
         }
         .render()
     }
+
+    fn vectors(&self) -> Option<&dyn Vectors> {
+        Some(self)
+    }
 }
 
 /// The wrapper's port list with the width of each `Width::Bits` (for the README table).
@@ -420,6 +426,33 @@ mod tests {
         )
         .unwrap();
         assert!(!plain.contains("AXI4-Stream ports"));
+    }
+
+    #[test]
+    fn the_testbench_packs_every_field_of_the_tops_vectors_at_its_slot() {
+        for (color, user) in [(false, 0), (true, 3), (false, 64)] {
+            let cfg = axis(color, user);
+            let text = crate::emit::tb::render(&cfg, &RmapAxis).unwrap();
+            assert!(text.contains("module rmap_axis_tb;"));
+            assert!(text.contains("  rmap_axis #("), "{text}");
+            for (bus, dir) in [("nx_tdata", field::Dir::In), ("exp_tdata", field::Dir::Out)] {
+                for s in &packing(&cfg, dir).slots {
+                    let want = format!("{bus}{} = v_{}[", s.range(), s.field);
+                    assert!(text.contains(&want), "{want}");
+                }
+            }
+            // Every top field the vectors carry with a port has a slot: none is left unchecked.
+            let top = TOP.vectors().unwrap();
+            let slotted = packing(&cfg, field::Dir::In).slots.len()
+                + packing(&cfg, field::Dir::Out).slots.len();
+            let ported = top
+                .fields(&cfg)
+                .iter()
+                .filter(|f| top.port(f).is_some())
+                .count();
+            assert_eq!(slotted, ported);
+            assert_eq!(text.contains("m_axis_tuser"), user > 0);
+        }
     }
 
     #[test]
