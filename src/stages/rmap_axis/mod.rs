@@ -462,6 +462,11 @@ mod tests {
                 .count();
             assert_eq!(slotted, ported);
             assert_eq!(text.contains("m_axis_tuser"), user > 0);
+            // Between host writes the write port carries random values (wr_en_i must gate it).
+            for p in ["wr_axis_i", "wr_addr_i", "wr_data_i"] {
+                assert!(text.contains(&format!("      {p} = rnd[")), "{p}");
+            }
+            assert!(text.contains("      if (!wr_en_i) host_garbage;"));
         }
     }
 

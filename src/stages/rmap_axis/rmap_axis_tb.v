@@ -25,7 +25,8 @@
 // backpressure came in between, never sooner.
 //
 // While the map-0 part streams, the host port writes {= t.map2_pattern =} into the back buffer (three
-// clocks in four); the first map-1 vector waits until the load is complete and is offered with
+// clocks in four; random addresses and data with wr_en_i low in the other clocks, from reset
+// to the end); the first map-1 vector waits until the load is complete and is offered with
 // swap_i high (a swap takes effect for the sample accepted in the same clock). The design is
 // reset once mid-stream, before the swap; the samples then in flight are lost and sent again.
 // Every result must leave once, in order. Mismatches print the vector's line, its inputs, the
@@ -145,6 +146,17 @@ module {= t.module =}_tb;
 {%- for (hi, lo) in s_fill %}
       rnd = $random(seed);
       nx_tdata[{= hi =}:{= lo =}] = rnd[{= hi - lo =}:0];
+{%- endfor %}
+    end
+  endtask
+
+  // Random values on the host write port's address and data, for clocks without a write:
+  // wr_en_i low must ignore them.
+  task host_garbage;
+    begin
+{%- for (name, bits) in host_data %}
+      rnd = $random(seed);
+      {= name =} = rnd[{= bits - 1 =}:0];
 {%- endfor %}
     end
   endtask
@@ -278,6 +290,7 @@ module {= t.module =}_tb;
       rnd = $random(seed);
       m_axis_tready = rnd[0];
       drive_garbage;
+      host_garbage;
     end
 
     read_vector;
@@ -396,12 +409,14 @@ module {= t.module =}_tb;
         drive_garbage;
       end
 
-      // Host writes into the back buffer, three clocks in four, never in the swap's clock.
+      // Host writes into the back buffer, three clocks in four, never in the swap's clock;
+      // random values on the write port in the other clocks.
       wr_en_i = 1'b0;
       if (nwr < NWRITES && !swap_i) begin
         rnd = $random(seed);
         if (rnd[1:0] != 2'b00) host_write;
       end
+      if (!wr_en_i) host_garbage;
       m_axis_tready = rdy_next;
       hold_valid = present && !en_next;
       prev_stall = (m_axis_tvalid === 1'b1) && !rdy_next;

@@ -6,11 +6,12 @@
 
 use super::{packing, Packing, RmapAxis};
 use crate::config::Config;
+use crate::hdl::ports::Width;
 use crate::model::{MapSet, Model};
 use crate::rng::SplitMix64;
 use crate::stages::rmap_top::RmapTop;
 use crate::stages::testbench::TbData;
-use crate::stages::unit::{Traced, Vectors};
+use crate::stages::unit::{Traced, Unit, Vectors};
 use crate::vectors::field::{self, Field};
 use anyhow::Result;
 use askama::Template;
@@ -41,7 +42,14 @@ struct Testbench<'a> {
     /// `(hi, lo)` pieces of `s_axis_tdata` and of tuser, each filled by one `$random`.
     s_fill: Vec<(u32, u32)>,
     user_fill: Vec<(u32, u32)>,
+    /// The host write port's address and data inputs with their widths: random while
+    /// `wr_en_i` is low.
+    host_data: Vec<(&'static str, u32)>,
 }
+
+/// The host write port's inputs besides its enable, which the testbench drives with random
+/// values between writes.
+const HOST_DATA: [&str; 3] = ["wr_axis_i", "wr_addr_i", "wr_data_i"];
 
 /// The `(hi, lo)` pieces of a `bits`-wide bus, 32 bits at most each (one `$random`), from bit 0.
 fn pieces(bits: u32) -> Vec<(u32, u32)> {
@@ -133,6 +141,15 @@ impl Vectors for RmapAxis {
             held_bits: 1 + m.bits + user_bits + 1,
             s_fill: pieces(s.bits),
             user_fill: pieces(user_bits),
+            host_data: self
+                .ports(cfg)
+                .into_iter()
+                .filter(|p| HOST_DATA.contains(&p.name))
+                .map(|p| match p.width {
+                    Width::Bits(b) => (p.name, b),
+                    Width::Param(_) => unreachable!("the wrapper's ports have fixed widths"),
+                })
+                .collect(),
         }
         .render()
     }
