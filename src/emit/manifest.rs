@@ -24,6 +24,52 @@ pub struct VectorsInfo {
     pub seed: u64,
 }
 
+/// The FuseSoC core of a design, named by one rule: after the module users instantiate, the
+/// design's top ([`stages::top`]: rmap_axis with `axis`, rmap_lanes with lanes, else rmap_top),
+/// which is also the core's toplevel; its `sim` target runs that module's own testbench. The
+/// core writer and the README writer (`emit::package`) and the manifest all read it from here.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct Core {
+    /// The core file, `<top>.core`.
+    pub file: String,
+    /// Its VLNV name, `rmapgen:ip:<top>_<hash>:<version>`: the hash ([`config_hash`]) tells
+    /// two configurations apart even without a prefix, and one configuration always has the
+    /// same name.
+    pub name: String,
+    /// The design's top, the toplevel of its `default`, `lint` and `synth` targets.
+    pub toplevel: String,
+    /// The top's testbench module (`<top>_tb`), the toplevel of its `sim` target.
+    pub sim_toplevel: String,
+}
+
+impl Core {
+    pub fn new(cfg: &Config) -> Core {
+        let top = stages::top(cfg).module(cfg);
+        Core {
+            file: format!("{top}.core"),
+            name: format!(
+                "rmapgen:ip:{top}_{}:{}",
+                config_hash(cfg),
+                env!("CARGO_PKG_VERSION")
+            ),
+            sim_toplevel: format!("{top}_tb"),
+            toplevel: top,
+        }
+    }
+}
+
+/// Eight hex digits naming a configuration: the low 32 bits of the 64-bit FNV-1a hash of
+/// its TOML (what `tb/config.toml` holds, prefix included). Stable across runs, machines
+/// and rmapgen versions as long as the configuration's fields are; the scene (the maps'
+/// initial contents) is data, not configuration, and is not part of it.
+pub fn config_hash(cfg: &Config) -> String {
+    let text = toml::to_string(cfg).expect("a Config serialises");
+    let h = text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
+    });
+    format!("{:08x}", h as u32)
+}
+
 #[derive(Clone, Debug, Serialize)]
 pub struct Manifest {
     pub rmapgen_version: &'static str,
@@ -42,6 +88,8 @@ pub struct Manifest {
     pub memory_bits: u64,
     /// Every file of the directory written by the design generator, in writing order.
     pub files: Vec<String>,
+    /// The FuseSoC core among them: its file, its name and its toplevels.
+    pub core: Core,
     /// Where the maps of buffer 0 come from: the scene's name (`scenes/standard.toml`, a
     /// file's name) and the scene itself, its `map_fit` the one that filled the maps.
     pub scene_name: String,
@@ -127,6 +175,7 @@ impl Manifest {
             memory_bits: memories.iter().map(|m| m.bits).sum(),
             memories,
             files,
+            core: Core::new(cfg),
             scene_name: scene.name.clone(),
             scene: scene.clone(),
             vectors,

@@ -77,7 +77,7 @@ pub fn write_design(
     for (name, text) in hex_files(design) {
         write(name, &text)?;
     }
-    write(package::core_file(cfg), &package::core(cfg)?)?;
+    write(manifest::Core::new(cfg).file, &package::core(cfg)?)?;
     write(package::README_FILE.into(), &package::readme(design)?)?;
     files.push(manifest::FILE.to_string());
     let manifest = Manifest::new(cfg, &design.scene, vectors, files);

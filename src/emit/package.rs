@@ -3,8 +3,8 @@
 //! and a `README.md` with the port table and the timing notes (latency, flow control, reset,
 //! buffer swap and write rules), both from the same tables as the Verilog.
 //!
-//! The core's name ([`vlnv`]) differs between configurations: it carries the top's module
-//! name (with the prefix) and a hash of the configuration.
+//! The core is named by one rule, [`manifest::Core`]: after the design's top, the module
+//! users instantiate, with a hash of the configuration.
 
 use super::manifest;
 use crate::config::Config;
@@ -23,11 +23,6 @@ use anyhow::{Context, Result};
 use askama::Template;
 
 pub const README_FILE: &str = "README.md";
-
-/// The FuseSoC core file, `<top module>.core`.
-pub fn core_file(cfg: &Config) -> String {
-    format!("{}.core", TOP.module(cfg))
-}
 
 #[derive(Template)]
 #[template(path = "pkg/rmap_top.core")]
@@ -96,8 +91,7 @@ struct Readme {
     summary: String,
     prefix: String,
     top: String,
-    core_file: String,
-    vlnv: String,
+    core: manifest::Core,
     tb_file: String,
     map2: String,
     bank_glob: String,
@@ -233,6 +227,8 @@ impl LanesReadme {
 /// layouts, from [`rmap_axis`].
 struct AxisReadme {
     top: String,
+    /// The wrapper's testbench, `tb/<rmap_axis>_tb.v`.
+    tb_file: String,
     tuser: u32,
     vectors: String,
     ports: Vec<(String, &'static str, u32, String)>,
@@ -259,6 +255,7 @@ impl AxisReadme {
         }
         Some(AxisReadme {
             top: rmap_axis::RmapAxis.module(cfg),
+            tb_file: rmap_axis::RmapAxis.testbench_file(cfg),
             tuser: info.tuser_bits,
             vectors: info.vectors,
             ports: rmap_axis::port_rows(cfg)
@@ -273,38 +270,17 @@ impl AxisReadme {
     }
 }
 
-/// The core's VLNV name, `rmapgen:ip:<top module>_<hash>:<version>`: the top's module name
-/// (with the prefix) and [`config_hash`], so that two configurations never share a name,
-/// with or without a prefix, and one configuration always has the same one.
-pub fn vlnv(cfg: &Config) -> String {
-    format!(
-        "rmapgen:ip:{}_{}:{}",
-        TOP.module(cfg),
-        config_hash(cfg),
-        env!("CARGO_PKG_VERSION")
-    )
-}
-
-/// Eight hex digits naming a configuration: the low 32 bits of the 64-bit FNV-1a hash of
-/// its TOML (what `tb/config.toml` holds, prefix included). Stable across runs, machines
-/// and rmapgen versions as long as the configuration's fields are; the scene (the maps'
-/// initial contents) is data, not configuration, and is not part of it.
-pub fn config_hash(cfg: &Config) -> String {
-    let text = toml::to_string(cfg).expect("a Config serialises");
-    let h = text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
-        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
-    });
-    format!("{:08x}", h as u32)
-}
-
-/// `<top module>.core` for `cfg`: the design's modules and the init files they read, and
-/// the top's testbench with its vectors and the second map it loads.
+/// The core file of `cfg` ([`manifest::Core`]): the design's modules and the init files they
+/// read, and the design top's testbench with its vectors and the second map it loads.
 pub fn core(cfg: &Config) -> Result<String> {
-    let top = TOP.vectors().expect("the top has vectors");
+    let named = manifest::Core::new(cfg);
+    let top = stages::top(cfg)
+        .vectors()
+        .expect("every design top has its testbench");
     // The design top's: with lanes it also sets the shared ROMs' file.
     let file_params = file_params(&manifest::memories(cfg));
     let mem_files = file_params.iter().map(|p| p.default.clone()).collect();
-    let (tb_files, _) = super::tb::testbench_files(cfg, &format!("{}_tb", TOP.module(cfg)))?;
+    let (tb_files, _) = super::tb::testbench_files(cfg, &named.sim_toplevel)?;
     let tb_params: Vec<TbFile> = tb_files
         .into_iter()
         .filter(|f| !file_params.iter().any(|p| p.name == f.param))
@@ -312,10 +288,10 @@ pub fn core(cfg: &Config) -> Result<String> {
     let text = Core {
         version: env!("CARGO_PKG_VERSION"),
         summary: cfg.summary(),
-        vlnv: vlnv(cfg),
-        core_file: core_file(cfg),
-        top: stages::top(cfg).module(cfg),
-        tb_top: format!("{}_tb", TOP.module(cfg)),
+        vlnv: named.name,
+        core_file: named.file,
+        top: named.toplevel,
+        tb_top: named.sim_toplevel,
         tb_file: top.testbench_file(cfg),
         vector_file: top.vector_file(cfg),
         latency: top_latency(cfg),
@@ -377,8 +353,7 @@ pub fn readme(design: &Design) -> Result<String> {
         summary: cfg.summary(),
         prefix: cfg.prefix.clone(),
         top: TOP.module(cfg),
-        core_file: core_file(cfg),
-        vlnv: vlnv(cfg),
+        core: manifest::Core::new(cfg),
         tb_file: TOP
             .vectors()
             .expect("the top has vectors")
@@ -517,6 +492,62 @@ fn describe(name: &str, note: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// One rule names the core, after the design's top (the module users instantiate), and
+    /// the core file, its toplevels, its sim target and the README all follow it.
+    #[test]
+    fn the_core_is_named_after_the_module_users_instantiate() {
+        let axis = Config {
+            handshake: true,
+            axis: true,
+            ..Config::default()
+        };
+        for (cfg, top) in [
+            (Config::default(), "rmap_top"),
+            (axis.clone(), "rmap_axis"),
+            (
+                Config {
+                    lanes: 2,
+                    ..Config::default()
+                },
+                "rmap_lanes",
+            ),
+            (
+                Config {
+                    prefix: "p_".into(),
+                    ..axis
+                },
+                "p_rmap_axis",
+            ),
+        ] {
+            let c = manifest::Core::new(&cfg);
+            assert_eq!(c.toplevel, top);
+            assert_eq!(c.file, format!("{top}.core"));
+            assert_eq!(c.sim_toplevel, format!("{top}_tb"));
+            assert_eq!(
+                c.name,
+                format!(
+                    "rmapgen:ip:{top}_{}:{}",
+                    manifest::config_hash(&cfg),
+                    env!("CARGO_PKG_VERSION")
+                )
+            );
+            let text = core(&cfg).unwrap();
+            for want in [
+                format!("# {top}.core: generated"),
+                format!("\nname: {}\n", c.name),
+                format!("    toplevel: {top}\n"),
+                format!("    toplevel: {top}_tb\n"),
+                format!("      - tb/{top}_tb.v\n"),
+            ] {
+                assert!(text.contains(&want), "{want}\n{text}");
+            }
+            let readme = readme(&Design::standard(&cfg).unwrap()).unwrap();
+            assert_eq!(readme.matches(&c.name).count(), 2, "{top}");
+            assert!(readme.contains(&format!("`{}`: the FuseSoC (CAPI2) core", c.file)));
+            assert_eq!(readme.matches("<module>_<hash>").count(), 1);
+        }
+    }
 
     /// A port's description never says its name's description and a note that repeats it
     /// ("colour channel times the intensity: colour times intensity"): every port of the top of

@@ -14,6 +14,12 @@
 //!   every file the top reads with `$readmemh` (both halves of a banked map: both buffers)
 //!   and the scene's map files that the model reads.
 //!
+//! - **Wrapper mutants** (`--truth wrapper`): the same draw of the wrapper around the top
+//!   alone (rmap_axis, rmap_lanes), the modules it instantiates read as black boxes; each
+//!   mutant is that module as Yosys writes it back ([`materialise`]), judged by the wrapper's
+//!   own testbench ([`Method::Wrapper`]) against [`Method::Wiring`], a Yosys miter of the
+//!   mutant's wrapper and the design's with the instances cut out.
+//!
 //! Every mutant is judged by the ground truth, `rmapgen prove --direct` (every gradient
 //! through the top, on both map buffers): a mutant it passes is equivalent (no output
 //! differs) and set aside. A non-equivalent mutant that the factored `rmapgen prove` passes
@@ -101,14 +107,89 @@ impl Mutant {
     }
 }
 
+/// The wrapper around the top that a `--truth wrapper` run mutates: the design's top (its
+/// module, file and the modules it instantiates), when it is not the top itself.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Wrapper {
+    pub module: String,
+    pub file: String,
+    /// The modules it instantiates, black boxes to the draw and to the miter.
+    pub children: Vec<String>,
+    /// The design it was drawn from (absolute): the miter compares each mutant with it.
+    pub reference: PathBuf,
+}
+
+impl Wrapper {
+    /// The wrapper of design `d`, or None when its top is the top ([`TOP`]) itself.
+    pub fn of(d: &DesignDir) -> Option<Wrapper> {
+        let cfg = &d.config;
+        let outer = crate::stages::top(cfg);
+        (outer.name() != TOP.name()).then(|| Wrapper {
+            module: outer.module(cfg),
+            file: outer.file(cfg),
+            children: outer.children(cfg).iter().map(|c| c.module(cfg)).collect(),
+            reference: d.path().to_path_buf(),
+        })
+    }
+
+    /// The Yosys lines that read the wrapper of the design in `dir` (its other files as black
+    /// boxes) and elaborate it after `proc`.
+    fn read_script(&self, dir: &Path, files: &[String]) -> String {
+        let libs: Vec<String> = files
+            .iter()
+            .filter(|f| **f != self.file)
+            .map(|f| dir.join(f).display().to_string())
+            .collect();
+        format!(
+            "read_verilog -lib {}\nread_verilog {}\nhierarchy -top {}\nproc\n",
+            libs.join(" "),
+            dir.join(&self.file).display(),
+            self.module
+        )
+    }
+
+    /// The Yosys script that proves the wrapper of the design in `mutant` equal to the
+    /// reference's, as a function of the wrapper's inputs and its instances' outputs: each
+    /// read, its instances cut out (`expose -evert`: their inputs become outputs of the
+    /// wrapper, their outputs inputs), and the two compared by a miter under SAT. It fails
+    /// with [`Wrapper::DIFFER`] when an output differs for some input.
+    fn miter_script(&self, mutant: &Path, files: &[String]) -> String {
+        let cut: Vec<String> = self
+            .children
+            .iter()
+            .map(|c| format!("{}/t:{c}", self.module))
+            .collect();
+        let side = |dir: &Path, name: &str| {
+            format!(
+                "{}expose -evert {}\nrename {} {name}\ndesign -stash {name}\n",
+                self.read_script(dir, files),
+                cut.join(" "),
+                self.module
+            )
+        };
+        format!(
+            "{}{}design -copy-from gold -as gold gold\ndesign -copy-from gate -as gate gate\nmiter -equiv -flatten -make_assert gold gate miter\nhierarchy -top miter\nsat -verify -prove-asserts miter\n",
+            side(&self.reference, "gold"),
+            side(mutant, "gate")
+        )
+    }
+
+    /// What Yosys says when the miter finds a difference.
+    const DIFFER: &'static str = "proof did fail";
+}
+
 /// The Yosys script lines that read design `d` (run in its directory: `$readmemh` paths
-/// resolve there) and elaborate its top after `proc`.
-fn read_script(d: &DesignDir) -> String {
-    format!(
-        "read_verilog {}\nhierarchy -top {}\nproc\n",
-        d.file_names().join(" "),
-        TOP.module(&d.config)
-    )
+/// resolve there) and elaborate its top after `proc`: the wrapper alone when `wrapper` is
+/// given (a `--truth wrapper` run), else the top ([`TOP`]) and everything under it.
+fn read_script(d: &DesignDir, wrapper: Option<&Wrapper>) -> String {
+    match wrapper {
+        Some(w) => w.read_script(d.path(), d.file_names()),
+        None => format!(
+            "read_verilog {}\nhierarchy -top {}\nproc\n",
+            d.file_names().join(" "),
+            TOP.module(&d.config)
+        ),
+    }
 }
 
 /// Runs Yosys on `script` in `dir`, its log in `log`.
@@ -150,6 +231,7 @@ pub fn draw_verilog(
     count: usize,
     seed: u64,
     select: Option<&str>,
+    wrapper: Option<&Wrapper>,
     work: &Path,
 ) -> Result<Vec<Change>> {
     ensure!(
@@ -164,9 +246,14 @@ pub fn draw_verilog(
     }
     crate::disk::create_dir_all(work)?;
     let list = work.join("mutations.ys");
+    // A wrapper run draws from the wrapper's own cells only.
+    let select = match wrapper {
+        Some(w) => Some(w.module.as_str()),
+        None => select,
+    };
     let script = format!(
         "{}mutate -list {count} -seed {seed} -o {} {}\n",
-        read_script(d),
+        read_script(d, wrapper),
         list.display(),
         select.unwrap_or("")
     );
@@ -292,8 +379,15 @@ fn split_modules(text: &str) -> Vec<(String, String)> {
 /// file holds the flat top (its memories' contents written in, its file parameters declared
 /// for the harnesses that set them), the front modules' files the front as Yosys wrote it
 /// when the mutation is in one of them.
-pub fn materialise(d: &DesignDir, m: &Mutant, to: &Path) -> Result<()> {
+///
+/// With `wrapper` (a `--truth wrapper` run) only the wrapper's file changes: the wrapper as
+/// Yosys writes it back (the modules it instantiates read as black boxes), its init-file
+/// parameters declared again and passed down by name, as the generated wrapper does.
+pub fn materialise(d: &DesignDir, m: &Mutant, wrapper: Option<&Wrapper>, to: &Path) -> Result<()> {
     copy_tree(d.path(), to)?;
+    if let (Some(w), Change::Null | Change::Verilog { .. }) = (wrapper, &m.change) {
+        return materialise_wrapper(d, m, w, to);
+    }
     match &m.change {
         Change::Memory { file, entry, xor } => {
             let p = to.join(file);
@@ -325,7 +419,7 @@ pub fn materialise(d: &DesignDir, m: &Mutant, to: &Path) -> Result<()> {
             };
             let script = format!(
                 "{}{mutation}opt_expr -mux_undef\nsetattr -mod -set keep_hierarchy 1 {}\nflatten\nwrite_verilog -noattr mutant.v\n",
-                read_script(d),
+                read_script(d, None),
                 front.join(" ")
             );
             yosys(to, &script, &to.join("mutant.log"))?;
@@ -368,6 +462,57 @@ pub fn materialise(d: &DesignDir, m: &Mutant, to: &Path) -> Result<()> {
     Ok(())
 }
 
+/// The wrapper of mutant `m` of design `d` into `to` (a copy of the design): Yosys reads the
+/// wrapper with the modules it instantiates as black boxes, applies the mutation and writes
+/// the wrapper alone. Yosys writes the init-file parameters it passes down as their default
+/// values; they are declared again and passed down by name, so that a testbench run from
+/// elsewhere still sets every file (a parameter that is not found is an error, never a file
+/// silently read from the working directory).
+fn materialise_wrapper(d: &DesignDir, m: &Mutant, w: &Wrapper, to: &Path) -> Result<()> {
+    let mutation = match &m.change {
+        Change::Verilog { command } => format!("{command}\n"),
+        _ => String::new(),
+    };
+    let script = format!(
+        "{}{mutation}write_verilog -noattr mutant.v\n",
+        w.read_script(d.path(), d.file_names())
+    );
+    yosys(to, &script, &to.join("mutant.log"))?;
+    let written = to.join("mutant.v");
+    let text = std::fs::read_to_string(&written)
+        .with_context(|| format!("cannot read {}", written.display()))?;
+    std::fs::remove_file(&written).ok();
+    let modules = split_modules(&text);
+    let (_, mut body) = modules
+        .into_iter()
+        .find(|(n, _)| *n == w.module)
+        .with_context(|| format!("Yosys wrote no module {}", w.module))?;
+    let cfg = &d.config;
+    let params = file_params(&crate::stages::top(cfg).memories(cfg));
+    for p in &params {
+        let literal = format!(".{}(\"{}\")", p.name, p.default);
+        ensure!(
+            body.contains(&literal),
+            "Yosys wrote {} without {literal}: the parameter cannot be passed down",
+            w.module
+        );
+        body = body.replace(&literal, &format!(".{0}({0})", p.name));
+    }
+    let decls: String = params
+        .iter()
+        .map(|p| format!("  parameter {} = \"{}\";\n", p.name, p.default))
+        .collect();
+    let header_end = body.find(");\n").context("the wrapper has no port list")? + 3;
+    crate::disk::write(
+        &to.join(&w.file),
+        format!(
+            "{YOSYS_WAIVERS}{}{decls}{}",
+            &body[..header_end],
+            &body[header_end..]
+        ),
+    )
+}
+
 /// Verilator's warnings on Verilog that Yosys writes (its case statements overlap, its
 /// logical operators take vectors), which would stop the proof's build: the mutants are
 /// judged on what they compute, not on their style.
@@ -401,6 +546,14 @@ pub enum Method {
     /// harness speaks of (ready_o, valid_o, the tag, the map buffers read and written), not
     /// in the datapath's results.
     Flow,
+    /// The wrapper's testbench (`rmapgen sim --icarus --only <wrapper>`), on a mutant of the
+    /// wrapper around the top.
+    Wrapper,
+    /// The ground truth of [`Method::Wrapper`]: a Yosys miter of the mutant's wrapper and the
+    /// design's, the modules it instantiates cut out ([`Wrapper::miter_script`]), proved by
+    /// SAT. A mutant it passes computes the same function of the wrapper's inputs and of its
+    /// instances' outputs: the same design.
+    Wiring,
 }
 
 impl Method {
@@ -413,19 +566,26 @@ impl Method {
             Method::Stream => "stream",
             Method::Formal => "formal",
             Method::Flow => "flow",
+            Method::Wrapper => "wrapper",
+            Method::Wiring => "wiring",
         }
     }
 
     /// Whether it can be a run's ground truth (every mutant is judged by it first).
     pub fn is_truth(self) -> bool {
-        matches!(self, Method::Direct | Method::Stream | Method::Flow)
+        matches!(
+            self,
+            Method::Direct | Method::Stream | Method::Flow | Method::Wiring
+        )
     }
 
     /// The proof that ground truth `self` judges: a non-equivalent mutant it passes is a
-    /// soundness bug. `prove` for the datapath's truths, the formal harness for the flow's.
+    /// soundness bug. `prove` for the datapath's truths, the formal harness for the flow's,
+    /// the wrapper's testbench for the wiring's (what checks the wrapper: `prove` does not).
     pub fn proof(self) -> Method {
         match self {
             Method::Flow | Method::Formal => Method::Formal,
+            Method::Wiring | Method::Wrapper => Method::Wrapper,
             _ => Method::Prove,
         }
     }
@@ -460,6 +620,9 @@ impl Method {
             // run_formal.py's, after its script (see `check`).
             Method::Formal => vec!["--reference"],
             Method::Flow => vec!["--miter"],
+            Method::Wrapper => vec!["sim", "--icarus", "--only"],
+            // Yosys's script, not arguments (see `check`).
+            Method::Wiring => vec![],
         };
         let mut v: Vec<String> = v.into_iter().map(String::from).collect();
         match self {
@@ -468,6 +631,13 @@ impl Method {
             Method::Formal | Method::Flow => {
                 let f = plan.formal.as_ref().expect("a formal plan names its tools");
                 v.push(f.reference.display().to_string());
+            }
+            Method::Wrapper => {
+                let w = plan
+                    .wrapper
+                    .as_ref()
+                    .expect("a wrapper plan names the wrapper");
+                v.push(w.module.clone());
             }
             _ => {}
         }
@@ -513,6 +683,9 @@ impl Verdict {
 /// them together, runs out), their output in `log`.
 pub fn check(method: Method, dir: &Path, build: &Path, log: &Path, plan: &Plan) -> Result<Verdict> {
     let t0 = Instant::now();
+    if method == Method::Wiring {
+        return wiring(dir, build, log, plan);
+    }
     let out =
         std::fs::File::create(log).with_context(|| format!("cannot write {}", log.display()))?;
     for args in method.runs(plan) {
@@ -552,6 +725,41 @@ pub fn check(method: Method, dir: &Path, build: &Path, log: &Path, plan: &Plan) 
         }
     }
     Ok(Verdict::Passed)
+}
+
+/// [`Method::Wiring`] on the mutant design `dir`: Yosys runs the wrapper's miter
+/// ([`Wrapper::miter_script`], written into `build`), bounded by `plan.timeout`, its output in
+/// `log`. It passes when the miter is proved, fails when SAT finds an input on which they
+/// differ ([`Wrapper::DIFFER`]); anything else (a script Yosys cannot run) refuses.
+fn wiring(dir: &Path, build: &Path, log: &Path, plan: &Plan) -> Result<Verdict> {
+    let w = plan
+        .wrapper
+        .as_ref()
+        .context("the wiring truth needs the wrapper")?;
+    let d = DesignDir::open(dir)?;
+    crate::disk::create_dir_all(build)?;
+    let script = build.join("miter.ys");
+    crate::disk::write(&script, w.miter_script(dir, d.file_names()))?;
+    let out =
+        std::fs::File::create(log).with_context(|| format!("cannot write {}", log.display()))?;
+    let mut c = Command::new(crate::toolchain::yosys::yosys());
+    c.arg("-q")
+        .arg("-s")
+        .arg(&script)
+        .current_dir(build)
+        .stdin(Stdio::null())
+        .stdout(out.try_clone()?)
+        .stderr(out);
+    let status = crate::toolchain::child::spawn(&mut c)
+        .context("cannot start yosys for the wiring miter")?
+        .wait_timeout(plan.timeout)?;
+    let said = std::fs::read_to_string(log).unwrap_or_default();
+    Ok(match status.and_then(|s| s.code()) {
+        None if status.is_none() => Verdict::Timeout,
+        Some(0) => Verdict::Passed,
+        _ if said.contains(Wrapper::DIFFER) => Verdict::Failed,
+        _ => Verdict::Refused,
+    })
 }
 
 /// One mutant's verdicts, method by method, in the order they ran.
@@ -606,6 +814,9 @@ pub struct Plan {
     pub truth_stream: u64,
     /// The formal tools, for [`Method::Formal`] and [`Method::Flow`].
     pub formal: Option<FormalTools>,
+    /// The wrapper mutated, for [`Method::Wrapper`] and [`Method::Wiring`]: the draw and every
+    /// mutant are of it alone.
+    pub wrapper: Option<Wrapper>,
 }
 
 /// How the formal harness runs on a mutant: `python script --reference REF|--miter REF
@@ -631,7 +842,7 @@ pub fn judge(d: &DesignDir, m: &Mutant, plan: &Plan, work: &Path) -> Result<Outc
     );
     let design = dir.join("design");
     crate::disk::create_dir_all(&design)?;
-    materialise(d, m, &design)?;
+    materialise(d, m, plan.wrapper.as_ref(), &design)?;
     let mut verdicts = Vec::new();
     let mut run = |method: Method| -> Result<Verdict> {
         let v = check(
@@ -857,6 +1068,83 @@ mod tests {
     }
 
     #[test]
+    fn under_the_wiring_truth_the_wrappers_testbench_is_the_check_judged() {
+        use Method::*;
+        use Verdict::*;
+        assert_eq!([Wiring, Wrapper].map(Method::proof), [Wrapper, Wrapper]);
+        assert!(Wiring.is_truth() && !Wrapper.is_truth());
+        assert_eq!((Wiring.name(), Wrapper.name()), ("wiring", "wrapper"));
+        // A wiring difference the testbench passed is what the run exists to find.
+        let survived = outcome(1, &[(Wiring, Failed), (Wrapper, Passed)]);
+        let killed = outcome(2, &[(Wiring, Failed), (Wrapper, Failed)]);
+        let equivalent = outcome(3, &[(Wiring, Passed), (Wrapper, Passed)]);
+        assert!(survived.unsound() && !killed.unsound() && !equivalent.unsound());
+        assert_eq!(survived.truth(), Some(Wiring));
+        let t = tally(Wrapper, &[survived, killed, equivalent]);
+        assert_eq!(
+            (
+                t.judged,
+                t.equivalent,
+                t.non_equivalent,
+                t.killed,
+                t.survived
+            ),
+            (3, 1, 2, 1, 1)
+        );
+        let plan = Plan {
+            methods: vec![Wrapper],
+            quick: false,
+            timeout: Duration::from_secs(60),
+            sim_stream: 7,
+            truth: Wiring,
+            truth_stream: 9,
+            formal: None,
+            wrapper: Some(super::Wrapper {
+                module: "p_rmap_axis".into(),
+                file: "p_rmap_axis.v".into(),
+                children: vec!["p_rmap_top".into()],
+                reference: PathBuf::from("/ref"),
+            }),
+        };
+        let runs: Vec<String> = Wrapper.runs(&plan).iter().map(|r| r.join(" ")).collect();
+        assert_eq!(runs, ["sim --icarus --only p_rmap_axis"]);
+    }
+
+    #[test]
+    fn the_wiring_miter_cuts_the_instances_out_of_both_wrappers() {
+        let w = Wrapper {
+            module: "rmap_lanes".into(),
+            file: "rmap_lanes.v".into(),
+            children: vec!["rmap_top".into(), "recip_rom".into()],
+            reference: PathBuf::from("/ref"),
+        };
+        let files = ["rmap_lanes.v", "rmap_top.v", "recip_rom.v"].map(String::from);
+        let script = w.miter_script(Path::new("/mut"), &files);
+        let lines: Vec<&str> = script.lines().collect();
+        for side in ["/ref", "/mut"] {
+            // The wrapper read as itself, the rest as black boxes.
+            let lib = format!("read_verilog -lib {side}/rmap_top.v {side}/recip_rom.v");
+            assert!(lines.contains(&lib.as_str()), "{script}");
+            let own = format!("read_verilog {side}/rmap_lanes.v");
+            assert!(lines.contains(&own.as_str()), "{script}");
+        }
+        assert_eq!(
+            lines
+                .iter()
+                .filter(|l| **l == "expose -evert rmap_lanes/t:rmap_top rmap_lanes/t:recip_rom")
+                .count(),
+            2,
+            "{script}"
+        );
+        let at = |l: &str| lines.iter().position(|x| *x == l).unwrap_or(usize::MAX);
+        assert!(at("rename rmap_lanes gold") < at("design -stash gold"));
+        assert!(at("design -stash gold") < at("read_verilog /mut/rmap_lanes.v"));
+        assert!(at("rename rmap_lanes gate") < at("design -stash gate"));
+        assert_eq!(lines.last(), Some(&"sat -verify -prove-asserts miter"));
+        assert!(lines.contains(&"miter -equiv -flatten -make_assert gold gate miter"));
+    }
+
+    #[test]
     fn the_proof_runs_its_cheap_parts_first_and_every_other_check_runs_once() {
         let plan = Plan {
             methods: vec![Method::Prove],
@@ -866,6 +1154,7 @@ mod tests {
             truth: Method::Stream,
             truth_stream: 9,
             formal: None,
+            wrapper: None,
         };
         let line =
             |m: Method| -> Vec<String> { m.runs(&plan).iter().map(|r| r.join(" ")).collect() };

@@ -205,11 +205,13 @@ impl Report {
             self.design, self.config_summary, self.shard.index, self.shard.count, self.mode
         );
         if self.config.axis {
-            // What the verdict covers: the proof drives rmap_top, not the wrapper.
+            // What the verdict covers: the proof drives rmap_top, not the wrapper, and names
+            // what does check the wrapper (it does not run it).
             s += &format!(
-                "  scope             {} inside {} (the AXI4-Stream wrapper only renames ports: its testbench checks it)\n",
+                "  scope             {} inside {} (the proof does not drive the AXI4-Stream wrapper: {} checks it)\n",
                 crate::stages::TOP.module(&self.config),
-                crate::stages::top(&self.config).module(&self.config)
+                crate::stages::top(&self.config).module(&self.config),
+                crate::stages::rmap_axis::checked_by(&self.config)
             );
         }
         for p in &self.parts {

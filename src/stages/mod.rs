@@ -6,7 +6,7 @@
 //!
 //! | folder | module | instantiated by | has vectors and a testbench |
 //! |---|---|---|---|
-//! | `rmap_axis` | the AXI4-Stream top (`axis`) | — | — (the cocotb test, tb/cocotb/) |
+//! | `rmap_axis` | the AXI4-Stream top (`axis`) | — | yes (the top's vectors, in `tdata`) |
 //! | `rmap_lanes` | the lanes top (`lanes` > 1): one rmap_top per lane | — | yes (the top's vectors) |
 //! | `rmap_top` | the top (the shading pipeline; inside rmap_axis with `axis`, once per lane in rmap_lanes) | rmap_axis, rmap_lanes | yes |
 //! | `zero_detect` | zero detect | rmap_top | yes |
@@ -95,7 +95,7 @@ pub fn parents(cfg: &Config) -> Vec<(&'static str, Option<&'static str>)> {
 }
 
 /// The modules with their own vectors and testbench, in pipeline order, then the top, then
-/// the design's top if it is another module with vectors (rmap_lanes).
+/// the design's top if it is another module with vectors (rmap_lanes, rmap_axis).
 pub fn checked(cfg: &Config) -> Vec<&'static dyn Vectors> {
     let outer = top(cfg);
     let mut v: Vec<&'static dyn Vectors> = modules(cfg)
@@ -134,8 +134,12 @@ pub fn path(
     let cfg = &model.cfg;
     let s = Traced::new(model, maps.buffer(buf), buf, g, rgb);
     let mut v = Vec::new();
-    // The lanes top carries the same sample in one of its lanes: the top's ports say it.
-    for m in checked(cfg).into_iter().filter(|m| m.lanes(cfg) == 1) {
+    // The lanes top carries the same sample in one of its lanes, the AXI4-Stream top in
+    // `tdata`: the top's ports say it.
+    for m in checked(cfg)
+        .into_iter()
+        .filter(|m| m.lanes(cfg) == 1 && m.inner().is_none())
+    {
         let inp = m.traced(cfg, &s);
         let out = m.expected(model, maps, &inp);
         let scope = if m.name() == TOP.name() {
@@ -224,6 +228,13 @@ mod tests {
                 comp_table: crate::config::CompTable::Ram,
                 ..d.clone()
             },
+            Config {
+                handshake: true,
+                axis: true,
+                axis_user: 2,
+                color: true,
+                ..d.clone()
+            },
             Config { lanes: 2, ..d },
         ]
     }
@@ -273,7 +284,7 @@ mod tests {
             let want: Vec<_> = checked(&cfg)
                 .iter()
                 .map(|m| m.name())
-                .filter(|&n| n != TOP.name() && n != "rmap_lanes")
+                .filter(|&n| n != TOP.name() && n != super::top(&cfg).name())
                 .collect();
             assert_eq!(scopes, want, "every checked stage, in pipeline order");
             assert!(

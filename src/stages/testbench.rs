@@ -31,6 +31,9 @@ pub struct TbFile {
 
 /// Everything the testbench templates read.
 pub struct TbData {
+    /// The configuration: a testbench that maps the vector fields onto ports of its own
+    /// ([`crate::stages::Vectors::inner`]) reads their layout from it.
+    pub cfg: crate::config::Config,
     pub header: String,
     /// The module under test ([`crate::stages::Unit::module`]); the testbench is `<module>_tb`.
     pub module: String,

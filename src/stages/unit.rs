@@ -336,6 +336,14 @@ pub trait Vectors: Unit {
         1
     }
 
+    /// The module inside this one whose ports the [`Self::fields`] name, when this one carries
+    /// them in ports of its own (rmap_axis: rmap_top's fields packed into `tdata`): its
+    /// testbench starts from that module's testbench data and maps the fields onto its own
+    /// ports itself. `None` (every module but the wrapper): the fields name this module's ports.
+    fn inner(&self) -> Option<&'static dyn Vectors> {
+        None
+    }
+
     /// `vectors/<module>.hex`, relative to the output directory.
     fn vector_file(&self, cfg: &Config) -> String {
         format!("vectors/{}.hex", self.module(cfg))

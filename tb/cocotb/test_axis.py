@@ -168,9 +168,14 @@ async def axis_stream_matches_the_model(dut):
             beats = len(f.tdata) // lanes
             for b in range(beats):
                 word = int.from_bytes(bytes(f.tdata[b * lanes:(b + 1) * lanes]), "little")
-                # The sink compacts a frame's sideband to one int when every byte agrees.
-                u = f.tuser if isinstance(f.tuser, int) else f.tuser[b * lanes]
-                u = u if tuser_bits else 0
+                # The sink compacts a frame's sideband to one int when every byte agrees, and
+                # gives None when the bus has no tuser (--axis-user 0).
+                if not tuser_bits:
+                    u = 0
+                elif isinstance(f.tuser, int):
+                    u = f.tuser
+                else:
+                    u = f.tuser[b * lanes]
                 got.append((word, u, int(b == beats - 1)))
 
     writes_done = cocotb.triggers.Event()

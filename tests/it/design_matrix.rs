@@ -1,6 +1,6 @@
 //! Every command that takes a generated design, on small designs built with each option that
-//! changes what a design is (issue 32 §2): a prefix, lanes, the AXI4-Stream top, colour, ECP5
-//! memories, inferred multipliers and a non-default width. Each command (lint, synth, roms
+//! changes what a design is (issue 32 §2): a prefix, lanes, the AXI4-Stream top (with a
+//! prefix), colour, ECP5 memories, inferred multipliers and a non-default width. Each command (lint, synth, roms
 //! --update, vectors --maps, sim, fpga --dir, prove) reads the design (its manifest) and either
 //! does its job right or refuses in one line (exit 2); none reports success on a wrong result
 //! or fails a correct design.
@@ -77,12 +77,8 @@ fn check(flags: &[&str], prove: Prove) {
         "vectors --maps equals the design's vectors"
     );
 
-    // The top's testbench (rmap_lanes's for lanes; rmap_top's inside rmap_axis) in Icarus.
-    let tb_top = if p.join(format!("d/tb/{top}_tb.v")).is_file() {
-        top.clone()
-    } else {
-        rmap_top.clone()
-    };
+    // The design top's testbench (rmap_lanes's, rmap_axis's: every top has one) in Icarus.
+    let tb_top = top.clone();
     let said = ok(
         "sim",
         &run_in(
@@ -146,6 +142,15 @@ fn check(flags: &[&str], prove: Prove) {
                 top != rmap_top,
                 "{said}"
             );
+            // The wrapper is claimed only as checked by what checks it: its testbench, which
+            // the sim above ran.
+            assert_eq!(
+                said.contains(&format!(
+                    "its testbench tb/{top}_tb.v, run by `rmapgen sim`"
+                )),
+                top != rmap_top,
+                "{said}"
+            );
         }
     }
 }
@@ -168,9 +173,14 @@ fn a_lanes_design() {
     check(&small(&["--lanes", "2"]), Prove::Refused);
 }
 
+/// Without tuser (`--axis-user 0`, the default) and with a prefix: the wrapper's testbench
+/// names every module and file with it.
 #[test]
 fn an_axis_design() {
-    check(&small(&["--axis", "--handshake"]), Prove::Structure);
+    check(
+        &small(&["--axis", "--handshake", "--prefix", "ax_"]),
+        Prove::Structure,
+    );
 }
 
 #[test]

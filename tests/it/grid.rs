@@ -40,7 +40,7 @@ tests! {
     paper, paper_depth0, paper_depth1, paper_hs, color, no_comp, no_interp, bare, no_comp_color,
     no_interp_color, bare_color, narrowest, narrowest_bare, widest, widest_depth0, grad16_red6,
     grad8_red8, no_truncation, frac4_recip20, frac12_recip13, index6_interp1, index2_interp5,
-    map12, map6_nearest, index6_nearest, axis_color, lanes2, lanes2_hs, lanes4, lanes4_hs,
+    map12, map6_nearest, index6_nearest, axis_color, axis_table_narrow, lanes2, lanes2_hs, lanes4, lanes4_hs,
     lanes2_hs_ecp5, lanes4_gowin,
     paper_infer, color_infer, hs_infer, widest_infer, table_ram, table_ram_narrow,
     table_ram_lanes2_hs,
@@ -68,14 +68,11 @@ fn check(name: &str) {
     let dir = tmp.path().join(name);
     hdl::generate_config(&dir, &r.config, VECTORS);
 
-    // The design's top: rmap_lanes with lanes, whose testbench checks every lane against the
-    // top's vectors (each lane is an rmap_top), else rmap_top.
+    // The design's top, whose testbench reads the top's vectors: rmap_lanes with lanes (every
+    // lane an rmap_top), rmap_axis with axis (each sample a beat, packed into tdata), else
+    // rmap_top.
     let top = rmapgen::stages::top(&r.config);
-    let checked = if r.config.lanes > 1 {
-        top.module(&r.config)
-    } else {
-        "rmap_top".to_string()
-    };
+    let checked = top.module(&r.config);
     hdl::assert_lint_clean_top(name, &dir, &top.module(&r.config));
     synthesise(name, &dir, &tmp.path().join("synth"));
 
@@ -94,7 +91,7 @@ fn check(name: &str) {
         for m in &tbs {
             let bin = hdl::icarus(&dir, m, tmp.path());
             let what = format!("{name}: icarus {m}");
-            // rmap_lanes' testbench reads the top's vectors.
+            // rmap_lanes' and rmap_axis' testbenches read the top's vectors.
             let vectors = if *m == checked {
                 "rmap_top"
             } else {
@@ -219,6 +216,10 @@ fn grid_covers_every_range_end_and_switch() {
         .iter()
         .any(|r| r.config.target == Target::Family(Family::Ice40)));
     assert!(ic.iter().any(|r| r.config.axis && r.config.axis_user > 0));
+    // The AXI4-Stream top without tuser, and with the loaded compensation table.
+    assert!(rows.iter().any(|r| r.config.axis
+        && r.config.axis_user == 0
+        && r.config.comp_table == CompTable::Ram));
     // Inferred multipliers (--mult infer): the paper's design, colour, the widest widths, the
     // handshake, every depth (each places the products' registers differently), in Icarus too.
     let inf: Vec<&GridRow> = rows

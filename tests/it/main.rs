@@ -1,6 +1,7 @@
 //! One integration-test binary; modules mirror the source tree.
 
 mod alloc;
+mod axis;
 mod bench;
 
 mod cmd_render;

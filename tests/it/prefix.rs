@@ -12,7 +12,7 @@
 use crate::hdl::{self, config_of, require, vector_count};
 use crate::helpers;
 use rmapgen::config::Config;
-use rmapgen::emit::package;
+use rmapgen::emit::manifest::{config_hash, Core};
 use rmapgen::hdl::ports::{Dir, Width};
 use rmapgen::stages::{self, TOP};
 use std::collections::BTreeSet;
@@ -154,8 +154,10 @@ fn two_prefixed_designs_share_one_directory_and_both_are_exact() {
         }
         let core = std::fs::read_to_string(dir.join(format!("{prefix}rmap_top.core"))).unwrap();
         assert!(
-            core.contains(&format!("\nname: {}\n", package::vlnv(&cfg)))
-                && package::vlnv(&cfg).starts_with(&format!("rmapgen:ip:{prefix}rmap_top_"))
+            core.contains(&format!("\nname: {}\n", Core::new(&cfg).name))
+                && Core::new(&cfg)
+                    .name
+                    .starts_with(&format!("rmapgen:ip:{prefix}rmap_top_"))
                 && core.contains(&format!("toplevel: {prefix}rmap_top_tb\n")),
             "{core}"
         );
@@ -180,14 +182,14 @@ fn two_prefixed_designs_share_one_directory_and_both_are_exact() {
         .collect();
     assert_eq!(shared, DIRECTORY_FILES);
     // The cores of the two configurations differ in name; so would they without prefixes.
-    assert_ne!(package::vlnv(&cfgs[0]), package::vlnv(&cfgs[1]));
+    assert_ne!(Core::new(&cfgs[0]).name, Core::new(&cfgs[1]).name);
     let bare = |c: &Config| Config {
         prefix: String::new(),
         ..c.clone()
     };
     assert_ne!(
-        package::vlnv(&bare(&cfgs[0])),
-        package::vlnv(&bare(&cfgs[1]))
+        Core::new(&bare(&cfgs[0])).name,
+        Core::new(&bare(&cfgs[1])).name
     );
     std::fs::write(both.join("pair_top.v"), wrapper(&cfgs)).unwrap();
 
@@ -225,23 +227,23 @@ fn without_a_prefix_the_names_are_the_stage_names() {
         assert_eq!(m.module(&cfg), m.name());
         assert_eq!(m.file(&cfg), format!("{}.v", m.name()));
     }
-    assert_eq!(package::core_file(&cfg), "rmap_top.core");
+    assert_eq!(Core::new(&cfg).file, "rmap_top.core");
     // The hash is of the configuration: stable, eight hex digits, different for another.
-    let h = package::config_hash(&cfg);
-    assert_eq!(h, package::config_hash(&Config::default()));
+    let h = config_hash(&cfg);
+    assert_eq!(h, config_hash(&Config::default()));
     assert!(
         h.len() == 8 && h.bytes().all(|b| b.is_ascii_hexdigit()),
         "{h}"
     );
     assert_eq!(
-        package::vlnv(&cfg),
+        Core::new(&cfg).name,
         format!("rmapgen:ip:rmap_top_{h}:{}", env!("CARGO_PKG_VERSION"))
     );
     let other = Config {
         color: true,
         ..Config::default()
     };
-    assert_ne!(package::config_hash(&other), h);
+    assert_ne!(config_hash(&other), h);
 }
 
 /// A prefixed design's stage testbenches need nothing of the unprefixed names: one stage

@@ -118,22 +118,59 @@ fn handshake_passes_under_backpressure_and_catches_a_broken_queue() {
 fn core_and_readme_describe_the_directory() {
     let tmp = helpers::tempdir();
     let mut names = Vec::new();
-    for flags in [&[][..], &["--handshake", "--color"][..]] {
-        let dir = tmp
-            .path()
-            .join(if flags.is_empty() { "plain" } else { "hs" });
+    for (name, flags) in [
+        ("plain", &[][..]),
+        ("hs", &["--handshake", "--color"][..]),
+        ("axis", &["--handshake", "--axis", "--axis-user", "2"][..]),
+        ("lanes", &["--lanes", "2"][..]),
+    ] {
+        let dir = tmp.path().join(name);
         generate(&dir, flags);
         let cfg = config_of(&dir);
-        let core = std::fs::read_to_string(dir.join("rmap_top.core")).unwrap();
-        assert!(core.starts_with("CAPI=2:\n"), "{core}");
-        // Named after the top and the configuration, so the two cores differ.
-        assert!(core.contains(&format!(
-            "name: rmapgen:ip:rmap_top_{}:{}\n",
-            emit::package::config_hash(&cfg),
+        // One rule names the core: after the module users instantiate, the design's top (the
+        // manifest's `top`), which is its toplevel; its sim target runs that module's testbench.
+        let m: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap())
+                .unwrap();
+        let top = m["top"].as_str().unwrap().to_string();
+        assert_eq!(top, stages::top(&cfg).module(&cfg));
+        let file = format!("{top}.core");
+        assert_eq!(m["core"]["file"], file.as_str());
+        assert_eq!(m["core"]["toplevel"], top.as_str());
+        assert_eq!(m["core"]["sim_toplevel"], format!("{top}_tb").as_str());
+        let core = std::fs::read_to_string(dir.join(&file)).unwrap();
+        assert!(
+            core.starts_with(&format!("CAPI=2:\n# {file}: generated")),
+            "{core}"
+        );
+        // Named after that top and the configuration, so the cores differ.
+        let vlnv = format!(
+            "rmapgen:ip:{top}_{}:{}",
+            emit::manifest::config_hash(&cfg),
             env!("CARGO_PKG_VERSION")
-        )));
-        names.push(emit::package::vlnv(&cfg));
-        assert!(core.contains("toplevel: rmap_top\n") && core.contains("toplevel: rmap_top_tb"));
+        );
+        assert_eq!(m["core"]["name"], vlnv.as_str());
+        assert!(core.contains(&format!("\nname: {vlnv}\n")), "{core}");
+        names.push(vlnv.clone());
+        assert!(
+            core.contains(&format!("    toplevel: {top}\n"))
+                && core.contains(&format!("    toplevel: {top}_tb\n"))
+                && core.contains(&format!("      - tb/{top}_tb.v\n")),
+            "{core}"
+        );
+        assert!(dir.join(format!("tb/{top}_tb.v")).is_file());
+        // The README says the name, and the rule, once.
+        let readme = std::fs::read_to_string(dir.join("README.md")).unwrap();
+        assert_eq!(readme.matches(&vlnv).count(), 2, "{readme}");
+        assert_eq!(readme.matches("rmapgen:ip:<module>_<hash>").count(), 1);
+        assert!(!readme.contains("rmapgen:ip:rmap_top_") || top == "rmap_top");
+        // No other core file: the one rule names the only one.
+        let cores: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .filter_map(|e| e.ok())
+            .filter(|e| e.file_name().to_string_lossy().ends_with(".core"))
+            .collect();
+        assert_eq!(cores.len(), 1, "{name}");
         // Every module file and every memory's init file, each of which exists.
         for m in stages::modules(&cfg) {
             assert!(
@@ -168,10 +205,12 @@ fn core_and_readme_describe_the_directory() {
         assert!(readme.contains("## Reset") && readme.contains("swap_i"));
         assert_eq!(readme.contains("`ready_i`"), cfg.handshake, "{flags:?}");
         // Both are in the manifest's file list.
-        let m = std::fs::read_to_string(dir.join("manifest.json")).unwrap();
-        assert!(m.contains("\"rmap_top.core\"") && m.contains("\"README.md\""));
+        let files = m["files"].as_array().unwrap();
+        assert!(files.contains(&file.as_str().into()) && files.contains(&"README.md".into()));
     }
-    assert_ne!(names[0], names[1]);
+    names.sort();
+    names.dedup();
+    assert_eq!(names.len(), 4);
 }
 
 #[test]

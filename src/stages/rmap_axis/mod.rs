@@ -9,8 +9,10 @@
 //! template slices `tdata` with them, the manifest carries them (for the cocotb test,
 //! tb/cocotb/test_axis.py) and the README prints them.
 
+mod vectors;
+
 use super::rmap_top::{top_latency, RmapTop};
-use super::unit::{Head, Memory, Unit};
+use super::unit::{Head, Memory, Unit, Vectors};
 use super::TOP;
 use crate::config::Config;
 use crate::hdl::ports::{i, o, Dir, Port, Width};
@@ -196,6 +198,16 @@ fn connections(cfg: &Config) -> (Vec<(&'static str, String)>, Vec<Port>) {
     (pins, through)
 }
 
+/// What checks the wrapper itself, which `rmapgen prove` does not drive (it proves the top
+/// inside; its scope line says so with this): the wrapper's testbench, which `rmapgen sim`
+/// runs.
+pub fn checked_by(cfg: &Config) -> String {
+    format!(
+        "its testbench {}, run by `rmapgen sim`",
+        RmapAxis.testbench_file(cfg)
+    )
+}
+
 /// The top's instance name, `u_rmap_top`.
 fn instance() -> String {
     format!("u_{}", RmapTop.name())
@@ -286,6 +298,10 @@ impl Unit for RmapAxis {
             latency: top_latency(cfg),
         }
         .render()
+    }
+
+    fn vectors(&self) -> Option<&dyn Vectors> {
+        Some(self)
     }
 }
 
@@ -420,6 +436,38 @@ mod tests {
         )
         .unwrap();
         assert!(!plain.contains("AXI4-Stream ports"));
+    }
+
+    #[test]
+    fn the_testbench_packs_every_field_of_the_tops_vectors_at_its_slot() {
+        for (color, user) in [(false, 0), (true, 3), (false, 64)] {
+            let cfg = axis(color, user);
+            let text = crate::emit::tb::render(&cfg, &RmapAxis).unwrap();
+            assert!(text.contains("module rmap_axis_tb;"));
+            assert!(text.contains("  rmap_axis #("), "{text}");
+            for (bus, dir) in [("nx_tdata", field::Dir::In), ("exp_tdata", field::Dir::Out)] {
+                for s in &packing(&cfg, dir).slots {
+                    let want = format!("{bus}{} = v_{}[", s.range(), s.field);
+                    assert!(text.contains(&want), "{want}");
+                }
+            }
+            // Every top field the vectors carry with a port has a slot: none is left unchecked.
+            let top = TOP.vectors().unwrap();
+            let slotted = packing(&cfg, field::Dir::In).slots.len()
+                + packing(&cfg, field::Dir::Out).slots.len();
+            let ported = top
+                .fields(&cfg)
+                .iter()
+                .filter(|f| top.port(f).is_some())
+                .count();
+            assert_eq!(slotted, ported);
+            assert_eq!(text.contains("m_axis_tuser"), user > 0);
+            // Between host writes the write port carries random values (wr_en_i must gate it).
+            for p in ["wr_axis_i", "wr_addr_i", "wr_data_i"] {
+                assert!(text.contains(&format!("      {p} = rnd[")), "{p}");
+            }
+            assert!(text.contains("      if (!wr_en_i) host_garbage;"));
+        }
     }
 
     #[test]
