@@ -81,6 +81,45 @@ pub struct Config {
     /// field existed.
     #[serde(skip_serializing_if = "CompTable::is_rom")]
     pub comp_table: CompTable,
+    /// A CPU bus slave around the design's top: [`Bus`]. Left out of the TOML and JSON when
+    /// `none` (the default), so a design without it is written as before the field existed.
+    #[serde(skip_serializing_if = "Bus::is_none")]
+    pub bus: Bus,
+}
+
+/// The bus a CPU loads the maps through (docs/SOC.md): with one, the design's top becomes
+/// `rmap_bus` (src/stages/rmap_bus), which puts the register block `rmap_regs`
+/// (src/stages/rmap_regs: the identification block, control, status and the map and table
+/// windows) on the bus and drives the host write port and the swap itself.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum,
+)]
+#[serde(rename_all = "kebab-case")]
+pub enum Bus {
+    /// No bus: the host write port (`wr_*`, `swap_i`) is the top's.
+    #[default]
+    None,
+    /// Wishbone B4 classic, 32-bit data, word addresses (`wb_*`), as LiteX's SoC bus.
+    Wishbone,
+    /// AXI4-Lite, 32-bit data, byte addresses (`s_axil_*`).
+    #[value(name = "axi4-lite")]
+    #[serde(rename = "axi4-lite")]
+    Axi4Lite,
+}
+
+impl Bus {
+    pub fn is_none(&self) -> bool {
+        *self == Bus::None
+    }
+
+    /// `none`, `wishbone` or `axi4-lite`, as the flag and the TOML spell it.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Bus::None => "none",
+            Bus::Wishbone => "wishbone",
+            Bus::Axi4Lite => "axi4-lite",
+        }
+    }
 }
 
 /// The compensation table (docs/ARCHITECTURE.md, "Compensation table"): the fixed atan ROM of
@@ -393,6 +432,7 @@ impl Default for Config {
             lanes: 1,
             mult: Mult::Tree,
             comp_table: CompTable::Rom,
+            bus: Bus::None,
         }
     }
 }
@@ -500,6 +540,14 @@ impl Config {
                     self.atan_entries(), self.pos_bits(), self.map_addr_bits(), self.map_bits, self.map_addr_bits()
                 ));
             }
+        }
+        if !self.bus.is_none() && (self.axis || self.lanes > 1) {
+            return c(&["bus", if self.axis { "axis" } else { "lanes" }], format!(
+                "bus = {} with {}: the bus slave is in front of one rmap_top so far (with or without the handshake); leave out {}",
+                self.bus.name(),
+                if self.axis { "axis".to_string() } else { format!("lanes = {}", self.lanes) },
+                if self.axis { "--axis" } else { "--lanes" }
+            ));
         }
         if self.interpolation && self.interp_bits == 0 {
             return c(&["interp_bits", "interpolation"], "interp_bits = 0 with interpolation on; give interp_bits >= 1 or turn interpolation off".into());
@@ -733,6 +781,10 @@ impl Config {
             String::new()
         } else {
             format!(" table={}", self.comp_table.name())
+        } + &if self.bus.is_none() {
+            String::new()
+        } else {
+            format!(" bus={}", self.bus.name())
         }
     }
 }

@@ -13,7 +13,7 @@
 //! compensation table as a loaded RAM (`--comp-table ram`: with and without the handshake and
 //! lanes, for each memory target).
 
-use crate::config::{CompTable, Config, Mult, Target, RANGES};
+use crate::config::{Bus, CompTable, Config, Mult, Target, RANGES};
 use crate::family::Family;
 
 /// One configuration of the grid.
@@ -35,7 +35,7 @@ macro_rules! grid {
         $comp:literal $interp:literal $color:literal $depth:literal $hs:literal $icarus:literal
         $ice40:literal
         $(axis $user:literal)? $(lanes $lanes:literal)? $(mult $mult:ident)? $(table $table:ident)?
-        $covers:literal; )*) => {
+        $(bus $bus:ident)? $covers:literal; )*) => {
         /// Every row, in the order below.
         pub fn rows() -> Vec<GridRow> {
             vec![$(GridRow {
@@ -52,6 +52,7 @@ macro_rules! grid {
                     lanes: 1 $(- 1 + $lanes)?,
                     mult: *[Mult::Tree $(, Mult::$mult)?].last().expect("a style"),
                     comp_table: *[CompTable::Rom $(, CompTable::$table)?].last().expect("a table"),
+                    bus: *[Bus::None $(, Bus::$bus)?].last().expect("a bus"),
                 },
                 icarus: $icarus == 1,
                 covers: $covers,
@@ -65,7 +66,8 @@ macro_rules! grid {
 // --target ice40 (1), ecp5 (2), gowin (3) or generic (0); `axis U`: the AXI4-Stream top rmap_axis with a U-bit tuser;
 // `lanes L`: the lanes top rmap_lanes with L lanes (its testbench runs in place of rmap_top's);
 // `mult Infer`: inferred multipliers (`--mult infer`), else adder trees; `table Ram`: the
-// compensation table as a RAM the host loads (`--comp-table ram`), else the atan ROM.
+// compensation table as a RAM the host loads (`--comp-table ram`), else the atan ROM; `bus
+// Wishbone` or `bus Axi4Lite`: the bus top rmap_bus (`--bus`), its sample top's testbenches run.
 grid! {
 //                  G  R  W  F  I  P  M  comp interp color depth hs icarus target
     paper:          12 8  10 8  3  3  8  1    1      0     2     0  1  0

@@ -67,6 +67,11 @@ pub struct ConfigArgs {
     /// scene) [default: rom].
     #[arg(long, value_enum, value_name = "T")]
     pub comp_table: Option<crate::config::CompTable>,
+    /// A CPU bus slave on top (rmap_bus: the register block rmap_regs on the bus, which
+    /// writes the maps and swaps them; docs/SOC.md): none, wishbone (B4 classic, LiteX's) or
+    /// axi4-lite [default: none].
+    #[arg(long, value_enum, value_name = "B")]
+    pub bus: Option<crate::config::Bus>,
 }
 
 impl ConfigArgs {
@@ -120,6 +125,9 @@ impl ConfigArgs {
         }
         if !cfg.comp_table.is_rom() {
             f.extend(["--comp-table".into(), cfg.comp_table.name().into()]);
+        }
+        if !cfg.bus.is_none() {
+            f.extend(["--bus".into(), cfg.bus.name().into()]);
         }
         f
     }
@@ -300,6 +308,10 @@ impl ConfigArgs {
         if let Some(t) = self.comp_table {
             c.comp_table = t;
             flags.push(("comp_table", format!("--comp-table {}", t.name())));
+        }
+        if let Some(b) = self.bus {
+            c.bus = b;
+            flags.push(("bus", format!("--bus {}", b.name())));
         }
         (c, flags)
     }

@@ -36,7 +36,9 @@ pub mod pipe_delay;
 pub mod position;
 pub mod recip_rom;
 pub mod rmap_axis;
+pub mod rmap_bus;
 pub mod rmap_lanes;
+pub mod rmap_regs;
 pub mod rmap_top;
 pub mod sort_shift;
 pub mod testbench;
@@ -44,16 +46,28 @@ pub mod unit;
 pub mod zero_detect;
 
 use crate::config::Config;
-pub use unit::{Head, Memory, Traced, Unit, Vectors};
+pub use unit::{Head, Memory, Stream, Traced, Unit, Vectors};
 
 /// The top of the shading pipeline, with the top-level vectors and testbench; the design's
 /// top too, except with `axis` ([`top`]).
 pub const TOP: &dyn Unit = &rmap_top::RmapTop;
 
-/// The design's outermost module: [`rmap_axis::RmapAxis`] (which instantiates [`TOP`]) with
-/// `axis`, [`rmap_lanes::RmapLanes`] (one [`TOP`] per lane) with `lanes` > 1, else [`TOP`].
-/// The manifest's `top`, lint, synthesis and the FPGA flow start here.
+/// The design's outermost module: [`rmap_bus::RmapBus`] (which instantiates the
+/// [`sample_top`] and the register block) with a `bus`, else the [`sample_top`]. The
+/// manifest's `top`, lint, synthesis and the FPGA flow start here.
 pub fn top(cfg: &Config) -> &'static dyn Unit {
+    if cfg.bus.is_none() {
+        sample_top(cfg)
+    } else {
+        &rmap_bus::RmapBus
+    }
+}
+
+/// The outermost module of the sample stream: [`rmap_axis::RmapAxis`] (which instantiates
+/// [`TOP`]) with `axis`, [`rmap_lanes::RmapLanes`] (one [`TOP`] per lane) with `lanes` > 1,
+/// else [`TOP`]. It has the host write port; the design's [`top`] unless a bus slave drives
+/// that port.
+pub fn sample_top(cfg: &Config) -> &'static dyn Unit {
     if cfg.axis {
         &rmap_axis::RmapAxis
     } else if cfg.lanes > 1 {
@@ -95,17 +109,20 @@ pub fn parents(cfg: &Config) -> Vec<(&'static str, Option<&'static str>)> {
 }
 
 /// The modules with their own vectors and testbench, in pipeline order, then the top, then
-/// the design's top if it is another module with vectors (rmap_lanes, rmap_axis).
+/// the sample stream's top if it is another module (rmap_lanes, rmap_axis), then the design's
+/// top if it is yet another with vectors.
 pub fn checked(cfg: &Config) -> Vec<&'static dyn Vectors> {
-    let outer = top(cfg);
+    let tops = [TOP.name(), sample_top(cfg).name(), top(cfg).name()];
     let mut v: Vec<&'static dyn Vectors> = modules(cfg)
         .into_iter()
-        .filter(|m| m.name() != TOP.name() && m.name() != outer.name())
+        .filter(|m| !tops.contains(&m.name()))
         .filter_map(|m| m.vectors())
         .collect();
     v.extend(TOP.vectors());
-    if outer.name() != TOP.name() {
-        v.extend(outer.vectors());
+    for (k, t) in [sample_top(cfg), top(cfg)].into_iter().enumerate() {
+        if !tops[..=k].contains(&t.name()) {
+            v.extend(t.vectors());
+        }
     }
     v
 }

@@ -264,11 +264,31 @@ pub trait Unit: Sync {
         None
     }
 
+    /// The sample stream at its ports, for a module that can be the design's top under the
+    /// bus slave (src/stages/rmap_bus): when a beat is accepted, when a result leaves, and the
+    /// frame's last flag if its ports carry one. None for a module that is never that.
+    fn stream(&self, _cfg: &Config) -> Option<Stream> {
+        None
+    }
+
     /// What each of its adder trees computes, from its plan: the specifications the formal
     /// proof of the multipliers checks the generated trees against (`rmapgen prove-mult`).
     fn trees(&self, _cfg: &Config) -> Vec<crate::hdl::tree_spec::TreeSpec> {
         Vec::new()
     }
+}
+
+/// A top's sample stream as Verilog expressions over its own ports ([`Unit::stream`]): the
+/// bus slave counts the beats in flight with them and finds the frame boundaries.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Stream {
+    /// High in a clock whose rising edge accepts a beat (one or more samples).
+    pub accept: String,
+    /// High in a clock whose rising edge takes a beat of results.
+    pub deliver: String,
+    /// The accepted beat's frame-last flag, when the ports carry one (`s_axis_tlast`); else
+    /// the bus top adds a port `last_i` for it.
+    pub last: Option<String>,
 }
 
 /// Accepted vectors before the mid-stream reset of a testbench.

@@ -300,6 +300,15 @@ impl Unit for RmapAxis {
         .render()
     }
 
+    /// A beat each way with its `tvalid && tready`; a frame ends with `s_axis_tlast`.
+    fn stream(&self, _cfg: &Config) -> Option<super::unit::Stream> {
+        Some(super::unit::Stream {
+            accept: "s_axis_tvalid && s_axis_tready".into(),
+            deliver: "m_axis_tvalid && m_axis_tready".into(),
+            last: Some("s_axis_tlast".into()),
+        })
+    }
+
     fn vectors(&self) -> Option<&dyn Vectors> {
         Some(self)
     }

@@ -427,6 +427,21 @@ impl Unit for RmapLanes {
         .render()
     }
 
+    /// A beat: a clock with any lane's valid bit (and `ready_o` with the handshake), in and
+    /// out; without the handshake the lanes run in step, so every beat in leaves as one beat.
+    fn stream(&self, cfg: &Config) -> Option<super::unit::Stream> {
+        let (accept, deliver) = if cfg.handshake {
+            ("|valid_i && ready_o", "|valid_o && ready_i")
+        } else {
+            ("|valid_i", "|valid_o")
+        };
+        Some(super::unit::Stream {
+            accept: accept.into(),
+            deliver: deliver.into(),
+            last: None,
+        })
+    }
+
     fn vectors(&self) -> Option<&dyn Vectors> {
         Some(self)
     }

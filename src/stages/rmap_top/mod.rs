@@ -265,6 +265,21 @@ impl Unit for RmapTop {
         .render()
     }
 
+    /// A sample is accepted with `valid_i` (and `ready_o` with the handshake); a result
+    /// leaves with `valid_o` (and `ready_i`).
+    fn stream(&self, cfg: &Config) -> Option<super::unit::Stream> {
+        let (accept, deliver) = if cfg.handshake {
+            ("valid_i && ready_o", "valid_o && ready_i")
+        } else {
+            ("valid_i", "valid_o")
+        };
+        Some(super::unit::Stream {
+            accept: accept.into(),
+            deliver: deliver.into(),
+            last: None,
+        })
+    }
+
     fn vectors(&self) -> Option<&dyn Vectors> {
         Some(self)
     }
