@@ -77,6 +77,11 @@ pub fn write_design(
     for (name, text) in hex_files(design) {
         write(name, &text)?;
     }
+    for m in stages::modules(cfg) {
+        for (name, text) in m.files(cfg)? {
+            write(name, &text)?;
+        }
+    }
     write(manifest::Core::new(cfg).file, &package::core(cfg)?)?;
     write(package::README_FILE.into(), &package::readme(design)?)?;
     files.push(manifest::FILE.to_string());

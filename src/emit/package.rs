@@ -155,6 +155,8 @@ struct Readme {
     axis: Option<AxisReadme>,
     /// The `## Lanes` section (`lanes` > 1 only).
     lanes: Option<LanesReadme>,
+    /// The sections of the design's modules ([`crate::stages::Unit::readme`]), in module order.
+    sections: Vec<String>,
 }
 
 /// What the README's `## Lanes` section prints: rmap_lanes' ports, the packing of the
@@ -461,6 +463,10 @@ pub fn readme(design: &Design) -> Result<String> {
         c_count: map_stream::c_count(cfg),
         axis: AxisReadme::new(cfg),
         lanes: LanesReadme::new(cfg),
+        sections: stages::modules(cfg)
+            .iter()
+            .filter_map(|m| m.readme(cfg))
+            .collect(),
     }
     .render()
     .context("cannot render templates/pkg/README.md")?;

@@ -259,6 +259,17 @@ pub trait Unit: Sync {
     /// The Verilog text (without the final newline).
     fn render(&self, cfg: &Config, head: Head) -> askama::Result<String>;
 
+    /// Files it adds to the design beside its Verilog, by name (the register block's C header,
+    /// driver, SystemRDL and Python views): `generate` writes them and the manifest lists them.
+    fn files(&self, _cfg: &Config) -> Result<Vec<(String, String)>> {
+        Ok(Vec::new())
+    }
+
+    /// A section of the design's README about it (Markdown, from its `## ` heading), if any.
+    fn readme(&self, _cfg: &Config) -> Option<String> {
+        None
+    }
+
     /// Its vectors and testbench, if it has them.
     fn vectors(&self) -> Option<&dyn Vectors> {
         None

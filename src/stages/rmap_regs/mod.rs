@@ -84,6 +84,14 @@ impl Unit for RmapRegs {
         Some(1)
     }
 
+    fn files(&self, cfg: &Config) -> anyhow::Result<Vec<(String, String)>> {
+        views::files(cfg)
+    }
+
+    fn readme(&self, cfg: &Config) -> Option<String> {
+        Some(views::readme_section(cfg))
+    }
+
     fn render(&self, cfg: &Config, h: Head) -> askama::Result<String> {
         let m = regmap(cfg);
         let a = cfg.map_addr_bits();
