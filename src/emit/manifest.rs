@@ -104,6 +104,10 @@ pub struct Manifest {
     /// (`lanes` > 1 only; absent without it).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lanes: Option<LanesInfo>,
+    /// The bus slave: its bus, the register map, the views' files and the vector file whose
+    /// samples its testbench streams (`bus` only; absent without it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bus: Option<crate::stages::rmap_bus::BusInfo>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -181,6 +185,7 @@ impl Manifest {
             vectors,
             axis: AxisInfo::new(cfg),
             lanes: LanesInfo::new(cfg),
+            bus: crate::stages::rmap_bus::BusInfo::new(cfg),
         }
     }
 

@@ -204,14 +204,21 @@ impl Report {
             "prove {} ({}, shard {}/{}, {}):\n",
             self.design, self.config_summary, self.shard.index, self.shard.count, self.mode
         );
-        if self.config.axis {
-            // What the verdict covers: the proof drives rmap_top, not the wrapper, and names
-            // what does check the wrapper (it does not run it).
+        let outer = crate::stages::top(&self.config);
+        if outer.name() != crate::stages::TOP.name() {
+            // What the verdict covers: the proof drives rmap_top, not the module around it
+            // (the AXI4-Stream wrapper, the bus slave), and names what does check that one
+            // (it does not run it).
+            let what = if self.config.bus.is_none() {
+                "the AXI4-Stream wrapper"
+            } else {
+                "the bus slave"
+            };
             s += &format!(
-                "  scope             {} inside {} (the proof does not drive the AXI4-Stream wrapper: {} checks it)\n",
+                "  scope             {} inside {} (the proof does not drive {what}: {} checks it)\n",
                 crate::stages::TOP.module(&self.config),
-                crate::stages::top(&self.config).module(&self.config),
-                crate::stages::rmap_axis::checked_by(&self.config)
+                outer.module(&self.config),
+                crate::stages::checked_by(&self.config)
             );
         }
         for p in &self.parts {

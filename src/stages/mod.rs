@@ -63,6 +63,17 @@ pub fn top(cfg: &Config) -> &'static dyn Unit {
     }
 }
 
+/// What checks the design's top when it is not [`TOP`] (the AXI4-Stream wrapper, the bus
+/// slave), which `rmapgen prove` does not drive (it proves the [`TOP`] inside; its scope line
+/// says so with this): the top's testbench, which `rmapgen sim` runs.
+pub fn checked_by(cfg: &Config) -> String {
+    let outer = top(cfg);
+    let tb = outer
+        .vectors()
+        .map_or_else(|| outer.file(cfg), |v| v.testbench_file(cfg));
+    format!("its testbench {tb}, run by `rmapgen sim`")
+}
+
 /// The outermost module of the sample stream: [`rmap_axis::RmapAxis`] (which instantiates
 /// [`TOP`]) with `axis`, [`rmap_lanes::RmapLanes`] (one [`TOP`] per lane) with `lanes` > 1,
 /// else [`TOP`]. It has the host write port; the design's [`top`] unless a bus slave drives

@@ -3,6 +3,7 @@
 mod alloc;
 mod axis;
 mod bench;
+mod bus;
 
 mod cmd_render;
 mod cmd_sim;

@@ -52,7 +52,8 @@ fn committed_rtl_out_is_what_the_default_generates() {
 /// Golden output beyond the default design: each directory under `golden/` is generated from
 /// the `tb/config.toml` it holds (`make golden` regenerates them all), so a change to the
 /// generator shows up as a diff in the handshake top, a design without the interpolator and
-/// one with the colour multiplier, not only in `rtl_out/`.
+/// one with the colour multiplier, the bus slaves with their register views (C, SystemRDL,
+/// Python), not only in `rtl_out/`.
 #[test]
 fn committed_golden_designs_are_what_their_configs_generate() {
     let golden = helpers::root().join("golden");
@@ -66,7 +67,17 @@ fn committed_golden_designs_are_what_their_configs_generate() {
         .iter()
         .map(|d| d.file_name().unwrap().to_string_lossy().into_owned())
         .collect();
-    assert_eq!(names, ["color", "handshake", "ice40", "no_interpolation"]);
+    assert_eq!(
+        names,
+        [
+            "bus_axi4_lite",
+            "bus_wishbone",
+            "color",
+            "handshake",
+            "ice40",
+            "no_interpolation"
+        ]
+    );
     let t = helpers::tempdir();
     for dir in &dirs {
         let fresh = t.path().join(dir.file_name().unwrap());

@@ -198,16 +198,6 @@ fn connections(cfg: &Config) -> (Vec<(&'static str, String)>, Vec<Port>) {
     (pins, through)
 }
 
-/// What checks the wrapper itself, which `rmapgen prove` does not drive (it proves the top
-/// inside; its scope line says so with this): the wrapper's testbench, which `rmapgen sim`
-/// runs.
-pub fn checked_by(cfg: &Config) -> String {
-    format!(
-        "its testbench {}, run by `rmapgen sim`",
-        RmapAxis.testbench_file(cfg)
-    )
-}
-
 /// The top's instance name, `u_rmap_top`.
 fn instance() -> String {
     format!("u_{}", RmapTop.name())

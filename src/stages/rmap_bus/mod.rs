@@ -64,6 +64,44 @@ fn bus_ports(cfg: &Config) -> Vec<Port> {
     }
 }
 
+/// What the manifest says about the bus slave (`bus` only): the bus, the register map as
+/// data, the files of its views, and the vector file (with its fields) that the testbench
+/// streams, for the cocotb test (tb/cocotb/test_bus.py) and the LiteX core.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct BusInfo {
+    pub kind: &'static str,
+    pub regmap: super::rmap_regs::RegMap,
+    /// Clocks one access takes at the least through the bus front.
+    pub clocks_per_access: u32,
+    /// `<prefix>rmap_regs.h`, `.rdl`, `.py`, the driver's `.h` and `.c`.
+    pub files: Vec<String>,
+    /// The port that marks a frame's last sample (`last_i`, or `s_axis_tlast`).
+    pub last: String,
+    pub vectors: String,
+    pub vector_fields: Vec<&'static str>,
+}
+
+impl BusInfo {
+    pub fn new(cfg: &Config) -> Option<BusInfo> {
+        use super::Vectors;
+        if cfg.bus == Bus::None {
+            return None;
+        }
+        let files = super::rmap_regs::views::files(cfg)
+            .map(|v| v.into_iter().map(|(n, _)| n).collect())
+            .unwrap_or_default();
+        Some(BusInfo {
+            kind: cfg.bus.name(),
+            regmap: regmap(cfg),
+            clocks_per_access: super::rmap_regs::views::clocks_per_access(cfg.bus),
+            files,
+            last: stream(cfg).last.unwrap_or_else(|| "last_i".into()),
+            vectors: RmapBus.vector_file(cfg),
+            vector_fields: RmapBus.fields(cfg).iter().map(|f| f.name).collect(),
+        })
+    }
+}
+
 /// The sample top's stream ([`Unit::stream`]).
 fn stream(cfg: &Config) -> super::Stream {
     let inner = super::sample_top(cfg);

@@ -42,6 +42,7 @@
   localparam [31:0] SWAP         = 32'h{= "{:x}"|format(swap_mask) =};
   localparam [31:0] SWAP_PENDING = 32'h{= "{:x}"|format(pending_mask) =};
   localparam POLLS      = 1000;  // STATUS reads before the swap counts as lost
+  localparam BUS_WAIT   = 4 * TIMEOUT;  // clocks an access may wait for its answer
   // The register checks, in order: a write or a read, its word address, data and byte
   // enables, whether it must be refused, and the read data expected under a mask.
   reg          c_we [0:NCHECKS-1];
@@ -60,6 +61,7 @@
   reg [2:0]    op_kind;  // 0 a check, 1 a map write, 2 the swap request, 3 a STATUS poll, 4 FRAMES
   reg          want_swap, swap_asked, swap_seen;
   integer      polls;
+  integer      op_clocks;  // clocks the access in progress has waited
 {%- if !wishbone %}
   reg [1:0]    ax_phase;  // 0 address offered, 1 taken at the last edge, 2 awaiting the response
 {%- endif %}
@@ -72,6 +74,7 @@
     input [3:0]    be;
     begin
       op_active = 1'b1;
+      op_clocks = 0;
       op_we = we;
       op_adr = adr;
       op_dat = dat;
@@ -121,6 +124,11 @@
   task bus_clock;
     begin
       ended = 1'b0;
+      if (op_active) begin
+        op_clocks = op_clocks + 1;
+        if (op_clocks > BUS_WAIT)
+          $fatal(1, "a bus access not answered in %0d clocks: %0s word %0d", BUS_WAIT, op_we ? "write" : "read", op_adr);
+      end
 {%- if wishbone %}
       if (wb_ack_o === 1'b1 && wb_err_o === 1'b1) protocol_error("wb_ack_o and wb_err_o together");
       if (!op_active && (wb_ack_o !== 1'b0 || wb_err_o !== 1'b0)) protocol_error("wb_ack_o or wb_err_o without an access");
