@@ -83,7 +83,7 @@ fn the_bus_testbench_passes_and_fails_on_each_planted_fault() {
                 "an error answered as an ack",
                 "assign wb_err_o = ack && err;",
                 "assign wb_err_o = 1'b0;",
-                "REGISTER check",
+                "a bus access not answered",
             ),
         ),
         (
