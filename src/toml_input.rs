@@ -433,7 +433,7 @@ mod tests {
         );
         assert_eq!(
             err("v = 1 2\n"),
-            "scene s.toml:1:7: v: unexpected content, expected nothing"
+            "scene s.toml:1:5: v: string values must be quoted, expected literal string"
         );
         // In a header or a key: no key named.
         assert_eq!(
@@ -442,7 +442,7 @@ mod tests {
         );
         assert_eq!(
             err("[t]\nb c = 1\n"),
-            "scene s.toml:2:3: unexpected content, expected nothing"
+            "scene s.toml:2:3: key with no value, expected `=`"
         );
         // Quoted and dotted keys as written, without quotes or spaces.
         assert_eq!(

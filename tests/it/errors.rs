@@ -60,11 +60,15 @@ fn render_sphere(scene: &str, dir: &Path, name: &str) -> (Vec<u8>, Vec<u8>, serd
 #[test]
 fn huge_light_directions_give_the_image_of_the_unit_direction() {
     let t = tempdir();
-    let none = render_sphere(
-        &scene_with_lights(t.path(), "none.toml", &[]),
-        t.path(),
-        "n",
-    );
+    // No light: the ambient term alone, said as a light of intensity 0 (a scene without any
+    // [[light]] is refused).
+    let ambient = t.path().join("none.toml");
+    std::fs::write(
+        &ambient,
+        format!("{MATERIAL}[[light]]\ndirection = [0.0, 0.0, 1.0]\nintensity = 0.0\n"),
+    )
+    .unwrap();
+    let none = render_sphere(ambient.to_str().unwrap(), t.path(), "n");
     for (huge, unit) in [
         ("1e200, 0.0, 0.0", "1.0, 0.0, 0.0"),
         ("1e308, 1e308, 1e308", "1.0, 1.0, 1.0"),
