@@ -789,6 +789,18 @@ impl Config {
     }
 }
 
+/// Eight hex digits naming a configuration: the low 32 bits of the 64-bit FNV-1a hash of
+/// its TOML (what `tb/config.toml` holds, prefix included). Stable across runs, machines
+/// and rmapgen versions as long as the configuration's fields are; the scene (the maps'
+/// initial contents) is data, not configuration, and is not part of it.
+pub fn config_hash(cfg: &Config) -> String {
+    let text = toml::to_string(cfg).expect("a Config serialises");
+    let h = text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
+    });
+    format!("{:08x}", h as u32)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

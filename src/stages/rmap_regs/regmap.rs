@@ -195,12 +195,12 @@ pub fn rmapgen_version() -> (u32, u32, u32) {
     )
 }
 
-/// The configuration hash CFG_HASH holds: the manifest's [`config_hash`] (the FuseSoC
-/// core's name carries the same eight hex digits).
+/// The configuration hash CFG_HASH holds: [`config_hash`] (the manifest and the FuseSoC
+/// core's name carry the same eight hex digits).
 ///
-/// [`config_hash`]: crate::emit::manifest::config_hash
+/// [`config_hash`]: crate::config::config_hash
 pub fn cfg_hash(cfg: &Config) -> u32 {
-    u32::from_str_radix(&crate::emit::manifest::config_hash(cfg), 16).expect("eight hex digits")
+    u32::from_str_radix(&crate::config::config_hash(cfg), 16).expect("eight hex digits")
 }
 
 fn field(name: &'static str, lsb: u32, bits: u32, source: Source, doc: impl Into<String>) -> Field {

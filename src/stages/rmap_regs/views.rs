@@ -5,8 +5,8 @@
 //! Python names, so that two designs can live in one program.
 
 use super::regmap::{regmap, Access, RegMap, Source, MAGIC, REGMAP_VERSION};
+use crate::config::config_hash;
 use crate::config::Config;
-use crate::emit::manifest::config_hash;
 use crate::stages::Unit;
 use anyhow::Result;
 use askama::Template;
